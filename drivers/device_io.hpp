@@ -1,0 +1,33 @@
+// The hardware seam. Everything above this interface is the code that runs on the SBC;
+// below it is either the kernel (LinuxDeviceIo) or caracara-sim (SimDeviceIo), which
+// receives the very i2c_msg / spi_ioc_transfer arrays the driver built.
+#pragma once
+
+#include <memory>
+#include <string>
+
+namespace caracara {
+
+class DeviceIo {
+public:
+    virtual ~DeviceIo() = default;
+    // Each returns >= 0 on success or -errno, never touching the global errno contract.
+    virtual int open(const char* path, int flags) = 0;
+    // `arg` is what the kernel's ioctl(2) would receive: a pointer for pointer ioctls,
+    // the value cast to a pointer for value ioctls (I2C_TIMEOUT, I2C_RETRIES).
+    virtual int ioctl(int fd, unsigned long request, void* arg) = 0;
+    virtual int close(int fd) = 0;
+};
+
+class LinuxDeviceIo final : public DeviceIo {
+public:
+    int open(const char* path, int flags) override;
+    int ioctl(int fd, unsigned long request, void* arg) override;
+    int close(int fd) override;
+};
+
+// Parses a --hardware=linux|sim:SOCKET argument. Returns nullptr and sets `error` on a bad spec
+// or when the simulator cannot be reached.
+std::unique_ptr<DeviceIo> make_device_io(const std::string& spec, std::string& error);
+
+} // namespace caracara

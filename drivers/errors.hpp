@@ -1,0 +1,26 @@
+// Typed device errors: what a transfer failure means on this hardware, mapped from errno
+// the way the Linux i2c/spi bus drivers report it (see DESIGN.md "Protocol facts").
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace caracara {
+
+enum class IoError {
+    None = 0,
+    Nack,          // EREMOTEIO / ENXIO: no ACK from the slave (absent, busy, or unpowered)
+    Timeout,       // ETIMEDOUT: the controller gave up on the transfer
+    ClockStretch,  // EIO: clock-stretch timeout or bus error (a stuck line looks like this)
+    Arbitration,   // EAGAIN: arbitration lost
+    NoDevice,      // ENOENT / ENODEV: the device node or adapter is gone (driver unbound)
+    BadReply,      // the reply arrived but its first byte or checksum was wrong
+    Unsupported,   // the adapter lacks a required functionality (I2C_FUNCS) or ioctl
+    Other,
+};
+
+IoError io_error_from_errno(int err);   // err is positive errno
+std::string_view io_error_name(IoError e);
+std::string errno_name(int err);       // "ETIMEDOUT (Connection timed out)"
+
+} // namespace caracara
