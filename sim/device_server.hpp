@@ -1,0 +1,56 @@
+// Serves the device protocol (drivers/sim_protocol.hpp) on a Unix SOCK_SEQPACKET socket:
+// the simulator's stand-in for the kernel's i2c-dev and spidev.
+#pragma once
+
+#include "sdbus.hpp"
+#include "vehicle.hpp"
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace caracara::sim {
+
+class DeviceServer {
+public:
+    DeviceServer(sd_event* event, SimVehicle& vehicle) : event_(event), vehicle_(vehicle) {}
+    ~DeviceServer();
+    int listen(const std::string& path); // -errno
+    uint64_t bad_requests() const { return bad_requests_; }
+    size_t clients() const { return clients_.size(); }
+
+private:
+    struct Handle {
+        SimVehicle::NodeKind kind;
+        std::string path;
+    };
+    struct Client {
+        DeviceServer* server = nullptr;
+        int fd = -1;
+        dbus::SourcePtr io;
+        dbus::SourcePtr reply_timer;
+        std::map<int, Handle> handles;
+        int next_handle = 3;
+        std::vector<uint8_t> reply;
+    };
+
+    static int on_accept(sd_event_source*, int fd, uint32_t, void* userdata);
+    static int on_client(sd_event_source*, int fd, uint32_t revents, void* userdata);
+    static int on_reply_due(sd_event_source*, uint64_t, void* userdata);
+    void drop(Client* c);
+    // Builds the reply into c.reply; returns the wire time the request occupied.
+    uint64_t handle(Client& c, std::span<const uint8_t> req);
+    void send_reply(Client& c);
+
+    sd_event* event_;
+    SimVehicle& vehicle_;
+    int listen_fd_ = -1;
+    std::string path_;
+    dbus::SourcePtr accept_source_;
+    std::map<Client*, std::unique_ptr<Client>> clients_;
+    uint64_t bad_requests_ = 0;
+};
+
+} // namespace caracara::sim

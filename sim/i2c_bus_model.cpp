@@ -1,0 +1,90 @@
+#include "i2c_bus_model.hpp"
+
+#include <cerrno>
+#include <linux/i2c.h>
+
+namespace caracara::sim {
+
+void Pca9544::on_write(std::span<const uint8_t> data, uint64_t) {
+    if (!data.empty())
+        control_ = static_cast<uint8_t>(data.back() & 0x07);
+}
+
+void Pca9544::on_read(std::span<uint8_t> out, uint64_t) {
+    for (auto& b : out)
+        b = control_;
+}
+
+std::optional<uint8_t> Pca9544::selected() const {
+    if (!(control_ & 0x04))
+        return std::nullopt;
+    return static_cast<uint8_t>(control_ & 0x03);
+}
+
+void I2cBusModel::add_mux(uint16_t addr7) {
+    if (!muxes_.count(addr7))
+        muxes_[addr7] = std::make_unique<Pca9544>();
+}
+
+void I2cBusModel::attach(I2cSlave* slave, uint16_t addr7, std::optional<uint16_t> mux_addr, uint8_t channel) {
+    if (mux_addr)
+        add_mux(*mux_addr);
+    slaves_.push_back({slave, addr7, mux_addr, channel});
+}
+
+I2cSlave* I2cBusModel::find(uint16_t addr7) const {
+    if (auto it = muxes_.find(addr7); it != muxes_.end())
+        return it->second.get();
+    for (const auto& a : slaves_) {
+        if (a.addr7 != addr7)
+            continue;
+        if (!a.mux)
+            return a.slave;
+        auto sel = muxes_.at(*a.mux)->selected();
+        if (sel && *sel == a.channel)
+            return a.slave;
+    }
+    return nullptr;
+}
+
+I2cBusModel::Result I2cBusModel::transfer(std::vector<I2cMessage>& msgs, uint64_t start_ns) {
+    ++transactions_;
+    const uint64_t txn = log_.new_transaction();
+    const uint64_t bit = bit_time_ns();
+    uint64_t t = start_ns;
+    Result res{static_cast<int>(msgs.size()), 0};
+    for (auto& m : msgs) {
+        const bool read = m.flags & I2C_M_RD;
+        WireEntry e;
+        e.transaction = txn;
+        e.bus = "i2c";
+        e.addr = m.addr;
+        e.read = read;
+        t += bit;     // (repeated) START
+        t += 9 * bit; // address byte + ACK slot
+        I2cSlave* s = (m.flags & I2C_M_TEN) ? nullptr : find(m.addr);
+        if (!s || !s->ack_address(read)) {
+            // No ACK to the address: the controller sends STOP and i2c-dev reports EREMOTEIO.
+            e.result = "nack";
+            e.time_ns = t;
+            log_.append(std::move(e));
+            res.ret = -EREMOTEIO;
+            break;
+        }
+        t += 9 * bit * m.data.size();
+        if (read)
+            s->on_read(m.data, t);
+        else
+            s->on_write(m.data, t);
+        e.data = m.data;
+        e.result = "ack";
+        e.time_ns = t;
+        log_.append(std::move(e));
+    }
+    t += bit; // STOP
+    res.wire_ns = t - start_ns;
+    wire_time_ns_ += res.wire_ns;
+    return res;
+}
+
+} // namespace caracara::sim

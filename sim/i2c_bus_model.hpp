@@ -1,0 +1,74 @@
+// The simulated I2C bus: slaves by 7-bit address, PCA9544A multiplexers in front of some of
+// them, wire time at the configured clock, and the wire log. One call = one I2C_RDWR.
+#pragma once
+
+#include "slave.hpp"
+#include "wire_log.hpp"
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace caracara::sim {
+
+struct I2cMessage {
+    uint16_t addr = 0;
+    uint16_t flags = 0;         // I2C_M_RD etc.
+    std::vector<uint8_t> data;  // write payload, or the read buffer (sized to len)
+};
+
+// PCA9544A: one control byte, bit 2 enables, bits 0-1 pick the downstream channel.
+class Pca9544 final : public I2cSlave {
+public:
+    bool ack_address(bool) override { return true; }
+    void on_write(std::span<const uint8_t> data, uint64_t) override;
+    void on_read(std::span<uint8_t> out, uint64_t) override;
+    std::optional<uint8_t> selected() const;
+    uint8_t control() const { return control_; }
+
+private:
+    uint8_t control_ = 0; // power-on: no channel selected
+};
+
+class I2cBusModel {
+public:
+    I2cBusModel(WireLog& log, uint32_t clock_hz) : log_(log), clock_hz_(clock_hz) {}
+
+    void add_mux(uint16_t addr7);
+    // A slave directly on the bus (no mux) or behind channel `channel` of the mux at mux_addr.
+    void attach(I2cSlave* slave, uint16_t addr7, std::optional<uint16_t> mux_addr = {}, uint8_t channel = 0);
+
+    struct Result {
+        int ret = 0;          // number of messages, or -errno as i2c-dev would return
+        uint64_t wire_ns = 0; // time the transaction occupies the wire
+    };
+    // `start_ns` is when the transaction begins on the wire; log entries are stamped with
+    // the end of each message.
+    Result transfer(std::vector<I2cMessage>& msgs, uint64_t start_ns);
+
+    uint32_t clock_hz() const { return clock_hz_; }
+    void set_clock_hz(uint32_t hz) { clock_hz_ = hz; }
+    uint64_t transactions() const { return transactions_; }
+    uint64_t wire_time_ns() const { return wire_time_ns_; }
+    uint64_t bit_time_ns() const { return 1000000000ull / clock_hz_; }
+
+private:
+    I2cSlave* find(uint16_t addr7) const;
+
+    WireLog& log_;
+    uint32_t clock_hz_;
+    uint64_t transactions_ = 0;
+    uint64_t wire_time_ns_ = 0;
+    std::map<uint16_t, std::unique_ptr<Pca9544>> muxes_;
+    struct Attached {
+        I2cSlave* slave;
+        uint16_t addr7;
+        std::optional<uint16_t> mux;
+        uint8_t channel;
+    };
+    std::vector<Attached> slaves_;
+};
+
+} // namespace caracara::sim

@@ -1,0 +1,164 @@
+// caracara-sim: plays the Caracara vehicle's hardware for caracarad (device protocol on a
+// Unix socket) and for people and tests (org.caracara.Simulator1 on D-Bus).
+#include "device_server.hpp"
+#include "errors.hpp"
+#include "inspect.hpp"
+#include "sdbus.hpp"
+#include "sim_config.hpp"
+#include "vehicle.hpp"
+
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <systemd/sd-daemon.h>
+#include <ctime>
+
+using namespace caracara;
+using namespace caracara::sim;
+
+namespace {
+
+void usage(FILE* f) {
+    std::fputs("Usage: caracara-sim [OPTIONS]\n"
+               "Simulated Caracara vehicle: serves the device protocol for caracarad --hardware=sim:SOCKET.\n\n"
+               "  --socket PATH         device socket to serve (default /run/caracara/sim.sock)\n"
+               "  --config FILE         vehicle description (TOML; [i2c], [spi], [[thruster]], [sim])\n"
+               "  --system              inspection API on the system bus\n"
+               "  --user                inspection API on the user bus (default)\n"
+               "  --bus-address ADDR    inspection API on the bus at ADDR\n"
+               "  --no-dbus             no inspection API\n"
+               "  --realistic-timing    really wait the wire time of every transaction\n"
+               "  --clock-hz HZ         I2C clock (default 100000)\n"
+               "  --physics-hz HZ       model update rate (default 100)\n"
+               "  -h, --help            this text\n",
+               f);
+}
+
+struct Physics {
+    SimVehicle* vehicle;
+    uint64_t last_us = 0;
+    uint64_t period_us = 10000;
+};
+
+int on_physics(sd_event_source* s, uint64_t usec, void* userdata) {
+    auto* p = static_cast<Physics*>(userdata);
+    const double dt = p->last_us ? static_cast<double>(usec - p->last_us) / 1e6 : 0.0;
+    p->last_us = usec;
+    p->vehicle->step(dt, usec * 1000);
+    sd_event_source_set_time(s, usec + p->period_us);
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::string socket_path = "/run/caracara/sim.sock";
+    std::string config_path;
+    dbus::BusChoice bus_choice{dbus::BusChoice::Kind::User, {}};
+    bool use_dbus = true;
+    int realistic = -1;
+    long clock_hz = 0;
+    long physics_hz = 100;
+
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto value = [&](const char* name) -> std::string {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "caracara-sim: %s needs a value\n", name);
+                std::exit(2);
+            }
+            return argv[++i];
+        };
+        if (a == "--socket") socket_path = value("--socket");
+        else if (a == "--config") config_path = value("--config");
+        else if (a == "--system") bus_choice = {dbus::BusChoice::Kind::System, {}};
+        else if (a == "--user") bus_choice = {dbus::BusChoice::Kind::User, {}};
+        else if (a == "--bus-address") bus_choice = {dbus::BusChoice::Kind::Address, value("--bus-address")};
+        else if (a == "--no-dbus") use_dbus = false;
+        else if (a == "--realistic-timing") realistic = 1;
+        else if (a == "--clock-hz") clock_hz = std::strtol(value("--clock-hz").c_str(), nullptr, 10);
+        else if (a == "--physics-hz") physics_hz = std::strtol(value("--physics-hz").c_str(), nullptr, 10);
+        else if (a == "-h" || a == "--help") { usage(stdout); return 0; }
+        else {
+            std::fprintf(stderr, "caracara-sim: unknown option '%s'\n", a.c_str());
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (physics_hz < 1 || physics_hz > 10000) {
+        std::fprintf(stderr, "caracara-sim: --physics-hz must be 1..10000\n");
+        return 2;
+    }
+
+    SimConfig cfg = default_sim_config();
+    std::string err;
+    if (!config_path.empty() && !load_sim_config(config_path, cfg, err)) {
+        std::fprintf(stderr, "caracara-sim: %s\n", err.c_str());
+        return 1;
+    }
+    if (realistic >= 0)
+        cfg.realistic_timing = realistic;
+    if (clock_hz) {
+        if (clock_hz < 1000 || clock_hz > 3400000) {
+            std::fprintf(stderr, "caracara-sim: --clock-hz must be 1000..3400000\n");
+            return 2;
+        }
+        cfg.i2c_clock_hz = static_cast<uint32_t>(clock_hz);
+    }
+
+    SimVehicle vehicle(cfg);
+
+    sd_event* ev_raw = nullptr;
+    if (int r = sd_event_default(&ev_raw); r < 0) {
+        std::fprintf(stderr, "caracara-sim: sd_event: %s\n", errno_name(-r).c_str());
+        return 1;
+    }
+    dbus::EventPtr event(ev_raw);
+    sigset_t ss;
+    sigemptyset(&ss);
+    sigaddset(&ss, SIGTERM);
+    sigaddset(&ss, SIGINT);
+    sigprocmask(SIG_BLOCK, &ss, nullptr);
+    sd_event_add_signal(event.get(), nullptr, SIGTERM, nullptr, nullptr);
+    sd_event_add_signal(event.get(), nullptr, SIGINT, nullptr, nullptr);
+
+    DeviceServer server(event.get(), vehicle);
+    if (int r = server.listen(socket_path); r < 0) {
+        std::fprintf(stderr, "caracara-sim: cannot listen on %s: %s\n", socket_path.c_str(), errno_name(-r).c_str());
+        return 1;
+    }
+
+    dbus::BusPtr bus;
+    std::unique_ptr<Inspector> inspector;
+    if (use_dbus) {
+        if (int r = dbus::open_bus(bus_choice, "caracara-sim", bus); r < 0) {
+            std::fprintf(stderr, "caracara-sim: cannot connect to %s: %s\n", bus_choice.describe().c_str(),
+                         errno_name(-r).c_str());
+            return 1;
+        }
+        inspector = std::make_unique<Inspector>(bus.get(), vehicle, server);
+        if (int r = inspector->start(); r < 0) {
+            std::fprintf(stderr, "caracara-sim: cannot publish org.caracara.Simulator1: %s\n", errno_name(-r).c_str());
+            return 1;
+        }
+        sd_bus_attach_event(bus.get(), event.get(), SD_EVENT_PRIORITY_NORMAL);
+    }
+
+    Physics physics{&vehicle, 0, static_cast<uint64_t>(1000000 / physics_hz)};
+    uint64_t now_us = 0;
+    sd_event_now(event.get(), CLOCK_MONOTONIC, &now_us);
+    sd_event_source* phys = nullptr;
+    sd_event_add_time(event.get(), &phys, CLOCK_MONOTONIC, now_us, 0, on_physics, &physics);
+    sd_event_source_set_enabled(phys, SD_EVENT_ON);
+    dbus::SourcePtr phys_guard(phys);
+
+    std::printf("caracara-sim: %zu thrusters on %s at %u Hz%s; device socket %s\n", vehicle.thrusters().size(),
+                vehicle.i2c_path().c_str(), vehicle.i2c().clock_hz(),
+                vehicle.realistic_timing() ? " (realistic timing)" : "", socket_path.c_str());
+    std::fflush(stdout);
+    sd_notify(0, "READY=1\nSTATUS=Simulating the vehicle");
+
+    int r = sd_event_loop(event.get());
+    return r < 0 ? 1 : 0;
+}

@@ -1,0 +1,119 @@
+#include "sim_config.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace caracara::sim {
+
+SimConfig default_sim_config() {
+    SimConfig c;
+    // Same default vehicle as caracarad: eight SeaBotix controllers at distinct even addresses.
+    for (int mt : {0x52, 0x56, 0x58, 0x5A, 0x5C, 0x5E, 0x60, 0x62}) {
+        ThrusterSpec s;
+        s.mt = static_cast<uint8_t>(mt);
+        c.thrusters.push_back(s);
+    }
+    return c;
+}
+
+namespace {
+template <typename T>
+bool get_int(const toml::table& t, const char* key, const std::string& where, T lo, T hi, T& out, std::string& err) {
+    auto node = t.get(key);
+    if (!node)
+        return true;
+    auto v = node->value<int64_t>();
+    if (!v || *v < lo || *v > hi) {
+        err = where + key + ": must be an integer between " + std::to_string(lo) + " and " + std::to_string(hi);
+        return false;
+    }
+    out = static_cast<T>(*v);
+    return true;
+}
+} // namespace
+
+bool parse_sim_config(const std::string& text, SimConfig& out, std::string& error) {
+    toml::table root;
+    try {
+        root = toml::parse(text);
+    } catch (const toml::parse_error& e) {
+        std::ostringstream os;
+        os << "line " << e.source().begin.line << ": " << e.description();
+        error = os.str();
+        return false;
+    }
+    SimConfig c = default_sim_config();
+    if (auto i2c = root["i2c"].as_table()) {
+        if (auto d = (*i2c)["device"].value<std::string>())
+            c.i2c_device = *d;
+        if (!get_int<uint32_t>(*i2c, "clock_hz", "i2c.", 1000, 3400000, c.i2c_clock_hz, error))
+            return false;
+    }
+    if (auto sim = root["sim"].as_table()) {
+        if (auto rt = (*sim)["realistic_timing"].value<bool>())
+            c.realistic_timing = *rt;
+    }
+    if (auto spi = root["spi"].as_table()) {
+        if (auto d = (*spi)["device"].value<std::string>())
+            c.spi_device = *d;
+    }
+    if (auto arr = root["thruster"].as_array()) {
+        c.thrusters.clear();
+        for (size_t i = 0; i < arr->size(); ++i) {
+            auto t = (*arr)[i].as_table();
+            const std::string where = "thruster[" + std::to_string(i) + "].";
+            if (!t) {
+                error = where + ": must be a table";
+                return false;
+            }
+            ThrusterSpec s;
+            if (!get_int<uint8_t>(*t, "address", where, 0x10, 0xEE, s.mt, error))
+                return false;
+            if (s.mt & 1) {
+                error = where + "address: must be the even write address byte";
+                return false;
+            }
+            if (auto v = (*t)["variant"].value<std::string>()) {
+                if (*v == "seabotix")
+                    s.variant = ThrusterVariant::SeaBotix;
+                else if (*v == "legacy")
+                    s.variant = ThrusterVariant::Legacy;
+                else {
+                    error = where + "variant: must be \"seabotix\" or \"legacy\"";
+                    return false;
+                }
+            }
+            uint16_t mux = 0;
+            if (t->contains("mux_address")) {
+                if (!get_int<uint16_t>(*t, "mux_address", where, 0x70, 0x77, mux, error))
+                    return false;
+                s.mux_addr = mux;
+            }
+            if (!get_int<uint8_t>(*t, "mux_channel", where, 0, 3, s.mux_channel, error))
+                return false;
+            if (auto b = (*t)["brushless"].value<bool>())
+                s.brushless = *b;
+            c.thrusters.push_back(s);
+        }
+    }
+    out = std::move(c);
+    return true;
+}
+
+bool load_sim_config(const std::string& path, SimConfig& out, std::string& error) {
+    std::ifstream f(path);
+    if (!f) {
+        error = "cannot read " + path;
+        return false;
+    }
+    std::stringstream ss;
+    ss << f.rdbuf();
+    if (!parse_sim_config(ss.str(), out, error)) {
+        error = path + ": " + error;
+        return false;
+    }
+    return true;
+}
+
+} // namespace caracara::sim

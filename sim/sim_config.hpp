@@ -1,0 +1,26 @@
+// caracara-sim's description of the vehicle it plays: device nodes, bus clock, thrusters.
+// The [[thruster]] tables use the same keys as caracarad.toml so one file can describe both.
+#pragma once
+
+#include "thruster_model.hpp"
+
+#include <string>
+#include <vector>
+
+namespace caracara::sim {
+
+struct SimConfig {
+    std::string i2c_device = "/dev/i2c-1";
+    uint32_t i2c_clock_hz = 100000;
+    bool realistic_timing = false;
+    std::string spi_device = "/dev/spidev0.0";
+    std::vector<ThrusterSpec> thrusters;
+};
+
+SimConfig default_sim_config();
+// Parses a TOML file; returns false with a message naming the key on error. Keys of
+// caracarad.toml that do not concern the simulator are ignored.
+bool load_sim_config(const std::string& path, SimConfig& out, std::string& error);
+bool parse_sim_config(const std::string& text, SimConfig& out, std::string& error);
+
+} // namespace caracara::sim

@@ -1,0 +1,41 @@
+// The simulator's wire log: every I2C message (and SPI frame) with its monotonic
+// timestamp, in a bounded ring so a long run cannot eat memory.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+namespace caracara::sim {
+
+struct WireEntry {
+    uint64_t index = 0;        // monotonic, never reused
+    uint64_t time_ns = 0;      // CLOCK_MONOTONIC at the end of the message on the wire
+    uint64_t transaction = 0;  // messages of one I2C_RDWR share this
+    std::string bus;           // "i2c" or "spi"
+    uint16_t addr = 0;         // 7-bit I2C address (SPI: chip select)
+    bool read = false;
+    std::vector<uint8_t> data; // bytes after the address byte (SPI: MOSI bytes)
+    std::vector<uint8_t> miso; // SPI only: what the slave shifted out
+    std::string result;        // "ack", "nack", "bus-hung", "ok", "no-device"...
+};
+
+class WireLog {
+public:
+    explicit WireLog(size_t capacity = 200000) : capacity_(capacity) {}
+    uint64_t append(WireEntry e);
+    uint64_t new_transaction() { return ++transaction_; }
+    // Entries with index >= since, oldest first.
+    std::vector<const WireEntry*> since(uint64_t since_index) const;
+    uint64_t next_index() const { return next_; }
+    void clear() { entries_.clear(); }
+
+private:
+    size_t capacity_;
+    uint64_t next_ = 1;
+    uint64_t transaction_ = 0;
+    std::deque<WireEntry> entries_;
+};
+
+} // namespace caracara::sim

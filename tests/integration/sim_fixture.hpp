@@ -1,0 +1,75 @@
+// Integration-test fixture: a private dbus-daemon and a real caracara-sim process, plus
+// small sd-bus helpers to read the simulator's inspection API. Nothing here is mocked.
+#pragma once
+
+#include "sdbus.hpp"
+
+#include <cstdint>
+#include <string>
+#include <sys/types.h>
+#include <vector>
+
+namespace caracara::test {
+
+class Process {
+public:
+    Process() = default;
+    Process(const Process&) = delete;
+    Process& operator=(const Process&) = delete;
+    ~Process() { stop(); }
+    // Starts argv[0] with the given arguments; stdout/stderr go to `log_path`.
+    void start(const std::vector<std::string>& argv, const std::string& log_path);
+    void stop(int sig = 15);    // signal, then wait
+    int wait_exit(int timeout_ms); // exit status, or -1 if still running
+    bool running();
+    pid_t pid() const { return pid_; }
+
+private:
+    pid_t pid_ = -1;
+};
+
+struct WireEntry {
+    uint64_t index, time_ns, transaction;
+    std::string bus;
+    uint16_t addr;
+    bool read;
+    std::vector<uint8_t> data, miso;
+    std::string result;
+};
+
+class SimFixture {
+public:
+    // Starts a private bus and caracara-sim with `sim_args` appended (e.g. --config FILE).
+    explicit SimFixture(const std::vector<std::string>& sim_args = {});
+    ~SimFixture();
+
+    const std::string& dir() const { return dir_; }
+    const std::string& socket() const { return socket_; }
+    std::string bus_address() const { return "unix:path=" + dir_ + "/bus"; }
+    sd_bus* bus() { return bus_.get(); }
+    std::string write_file(const std::string& name, const std::string& text);
+
+    // Inspection API helpers (throw std::runtime_error on D-Bus errors).
+    std::string thruster_path(unsigned i) const { return "/org/caracara/Simulator1/thruster/" + std::to_string(i); }
+    uint8_t thruster_byte(unsigned i, const char* prop);
+    uint64_t thruster_u64(unsigned i, const char* prop);
+    double thruster_double(unsigned i, const char* prop);
+    std::vector<uint8_t> thruster_bytes(unsigned i, const char* prop);
+    std::vector<std::string> thruster_strings(unsigned i, const char* prop);
+    // Calls a method; returns the D-Bus error name, or "" on success.
+    std::string call(const std::string& path, const char* iface, const char* method, const char* sig, ...);
+    std::vector<WireEntry> wire_log(uint64_t since = 0);
+
+    Process sim;
+    Process dbus_daemon;
+
+private:
+    std::string dir_;
+    std::string socket_;
+    dbus::BusPtr bus_;
+};
+
+// Directory of the built binaries, set by CMake.
+std::string bin(const char* name);
+
+} // namespace caracara::test
