@@ -198,6 +198,148 @@ const sd_bus_vtable kThrusterVtable[] = {
     SD_BUS_VTABLE_END,
 };
 
+// --- Teensy ---------------------------------------------------------------------------------
+
+TeensyModel& teensy(void* userdata) { return insp(userdata).vehicle().teensy(); }
+
+#define TGET(name, type, expr)                                                                                 \
+    int name(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) { \
+        return sd_bus_message_append(reply, type, expr);                                                       \
+    }
+TGET(te_task, "s", std::string(to_string(teensy(userdata).task_state())).c_str())
+TGET(te_acks, "t", static_cast<uint64_t>(teensy(userdata).acknowledgements()))
+TGET(te_frames, "t", static_cast<uint64_t>(teensy(userdata).frames_total()))
+TGET(te_stop_duty, "y", teensy(userdata).stop_duty())
+TGET(te_last_turn, "d", static_cast<double>(teensy(userdata).last_turn_rad()))
+TGET(te_last_turn_to, "d", static_cast<double>(teensy(userdata).last_turn_to_rad()))
+TGET(te_heading_offset, "d", teensy(userdata).heading_offset())
+#undef TGET
+
+int te_orientation(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
+    auto o = teensy(userdata).orientation();
+    return sd_bus_message_append(reply, "(ddd)", o.yaw, o.pitch, o.roll);
+}
+int te_position(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
+    auto p = insp(userdata).vehicle().body().position();
+    return sd_bus_message_append(reply, "(ddd)", p.x, p.y, p.depth);
+}
+int te_wheels(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
+    auto w = teensy(userdata).wheels();
+    return sd_bus_message_append(reply, "(dddd)", w.front_left, w.front_right, w.back_left, w.back_right);
+}
+int te_leds(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
+    auto l = teensy(userdata).leds();
+    return sd_bus_message_append(reply, "(yyy)", l[0], l[1], l[2]);
+}
+int te_servos(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
+    const auto& v = teensy(userdata).servo_degrees();
+    return sd_bus_message_append_array(reply, 'y', v.data(), v.size());
+}
+int te_distances(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
+    const auto& v = teensy(userdata).distances_mm();
+    return sd_bus_message_append_array(reply, 'q', v.data(), v.size() * sizeof(uint16_t));
+}
+
+int m_te_inject(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    const char* kind = nullptr;
+    uint32_t frames = 0;
+    int r = sd_bus_message_read(m, "su", &kind, &frames);
+    if (r < 0)
+        return r;
+    std::string k = kind;
+    if (k == "busy")
+        teensy(userdata).inject_busy(frames);
+    else if (k == "garbage-ack")
+        teensy(userdata).inject_garbage_ack(frames);
+    else if (k == "no-answer")
+        teensy(userdata).inject_no_answer(frames);
+    else
+        return sd_bus_error_setf(err, kErrInvalid, "fault must be busy, garbage-ack or no-answer, got '%s'", kind);
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_te_random_busy(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    double p = 0;
+    uint64_t seed = 0;
+    int r = sd_bus_message_read(m, "dt", &p, &seed);
+    if (r < 0)
+        return r;
+    if (!teensy(userdata).set_random_busy(p, seed))
+        return sd_bus_error_setf(err, kErrInvalid, "probability must be within 0..1");
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_te_clear(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    teensy(userdata).clear_faults();
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_te_set_distance(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    uint8_t sensor = 0;
+    uint16_t mm = 0;
+    int r = sd_bus_message_read(m, "yq", &sensor, &mm);
+    if (r < 0)
+        return r;
+    if (!teensy(userdata).set_distance_mm(sensor, mm))
+        return sd_bus_error_setf(err, kErrInvalid, "no distance sensor %u", sensor);
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_te_commands(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    uint8_t cmd = 0;
+    int r = sd_bus_message_read(m, "y", &cmd);
+    if (r < 0)
+        return r;
+    return sd_bus_reply_method_return(m, "tt", static_cast<uint64_t>(teensy(userdata).commands_received(cmd)),
+                                      static_cast<uint64_t>(teensy(userdata).commands_executed(cmd)));
+}
+
+// GetFrameLog() -> a(tttysayay): seq, start_ns, end_ns, command, outcome, mosi, miso.
+int m_te_frame_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    sd_bus_message* reply = nullptr;
+    int r = sd_bus_message_new_method_return(m, &reply);
+    if (r < 0)
+        return r;
+    dbus::MessagePtr guard(reply);
+    r = sd_bus_message_open_container(reply, 'a', "(tttysayay)");
+    for (const auto& f : teensy(userdata).frame_log()) {
+        if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttysayay");
+        if (r >= 0) r = sd_bus_message_append(reply, "tttys", f.seq, f.start_ns, f.end_ns, f.command, std::string(to_string(f.outcome)).c_str());
+        if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.mosi.data(), f.mosi.size());
+        if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.miso.data(), f.miso.size());
+        if (r >= 0) r = sd_bus_message_close_container(reply);
+    }
+    if (r >= 0)
+        r = sd_bus_message_close_container(reply);
+    if (r < 0)
+        return r;
+    return sd_bus_send(nullptr, reply, nullptr);
+}
+
+const sd_bus_vtable kTeensyVtable[] = {
+    SD_BUS_VTABLE_START(0),
+    SD_BUS_PROPERTY("Orientation", "(ddd)", te_orientation, 0, 0),
+    SD_BUS_PROPERTY("Position", "(ddd)", te_position, 0, 0),
+    SD_BUS_PROPERTY("Wheels", "(dddd)", te_wheels, 0, 0),
+    SD_BUS_PROPERTY("Leds", "(yyy)", te_leds, 0, 0),
+    SD_BUS_PROPERTY("Servos", "ay", te_servos, 0, 0),
+    SD_BUS_PROPERTY("Distances", "aq", te_distances, 0, 0),
+    SD_BUS_PROPERTY("StopDuty", "y", te_stop_duty, 0, 0),
+    SD_BUS_PROPERTY("Task", "s", te_task, 0, 0),
+    SD_BUS_PROPERTY("Acknowledgements", "t", te_acks, 0, 0),
+    SD_BUS_PROPERTY("Frames", "t", te_frames, 0, 0),
+    SD_BUS_PROPERTY("LastTurn", "d", te_last_turn, 0, 0),
+    SD_BUS_PROPERTY("LastTurnTo", "d", te_last_turn_to, 0, 0),
+    SD_BUS_PROPERTY("HeadingOffset", "d", te_heading_offset, 0, 0),
+    SD_BUS_METHOD_WITH_ARGS("InjectFault", SD_BUS_ARGS("s", fault, "u", frames), SD_BUS_NO_RESULT, m_te_inject, 0),
+    SD_BUS_METHOD_WITH_ARGS("SetRandomBusy", SD_BUS_ARGS("d", probability, "t", seed), SD_BUS_NO_RESULT, m_te_random_busy, 0),
+    SD_BUS_METHOD("ClearFaults", "", "", m_te_clear, 0),
+    SD_BUS_METHOD_WITH_ARGS("SetDistance", SD_BUS_ARGS("y", sensor, "q", millimeters), SD_BUS_NO_RESULT, m_te_set_distance, 0),
+    SD_BUS_METHOD_WITH_ARGS("CommandCount", SD_BUS_ARGS("y", command), SD_BUS_RESULT("t", received, "t", executed), m_te_commands, 0),
+    SD_BUS_METHOD_WITH_ARGS("GetFrameLog", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(tttysayay)", frames), m_te_frame_log, 0),
+    SD_BUS_VTABLE_END,
+};
+
 } // namespace
 
 int Inspector::start() {
@@ -219,6 +361,11 @@ int Inspector::start() {
             return r;
         slots_.emplace_back(slot);
     }
+    r = sd_bus_add_object_vtable(bus_, &slot, (std::string(kRoot) + "/teensy").c_str(), "org.caracara.Simulator1.Teensy",
+                                 kTeensyVtable, this);
+    if (r < 0)
+        return r;
+    slots_.emplace_back(slot);
     return sd_bus_request_name(bus_, "org.caracara.Simulator1", 0);
 }
 

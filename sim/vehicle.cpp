@@ -13,6 +13,18 @@ SimVehicle::SimVehicle(const SimConfig& cfg)
         i2c_.attach(t, t->addr7(), spec.mux_addr, spec.mux_channel);
         stepped_.push_back(t);
     }
+    // The body is pushed by what the thrusters actually do (after ramp and faults), in the
+    // packet's motor numbering; missing thrusters push nothing.
+    body_ = std::make_unique<VehicleBody>([this] {
+        std::array<double, 8> f{};
+        for (size_t i = 0; i < f.size() && i < thrusters_.size(); ++i)
+            f[i] = thrusters_[i]->actual_fraction();
+        return f;
+    });
+    teensy_ = std::make_unique<TeensyModel>(TeensyConfig{}, *body_);
+    attach_spi(cfg_.spi_device, teensy_.get());
+    stepped_.push_back(body_.get());
+    stepped_.push_back(teensy_.get());
 }
 
 SimVehicle::NodeKind SimVehicle::node_kind(const std::string& path) const {

@@ -5,7 +5,9 @@
 #include "i2c_bus_model.hpp"
 #include "sim_config.hpp"
 #include "slave.hpp"
+#include "teensy_model.hpp"
 #include "thruster_model.hpp"
+#include "vehicle_body.hpp"
 #include "wire_log.hpp"
 
 #include <functional>
@@ -49,6 +51,8 @@ public:
     int spi_message(SpiPort& port, std::vector<SpiMessageXfer>& xfers, uint64_t start_ns, uint64_t& wire_ns);
 
     std::vector<std::unique_ptr<ThrusterModel>>& thrusters() { return thrusters_; }
+    VehicleBody& body() { return *body_; }
+    TeensyModel& teensy() { return *teensy_; }
     WireLog& log() { return log_; }
     void add_stepped(Stepped* s) { stepped_.push_back(s); }
     void step(double dt_s, uint64_t now_ns);
@@ -64,6 +68,8 @@ private:
     I2cBusModel i2c_;
     std::vector<std::unique_ptr<ThrusterModel>> thrusters_;
     std::map<std::string, SpiPort> spi_;
+    std::unique_ptr<VehicleBody> body_;
+    std::unique_ptr<TeensyModel> teensy_;
     std::vector<Stepped*> stepped_;
     bool realistic_ = false;
     uint64_t bus_free_at_ = 0;

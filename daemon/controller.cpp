@@ -1,0 +1,579 @@
+#include "controller.hpp"
+
+#include "log.hpp"
+#include "packet.hpp"
+
+#include <cmath>
+#include <ctime>
+
+namespace caracara {
+
+namespace {
+// Bus work runs below D-Bus so that calls are served between transactions.
+constexpr int64_t kWorkPriority = SD_EVENT_PRIORITY_NORMAL + 10;
+constexpr uint64_t kTelemetryPeriodNs = 200'000'000; // 5 Hz of PropertiesChanged
+constexpr const char* kPowerOffConfirmation = "power-off";
+
+Status teensy_status(teensy::TeensyError e) {
+    using E = teensy::TeensyError;
+    switch (e) {
+    case E::None: return Status::Ok;
+    case E::SpeedOutOfRange:
+    case E::DutyOutOfRange:
+    case E::ServoIdOutOfRange:
+    case E::ServoAngleOutOfRange:
+    case E::SensorIdOutOfRange:
+    case E::AxisOutOfRange:
+    case E::LedValueOutOfRange: return Status::OutOfRange;
+    case E::AngleNotFinite: return Status::InvalidValue;
+    case E::Busy:
+    case E::BusyExhausted: return Status::Busy;
+    case E::ConfirmTimeout: return Status::Timeout;
+    case E::LinkError:
+    case E::BadAnswer:
+    case E::Io:
+    case E::ConfirmAckFailed: return Status::LinkError;
+    }
+    return Status::LinkError;
+}
+
+Result teensy_result(teensy::TeensyError e, std::string_view what) {
+    if (e == teensy::TeensyError::None)
+        return {};
+    return {teensy_status(e), std::string(what) + ": " + std::string(teensy::teensy_error_name(e))};
+}
+} // namespace
+
+std::string_view status_name(Status s) {
+    switch (s) {
+    case Status::Ok: return "Ok";
+    case Status::InvalidLength: return "InvalidLength";
+    case Status::OutOfRange: return "OutOfRange";
+    case Status::InvalidValue: return "InvalidValue";
+    case Status::Killed: return "Killed";
+    case Status::Arming: return "Arming";
+    case Status::PoweredOff: return "PoweredOff";
+    case Status::OverBudget: return "OverBudget";
+    case Status::NotKilled: return "NotKilled";
+    case Status::KillSwitchSet: return "KillSwitchSet";
+    case Status::ConfirmationRequired: return "ConfirmationRequired";
+    case Status::Busy: return "Busy";
+    case Status::Timeout: return "Timeout";
+    case Status::LinkError: return "LinkError";
+    case Status::Hardware: return "Hardware";
+    }
+    return "Hardware";
+}
+
+Controller::Controller(sd_event* event, DeviceIo& io, DaemonConfig config)
+    : event_(event),
+      io_(io),
+      config_(std::move(config)),
+      i2c_(io_, config_.i2c.device),
+      spi_(io_, config_.spi.device, config_.spi.spi),
+      teensy_link_(spi_, config_.spi.teensy),
+      safety_(safety_config(config_), false, now()) {
+    for (const auto& tc : config_.thrusters)
+        thrusters_.push_back(std::make_unique<ThrusterDriver>(i2c_, mux_, tc));
+    teensy_tm_.distances.assign(static_cast<size_t>(config_.spi.teensy.limits.distance_sensor_count), 0);
+    teensy_tm_.servos.assign(static_cast<size_t>(config_.spi.teensy.limits.servo_count), 0);
+}
+
+Controller::~Controller() { shutdown(); }
+
+uint64_t Controller::now() const {
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+std::string Controller::start() {
+    if (int r = i2c_.open(); r < 0)
+        return "cannot open I2C bus " + config_.i2c.device + ": " + errno_name(-r);
+    // Zero before anything else: a previous instance may have died with orders standing.
+    zero_now();
+    if (int r = spi_.open(); r < 0) {
+        log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
+                    errno_name(-r).c_str());
+    } else {
+        teensy_tm_.online = true;
+    }
+
+    sd_event_source* s = nullptr;
+    int r = sd_event_add_defer(event_, &s, on_work, this);
+    if (r < 0)
+        return "sd_event_add_defer: " + errno_name(-r);
+    work_source_.reset(s);
+    sd_event_source_set_priority(s, kWorkPriority);
+    sd_event_source_set_enabled(s, SD_EVENT_OFF);
+
+    if (config_.control.loop_rate_hz > 0) {
+        uint64_t now_us = 0;
+        sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
+        r = sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 0, on_tick, this);
+        if (r < 0)
+            return "sd_event_add_time: " + errno_name(-r);
+        tick_source_.reset(s);
+        sd_event_source_set_enabled(s, SD_EVENT_ON);
+    }
+    started_ = true;
+    last_cycle_ns_ = now();
+    cycle();
+    return {};
+}
+
+void Controller::shutdown() {
+    if (!i2c_.is_open())
+        return;
+    tick_source_.reset();
+    work_source_.reset();
+    turn_source_.reset();
+    zero_now();
+    if (turn_done_)
+        finish_turn({Status::Hardware, "the daemon is shutting down"});
+    i2c_.close();
+    spi_.close();
+}
+
+int Controller::on_tick(sd_event_source* s, uint64_t usec, void* userdata) {
+    auto* self = static_cast<Controller*>(userdata);
+    const uint64_t period = 1'000'000ull / self->config_.control.loop_rate_hz;
+    // Fixed-rate schedule; after a stall skip ahead instead of bursting to catch up.
+    uint64_t next = usec + period;
+    uint64_t now_us = 0;
+    sd_event_now(self->event_, CLOCK_MONOTONIC, &now_us);
+    if (next <= now_us)
+        next = now_us + period;
+    sd_event_source_set_time(s, next);
+    self->cycle();
+    return 0;
+}
+
+int Controller::on_work(sd_event_source*, void* userdata) {
+    auto* self = static_cast<Controller*>(userdata);
+    if (!self->work_one()) {
+        sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
+        self->in_cycle_ = false;
+        self->last_cycle_ns_ = self->now();
+        if (self->config_.control.loop_rate_hz == 0)
+            self->cycle(); // as fast as the bus allows
+    }
+    return 0;
+}
+
+void Controller::cycle() {
+    const uint64_t t = now();
+    handle(safety_.tick(t));
+    if (in_cycle_) {
+        // The bus did not finish the last cycle in one period: refresh what is left rather
+        // than piling work up. Orders stay due; status reads are not stacked.
+        mark_orders_due();
+        publish_telemetry_if_due();
+        return;
+    }
+    ++cycles_;
+    in_cycle_ = true;
+    mark_orders_due();
+    status_due_ = config_.control.status_reads_per_tick;
+    teensy_due_ = spi_.is_open();
+    publish_telemetry_if_due();
+}
+
+void Controller::mark_orders_due() {
+    order_due_.fill(true);
+    if (work_source_)
+        sd_event_source_set_enabled(work_source_.get(), SD_EVENT_ON);
+}
+
+bool Controller::work_one() {
+    for (size_t i = 0; i < thrusters_.size(); ++i) {
+        if (order_due_[i]) {
+            order_due_[i] = false;
+            send_order(i);
+            return true;
+        }
+    }
+    if (status_due_ > 0) {
+        --status_due_;
+        const size_t i = status_next_;
+        status_next_ = (status_next_ + 1) % thrusters_.size();
+        note_bus_result(thrusters_[i]->read_status());
+        return true;
+    }
+    if (teensy_due_) {
+        teensy_due_ = false;
+        poll_teensy();
+        return true;
+    }
+    return false;
+}
+
+void Controller::send_order(size_t i) {
+    const int32_t v = safety_.may_drive() ? applied_[i] : 0;
+    ordered_[i] = v;
+    note_bus_result(thrusters_[i]->send_order(v));
+}
+
+void Controller::zero_now() {
+    // Back to back, without returning to the event loop: nothing may come between a kill
+    // and the zero orders. Failures are counted; the next tick retries.
+    for (size_t i = 0; i < thrusters_.size(); ++i) {
+        order_due_[i] = false;
+        ordered_[i] = 0;
+        note_bus_result(thrusters_[i]->send_order(0));
+    }
+}
+
+void Controller::note_bus_result(IoError e) {
+    ++bus_tm_.transactions;
+    if (e == IoError::None)
+        return;
+    ++bus_tm_.errors;
+    bus_tm_.last_error = std::string(io_error_name(e));
+    if (e == IoError::BadReply)
+        return; // the bus worked; the thruster's reply was bad
+    bool all_down = true;
+    for (const auto& t : thrusters_)
+        all_down = all_down && !t->online();
+    bus_tm_.state = all_down ? "lost" : "ok";
+}
+
+void Controller::handle(const SafetyAction& a) {
+    uint32_t changes = 0;
+    if (a.clear_commands) {
+        requested_.fill(0);
+        applied_.fill(0);
+        limit_ = 0;
+        saturated_ = false;
+        changes |= kChangeMotors | kChangeController;
+    }
+    if (a.zero_outputs)
+        zero_now();
+    if (a.state_changed)
+        changes |= kChangeState;
+    if (a.command_stale)
+        log_info("command stream silent for %llu ms: thrusters to zero",
+                 static_cast<unsigned long long>(config_.control.command_timeout_ms));
+    notify(changes);
+}
+
+void Controller::notify(uint32_t changes) {
+    if (changes && observer_)
+        observer_->vehicle_changed(changes);
+}
+
+Result Controller::state_error() const {
+    switch (safety_.state()) {
+    case SafetyState::Ready: return {};
+    case SafetyState::Arming: return {Status::Arming, "the vehicle is arming; commands are accepted when it is ready"};
+    case SafetyState::Killed:
+        return {Status::Killed, "the vehicle is killed (" + std::string(kill_source_name()) + "); call ClearKill first"};
+    case SafetyState::PoweredOff: return {Status::PoweredOff, "the vehicle is powered off"};
+    }
+    return {Status::Hardware, "unknown state"};
+}
+
+Result Controller::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
+    BudgetResult b = apply_budget(wanted, config_.control.budget_policy);
+    if (b.error == BudgetError::OutOfRange)
+        return {Status::OutOfRange, b.message};
+    if (b.error == BudgetError::OverBudget)
+        return {Status::OverBudget, b.message};
+    if (Result r = state_error(); !r.ok())
+        return r;
+    const std::string previous = safety_.commanding_client();
+    SafetyAction a = safety_.accept_command(now(), client);
+    if (!a.ok())
+        return state_error();
+    requested_ = wanted;
+    applied_ = b.motors;
+    limit_ = b.running ? b.limit : 0;
+    saturated_ = b.saturated || mix_saturated;
+    // The new orders go out now, one transaction per loop iteration, not at the next tick.
+    mark_orders_due();
+    notify(kChangeMotors | (previous != safety_.commanding_client() ? kChangeController : 0u));
+    return {};
+}
+
+Result Controller::set_thrust(std::span<const int32_t> values, std::string_view client) {
+    if (values.size() != kMotorCount)
+        return {Status::InvalidLength, "SetThrust needs exactly 8 motor values, got " + std::to_string(values.size())};
+    MotorValues m{};
+    for (size_t i = 0; i < kMotorCount; ++i) {
+        if (values[i] < -kMotorMax || values[i] > kMotorMax)
+            return {Status::OutOfRange, "motor " + std::to_string(i) + ": " + std::to_string(values[i]) +
+                                            " is outside -8850..8850"};
+        m[i] = values[i];
+    }
+    return accept_motors(m, false, client);
+}
+
+Result Controller::set_motion(const AxisDemand& demand, std::string_view client) {
+    MixResult mr = mix(demand, config_.mixing);
+    if (mr.error == MixError::NotFinite)
+        return {Status::InvalidValue, mr.message};
+    if (mr.error != MixError::None)
+        return {Status::OutOfRange, mr.message};
+    return accept_motors(mr.motors, mr.saturated, client);
+}
+
+Result Controller::apply_packet(std::span<const int32_t> words, std::string_view client) {
+    PacketResult pr = decode_packet(words);
+    switch (pr.error) {
+    case PacketError::None: break;
+    case PacketError::WrongLength: return {Status::InvalidLength, pr.message};
+    case PacketError::MotorOutOfRange:
+    case PacketError::ColorOutOfRange: return {Status::OutOfRange, pr.message};
+    case PacketError::BadPowerOffState: return {Status::InvalidValue, pr.message};
+    }
+    const Packet& p = pr.packet;
+    if (safety_.state() == SafetyState::PoweredOff)
+        return state_error();
+    if (p.kill) {
+        // The seed: a non-zero killState stops the motors until a zero is sent.
+        kill(KillSource::Packet, "packet killState=" + std::to_string(p.kill_state));
+        set_leds(p.red, p.green, p.blue);
+        return {};
+    }
+    if (p.power_off) {
+        Result r = power_off(kPowerOffConfirmation);
+        return r;
+    }
+    if (safety_.state() == SafetyState::Killed) {
+        if (safety_.kill_source() != KillSource::Packet)
+            return state_error();
+        // killState 0 is the packet's "all clear": it clears a packet kill (arming follows).
+        SafetyAction a = safety_.clear_kill(now());
+        if (!a.ok())
+            return {a.error == SafetyError::KillSwitchSet ? Status::KillSwitchSet : Status::Killed, a.message};
+        handle(a);
+        set_leds(p.red, p.green, p.blue);
+        return {};
+    }
+    Result r = accept_motors(p.motors, false, client);
+    if (!r.ok())
+        return r;
+    if (leds_ != std::array<uint8_t, 3>{p.red, p.green, p.blue})
+        set_leds(p.red, p.green, p.blue);
+    return {};
+}
+
+Result Controller::kill(KillSource source, std::string_view reason) {
+    const bool was_killed = safety_.state() == SafetyState::Killed;
+    SafetyAction a = safety_.kill(source, now(), reason);
+    handle(a);
+    if (!was_killed && safety_.state() == SafetyState::Killed)
+        log_warning("KILLED by %s%s%s", std::string(kill_source_name()).c_str(), reason.empty() ? "" : ": ",
+                    std::string(reason).c_str());
+    if (turn_done_)
+        finish_turn({Status::Killed, "the vehicle was killed during the turn"});
+    return {};
+}
+
+Result Controller::clear_kill() {
+    SafetyAction a = safety_.clear_kill(now());
+    switch (a.error) {
+    case SafetyError::None: break;
+    case SafetyError::NotKilled: return {Status::NotKilled, a.message};
+    case SafetyError::KillSwitchSet: return {Status::KillSwitchSet, a.message};
+    case SafetyError::PoweredOff: return {Status::PoweredOff, a.message};
+    case SafetyError::NotReady: return {Status::Arming, a.message};
+    }
+    handle(a);
+    log_notice("kill cleared; arming for %u ms", config_.control.arming_delay_ms);
+    return {};
+}
+
+Result Controller::power_off(std::string_view confirmation) {
+    if (confirmation != kPowerOffConfirmation)
+        return {Status::ConfirmationRequired,
+                std::string("power-off is irreversible: pass the confirmation string \"") + kPowerOffConfirmation + "\""};
+    SafetyAction a = safety_.power_off(now());
+    if (a.error == SafetyError::PoweredOff)
+        return {Status::PoweredOff, a.message};
+    handle(a);
+    zero_now(); // thrusters first, whatever handle() decided
+    log_warning("POWER-OFF confirmed: thrusters zeroed");
+    if (turn_done_)
+        finish_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
+    return {};
+}
+
+Result Controller::set_leds(int red, int green, int blue) {
+    if (safety_.state() == SafetyState::PoweredOff)
+        return state_error();
+    for (int v : {red, green, blue})
+        if (v < 0 || v > 255)
+            return {Status::OutOfRange, "LED values are 0..255"};
+    if (!spi_.is_open())
+        return {Status::LinkError, "the Teensy is not connected"};
+    if (Result r = teensy_result(teensy_link_.set_leds(red, green, blue), "Set LEDs"); !r.ok())
+        return r;
+    leds_ = {static_cast<uint8_t>(red), static_cast<uint8_t>(green), static_cast<uint8_t>(blue)};
+    notify(kChangeLeds);
+    return {};
+}
+
+void Controller::client_left(std::string_view unique_name) {
+    if (unique_name.empty() || unique_name != safety_.commanding_client())
+        return;
+    log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
+    SafetyAction a = safety_.client_left(unique_name, now());
+    handle(a);
+    notify(kChangeController);
+}
+
+std::string_view Controller::state_name() const { return caracara::state_name(safety_.state()); }
+
+std::string_view Controller::kill_source_name() const {
+    if (safety_.state() != SafetyState::Killed)
+        return "";
+    return caracara::kill_source_name(safety_.kill_source());
+}
+
+int64_t Controller::command_age_ms() const {
+    const uint64_t last = safety_.last_command_at();
+    if (last == 0)
+        return -1;
+    return static_cast<int64_t>((now() - last) / 1'000'000ull);
+}
+
+bool Controller::healthy(uint64_t now_ns) const {
+    const uint64_t period = config_.control.loop_rate_hz ? 1'000'000'000ull / config_.control.loop_rate_hz : 0;
+    const uint64_t allowed = std::max<uint64_t>(1'000'000'000ull, 5 * period);
+    return started_ && i2c_.is_open() && now_ns - last_cycle_ns_ <= allowed;
+}
+
+void Controller::publish_telemetry_if_due() {
+    const uint64_t t = now();
+    if (t - last_telemetry_ns_ < kTelemetryPeriodNs)
+        return;
+    last_telemetry_ns_ = t;
+    if (observer_)
+        observer_->telemetry();
+}
+
+// --- Teensy ---------------------------------------------------------------------------
+
+void Controller::poll_teensy() {
+    // One frame per cycle: the three orientation axes, then one distance sensor, in turn.
+    const unsigned sensors = static_cast<unsigned>(teensy_tm_.distances.size());
+    const unsigned slots = 3 + (sensors ? 1 : 0);
+    const unsigned slot = teensy_poll_index_ % slots;
+    ++teensy_poll_index_;
+    bool ok = false;
+    if (slot < 3) {
+        auto r = teensy_link_.get_orientation(static_cast<int>(slot));
+        ok = r.ok();
+        if (ok)
+            teensy_tm_.orientation[slot] = r.value;
+    } else {
+        const unsigned sensor = (teensy_poll_index_ / slots) % sensors;
+        auto r = teensy_link_.get_distance(static_cast<int>(sensor));
+        ok = r.ok();
+        if (ok)
+            teensy_tm_.distances[sensor] = r.value;
+    }
+    teensy_tm_.online = ok;
+}
+
+Result Controller::teensy_set_speed(int left, int right) {
+    if (safety_.state() == SafetyState::PoweredOff)
+        return state_error();
+    return teensy_result(teensy_link_.set_speed(left, right), "Set Speed");
+}
+
+Result Controller::teensy_stop(int duty) { return teensy_result(teensy_link_.stop(duty), "Stop"); }
+
+Result Controller::teensy_servo(int id, int degrees) {
+    if (safety_.state() == SafetyState::PoweredOff)
+        return state_error();
+    Result r = teensy_result(teensy_link_.servo(id, degrees), "Servo");
+    if (r.ok())
+        teensy_tm_.servos[static_cast<size_t>(id)] = static_cast<uint8_t>(degrees);
+    return r;
+}
+
+Result Controller::teensy_distance(int sensor, uint16_t& mm) {
+    auto r = teensy_link_.get_distance(sensor);
+    if (!r.ok())
+        return teensy_result(r.error, "Get distance");
+    mm = r.value;
+    if (sensor >= 0 && static_cast<size_t>(sensor) < teensy_tm_.distances.size())
+        teensy_tm_.distances[static_cast<size_t>(sensor)] = mm;
+    return {};
+}
+
+Result Controller::teensy_turn(double radians, bool absolute, std::function<void(const Result&)> done) {
+    if (Result r = state_error(); !r.ok() && safety_.state() != SafetyState::Arming)
+        return r;
+    if (turn_done_)
+        return {Status::Busy, "a turn is already running"};
+    if (!std::isfinite(radians))
+        return {Status::InvalidValue, "the angle must be a finite number of radians"};
+    auto e = absolute ? teensy_link_.turn_to(radians) : teensy_link_.turn(radians);
+    if (Result r = teensy_result(e, absolute ? "Turn to" : "Turn"); !r.ok())
+        return r;
+    turn_done_ = std::move(done);
+    teensy_tm_.turning = true;
+    handshake_ = teensy::ConfirmHandshake();
+    handshake_.start(now());
+    sd_event_source* s = nullptr;
+    uint64_t now_us = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
+    if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 0, on_turn_step, this) < 0) {
+        finish_turn({Status::Hardware, "cannot schedule the confirmation handshake"});
+        return {};
+    }
+    turn_source_.reset(s);
+    return {};
+}
+
+int Controller::on_turn_step(sd_event_source*, uint64_t, void* userdata) {
+    static_cast<Controller*>(userdata)->turn_step();
+    return 0;
+}
+
+void Controller::turn_step() {
+    // Drive the handshake without blocking: send what it asks for, then sleep until it
+    // wants the next poll.
+    for (;;) {
+        const uint64_t t = now();
+        auto step = handshake_.next(t);
+        switch (step.action) {
+        case teensy::ConfirmHandshake::Action::Send: {
+            auto reply = teensy_link_.execute(step.frame);
+            teensy::TeensyResult<uint8_t> res;
+            if (!reply.ok())
+                res.error = reply.error;
+            else
+                res = teensy::decode_confirm(reply.value);
+            handshake_.on_result(res, now());
+            continue;
+        }
+        case teensy::ConfirmHandshake::Action::Wait:
+            sd_event_source_set_time(turn_source_.get(), step.at_ns / 1000);
+            sd_event_source_set_enabled(turn_source_.get(), SD_EVENT_ONESHOT);
+            return;
+        case teensy::ConfirmHandshake::Action::Done:
+            finish_turn({});
+            return;
+        case teensy::ConfirmHandshake::Action::Failed:
+        case teensy::ConfirmHandshake::Action::Idle:
+            finish_turn(teensy_result(step.error == teensy::TeensyError::None ? teensy::TeensyError::LinkError : step.error,
+                                      "turn confirmation"));
+            return;
+        }
+    }
+}
+
+void Controller::finish_turn(const Result& r) {
+    teensy_tm_.turning = false;
+    auto done = std::move(turn_done_);
+    turn_done_ = nullptr;
+    turn_source_.reset();
+    if (done)
+        done(r);
+}
+
+} // namespace caracara

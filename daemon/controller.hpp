@@ -1,0 +1,209 @@
+// The control loop: owns the thruster drivers and the Teensy link, applies the safety state
+// machine, the mixing and the budget, and schedules bus work on the sd-event loop.
+//
+// Bus work is a small set of "due" flags (an order per thruster, status reads, a Teensy poll)
+// executed ONE transaction per event-loop dispatch at a lower priority than D-Bus, so a Kill
+// or a new command waits at most for the transaction already on the wire. A kill zeroes every
+// thruster synchronously before its D-Bus reply; a new command marks all orders due at once.
+#pragma once
+
+#include "budget.hpp"
+#include "config.hpp"
+#include "device_io.hpp"
+#include "i2c_dev.hpp"
+#include "mixing.hpp"
+#include "safety.hpp"
+#include "sdbus.hpp"
+#include "spi_dev.hpp"
+#include "teensy_link.hpp"
+#include "thruster.hpp"
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace caracara {
+
+// Outcome of a command, mapped 1:1 to org.caracara.Vehicle1.Error.<name> by dbus/.
+enum class Status {
+    Ok,
+    InvalidLength,
+    OutOfRange,
+    InvalidValue,
+    Killed,
+    Arming,
+    PoweredOff,
+    OverBudget,
+    NotKilled,
+    KillSwitchSet,
+    ConfirmationRequired,
+    Busy,
+    Timeout,
+    LinkError,
+    Hardware,
+};
+std::string_view status_name(Status s); // "OutOfRange", ...
+
+struct Result {
+    Status status = Status::Ok;
+    std::string message;
+    bool ok() const { return status == Status::Ok; }
+};
+
+// Which vehicle properties changed, for PropertiesChanged.
+enum VehicleChange : uint32_t {
+    kChangeState = 1u << 0,      // State, KillSource
+    kChangeMotors = 1u << 1,     // MotorValues, RequestedValues, BudgetLimit, Saturated
+    kChangeLeds = 1u << 2,
+    kChangeController = 1u << 3, // Controller
+};
+
+class ControllerObserver {
+public:
+    virtual ~ControllerObserver() = default;
+    virtual void vehicle_changed(uint32_t changes) = 0;
+    // Periodic: thruster, Teensy and bus telemetry, command age, cycles.
+    virtual void telemetry() = 0;
+};
+
+struct ThrusterTelemetry {
+    int32_t ordered_value = 0;
+    uint8_t ordered_speed = 0x80;
+};
+
+struct TeensyTelemetry {
+    bool online = false;
+    std::array<double, 3> orientation{}; // yaw, pitch, roll
+    std::vector<uint16_t> distances;
+    std::vector<uint8_t> servos;
+    bool turning = false;
+};
+
+struct BusTelemetry {
+    std::string state = "ok";
+    uint64_t transactions = 0;
+    uint64_t errors = 0;
+    std::string last_error;
+};
+
+class Controller {
+public:
+    Controller(sd_event* event, DeviceIo& io, DaemonConfig config);
+    ~Controller();
+    Controller(const Controller&) = delete;
+    Controller& operator=(const Controller&) = delete;
+
+    // Opens the devices and orders zero to every thruster. Returns "" or a reason the
+    // daemon cannot run (the I2C bus cannot be opened). A missing Teensy is not fatal.
+    std::string start();
+    // Orders zero to every thruster (SIGTERM, fatal errors). Safe to call more than once.
+    void shutdown();
+    void set_observer(ControllerObserver* o) { observer_ = o; }
+
+    Result set_thrust(std::span<const int32_t> values, std::string_view client);
+    Result set_motion(const AxisDemand& demand, std::string_view client);
+    Result apply_packet(std::span<const int32_t> words, std::string_view client);
+    Result kill(KillSource source, std::string_view reason = {});
+    Result clear_kill();
+    Result power_off(std::string_view confirmation);
+    Result set_leds(int red, int green, int blue);
+    void client_left(std::string_view unique_name);
+
+    Result teensy_set_speed(int left, int right);
+    Result teensy_stop(int duty);
+    Result teensy_servo(int id, int degrees);
+    Result teensy_distance(int sensor, uint16_t& mm);
+    // Starts a Turn (relative) or Turn to (absolute); `done` runs when the Teensy confirms
+    // completion, or on failure. Returns an error at once if it cannot start.
+    Result teensy_turn(double radians, bool absolute, std::function<void(const Result&)> done);
+
+    // State for the D-Bus layer.
+    const DaemonConfig& config() const { return config_; }
+    const SafetyMachine& safety() const { return safety_; }
+    std::string_view state_name() const;
+    std::string_view kill_source_name() const;
+    const MotorValues& motor_values() const { return applied_; }
+    const MotorValues& requested_values() const { return requested_; }
+    int32_t budget_limit() const { return limit_; }
+    bool saturated() const { return saturated_; }
+    std::array<uint8_t, 3> leds() const { return leds_; }
+    int64_t command_age_ms() const;
+    const std::string& controller_client() const { return safety_.commanding_client(); }
+    uint64_t cycles() const { return cycles_; }
+    size_t thruster_count() const { return thrusters_.size(); }
+    const ThrusterDriver& thruster(size_t i) const { return *thrusters_[i]; }
+    int32_t ordered_value(size_t i) const { return ordered_[i]; }
+    const TeensyTelemetry& teensy() const { return teensy_tm_; }
+    const TeensyLinkCounters& teensy_counters() const { return teensy_link_.counters(); }
+    const BusTelemetry& bus() const { return bus_tm_; }
+    // Healthy = the control loop completed a cycle recently (fed to the systemd watchdog).
+    bool healthy(uint64_t now_ns) const;
+
+private:
+    static int on_tick(sd_event_source*, uint64_t usec, void* userdata);
+    static int on_work(sd_event_source*, void* userdata);
+    static int on_turn_step(sd_event_source*, uint64_t usec, void* userdata);
+
+    uint64_t now() const;
+    void cycle();
+    bool work_one();
+    void mark_orders_due();
+    void send_order(size_t i);
+    void zero_now();
+    void handle(const SafetyAction& a);
+    Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);
+    Result state_error() const;
+    void note_bus_result(IoError e);
+    void poll_teensy();
+    void turn_step();
+    void finish_turn(const Result& r);
+    void publish_telemetry_if_due();
+    void notify(uint32_t changes);
+
+    sd_event* event_;
+    DeviceIo& io_;
+    DaemonConfig config_;
+    I2cDev i2c_;
+    MuxTracker mux_;
+    std::vector<std::unique_ptr<ThrusterDriver>> thrusters_;
+    SpiDev spi_;
+    TeensyLink teensy_link_;
+    SafetyMachine safety_;
+    ControllerObserver* observer_ = nullptr;
+
+    MotorValues requested_{};
+    MotorValues applied_{};
+    std::array<int32_t, kMotorCount> ordered_{};
+    int32_t limit_ = 0;
+    bool saturated_ = false;
+    std::array<uint8_t, 3> leds_{};
+
+    // Due work; see the header comment.
+    std::array<bool, kMotorCount> order_due_{};
+    uint32_t status_due_ = 0;
+    size_t status_next_ = 0;
+    bool teensy_due_ = false;
+    unsigned teensy_poll_index_ = 0;
+    bool in_cycle_ = false;
+
+    dbus::SourcePtr tick_source_;
+    dbus::SourcePtr work_source_;
+    dbus::SourcePtr turn_source_;
+    uint64_t cycles_ = 0;
+    uint64_t last_cycle_ns_ = 0;
+    uint64_t last_telemetry_ns_ = 0;
+    bool started_ = false;
+
+    teensy::ConfirmHandshake handshake_;
+    std::function<void(const Result&)> turn_done_;
+
+    TeensyTelemetry teensy_tm_;
+    BusTelemetry bus_tm_;
+};
+
+} // namespace caracara

@@ -1,0 +1,182 @@
+// caracarad: the Caracara vehicle daemon. One sd-event loop; see DESIGN.md.
+#include "config.hpp"
+#include "controller.hpp"
+#include "device_io.hpp"
+#include "errors.hpp"
+#include "log.hpp"
+#include "sdbus.hpp"
+#include "vehicle_service.hpp"
+
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <systemd/sd-daemon.h>
+#include <unistd.h>
+
+using namespace caracara;
+
+namespace {
+
+constexpr const char* kDefaultConfig = "/etc/caracara/caracarad.toml";
+
+void usage(FILE* f) {
+    std::fputs("Usage: caracarad [OPTIONS]\n"
+               "The Caracara vehicle daemon: thrusters, Teensy, kill and power-off on D-Bus.\n\n"
+               "  --config FILE          configuration (default /etc/caracara/caracarad.toml;\n"
+               "                         built-in defaults when the default file is absent)\n"
+               "  --hardware=linux       real devices (default)\n"
+               "  --hardware=sim:SOCKET  a running caracara-sim\n"
+               "  --system               serve on the system bus (default)\n"
+               "  --user                 serve on the user bus\n"
+               "  --bus-address ADDR     serve on the bus at ADDR\n"
+               "  --check-config         validate the configuration and exit\n"
+               "  -h, --help             this text\n",
+               f);
+}
+
+struct Watchdog {
+    Controller* controller;
+    uint64_t interval_us;
+};
+
+int on_watchdog(sd_event_source* s, uint64_t usec, void* userdata) {
+    auto* w = static_cast<Watchdog*>(userdata);
+    // Only a control loop that keeps completing cycles keeps systemd from restarting us.
+    if (w->controller->healthy(usec * 1000))
+        sd_notify(0, "WATCHDOG=1");
+    sd_event_source_set_time(s, usec + w->interval_us);
+    return 0;
+}
+
+int on_signal(sd_event_source* s, const signalfd_siginfo* si, void*) {
+    log_notice("received %s: thrusters to zero, exiting", strsignal(static_cast<int>(si->ssi_signo)));
+    return sd_event_exit(sd_event_source_get_event(s), 0);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::string config_path;
+    std::string hardware = "linux";
+    dbus::BusChoice bus_choice;
+    bool check_only = false;
+
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto value = [&](const std::string& name) -> std::string {
+            const std::string prefix = name + "=";
+            if (a.rfind(prefix, 0) == 0)
+                return a.substr(prefix.size());
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "caracarad: %s needs a value\n", name.c_str());
+                std::exit(2);
+            }
+            return argv[++i];
+        };
+        auto is = [&](const char* name) { return a == name || a.rfind(std::string(name) + "=", 0) == 0; };
+        if (is("--config")) config_path = value("--config");
+        else if (is("--hardware")) hardware = value("--hardware");
+        else if (a == "--system") bus_choice = {dbus::BusChoice::Kind::System, {}};
+        else if (a == "--user") bus_choice = {dbus::BusChoice::Kind::User, {}};
+        else if (is("--bus-address")) bus_choice = {dbus::BusChoice::Kind::Address, value("--bus-address")};
+        else if (a == "--check-config") check_only = true;
+        else if (a == "-h" || a == "--help") { usage(stdout); return 0; }
+        else {
+            std::fprintf(stderr, "caracarad: unknown option '%s'\n", a.c_str());
+            usage(stderr);
+            return 2;
+        }
+    }
+
+    // An explicitly named file must exist; the default path may be absent (built-in defaults).
+    ConfigResult cr;
+    if (config_path.empty() && access(kDefaultConfig, F_OK) != 0)
+        cr = parse_config_string("", "built-in defaults");
+    else
+        cr = parse_config_file(config_path.empty() ? kDefaultConfig : config_path);
+    if (!cr.ok()) {
+        log_error("invalid configuration %s:", config_path.empty() ? kDefaultConfig : config_path.c_str());
+        for (const auto& e : cr.errors)
+            log_error("  %s", e.c_str());
+        sd_notifyf(0, "STATUS=Invalid configuration: %s", cr.errors.empty() ? "?" : cr.errors.front().c_str());
+        return 1;
+    }
+    if (check_only) {
+        std::printf("configuration OK\n");
+        return 0;
+    }
+
+    std::string err;
+    auto io = make_device_io(hardware, err);
+    if (!io) {
+        log_error("%s", err.c_str());
+        return 1;
+    }
+
+    sd_event* ev_raw = nullptr;
+    if (int r = sd_event_default(&ev_raw); r < 0) {
+        log_error("sd_event_default: %s", errno_name(-r).c_str());
+        return 1;
+    }
+    dbus::EventPtr event(ev_raw);
+    sigset_t ss;
+    sigemptyset(&ss);
+    sigaddset(&ss, SIGTERM);
+    sigaddset(&ss, SIGINT);
+    sigaddset(&ss, SIGHUP);
+    sigprocmask(SIG_BLOCK, &ss, nullptr);
+    sd_event_add_signal(event.get(), nullptr, SIGTERM, on_signal, nullptr);
+    sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
+    sd_event_add_signal(event.get(), nullptr, SIGHUP, on_signal, nullptr);
+
+    Controller controller(event.get(), *io, *cr.config);
+    if (std::string e = controller.start(); !e.empty()) {
+        log_error("%s", e.c_str());
+        sd_notifyf(0, "STATUS=%s", e.c_str());
+        return 1;
+    }
+
+    dbus::BusPtr bus;
+    if (int r = dbus::open_bus(bus_choice, "caracarad", bus); r < 0) {
+        log_error("cannot connect to %s: %s", bus_choice.describe().c_str(), errno_name(-r).c_str());
+        return 1; // the Controller destructor has zeroed the thrusters
+    }
+    dbus::VehicleService service(bus.get(), controller);
+    controller.set_observer(&service);
+    if (int r = service.start(); r < 0) {
+        log_error("cannot publish %s on %s: %s", dbus::kBusName, bus_choice.describe().c_str(), errno_name(-r).c_str());
+        return 1;
+    }
+    // Losing the bus ends the loop; the thrusters are zeroed on the way out and systemd restarts us.
+    sd_bus_set_exit_on_disconnect(bus.get(), 1);
+    sd_bus_attach_event(bus.get(), event.get(), SD_EVENT_PRIORITY_NORMAL);
+
+    uint64_t wd_usec = 0;
+    Watchdog wd{&controller, 0};
+    dbus::SourcePtr wd_source;
+    if (sd_watchdog_enabled(0, &wd_usec) > 0) {
+        wd.interval_us = wd_usec / 2;
+        uint64_t now_us = 0;
+        sd_event_now(event.get(), CLOCK_MONOTONIC, &now_us);
+        sd_event_source* s = nullptr;
+        sd_event_add_time(event.get(), &s, CLOCK_MONOTONIC, now_us + wd.interval_us, 0, on_watchdog, &wd);
+        sd_event_source_set_enabled(s, SD_EVENT_ON);
+        wd_source.reset(s);
+    }
+
+    log_notice("serving %s on %s with %zu thrusters on %s (%s)", dbus::kBusName, bus_choice.describe().c_str(),
+               controller.thruster_count(), cr.config->i2c.device.c_str(), hardware.c_str());
+    sd_notifyf(0, "READY=1\nSTATUS=Thrusters zeroed; %s; serving %s", std::string(controller.state_name()).c_str(),
+               dbus::kBusName);
+
+    int r = sd_event_loop(event.get());
+    controller.set_observer(nullptr);
+    controller.shutdown();
+    sd_notify(0, "STOPPING=1\nSTATUS=Thrusters zeroed; stopped");
+    if (r < 0) {
+        log_error("event loop failed: %s", errno_name(-r).c_str());
+        return 1;
+    }
+    return r;
+}

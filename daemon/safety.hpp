@@ -1,0 +1,126 @@
+// The safety state machine and the command watchdog (DESIGN.md "Safety semantics").
+// Pure logic: the owner feeds it events with the monotonic time in nanoseconds and acts on
+// the returned SafetyAction (zero the thrusters now, drop stored commands); it never
+// touches hardware itself, so every rule here is unit-tested.
+//
+//   start ──> Arming ──(arming delay, zero output)──> Ready
+//   start with the kill switch set ──> Killed
+//   Arming/Ready ──kill (dbus, switch, packet, fault)──> Killed   (latches)
+//   Killed ──clear_kill, switch released──> Arming
+//   any ──power_off──> PoweredOff   (irreversible)
+//
+// A silent command stream (timeout) or a commanding client that left zeroes the output
+// and drops the stored commands, but is NOT a kill: the next command drives again.
+// An escalated fault (e.g. a failed I2C bus recovery) is a kill with source Fault.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+
+namespace caracara {
+
+constexpr uint64_t ms_to_ns(uint64_t ms) { return ms * 1'000'000; }
+
+enum class SafetyState { Arming, Ready, Killed, PoweredOff };
+std::string_view state_name(SafetyState s);  // "arming", "ready", "killed", "powered-off"
+
+enum class KillSource {
+    None,    // not killed
+    DBus,    // the Kill method
+    Switch,  // the kill switch GPIO
+    Packet,  // a legacy packet with killState != 0
+    Fault,   // an escalated fault, e.g. the I2C bus could not be recovered
+};
+std::string_view kill_source_name(KillSource s);  // "none", "dbus", "switch", "packet", "fault"
+
+enum class SafetyError {
+    None,
+    NotKilled,      // clear_kill while not killed
+    KillSwitchSet,  // clear_kill while the kill switch is still set
+    PoweredOff,     // anything that needs power after power-off
+    NotReady,       // a thrust command while arming or killed
+};
+std::string_view error_name(SafetyError e);  // "NotKilled", "KillSwitchSet", ... (D-Bus error suffix)
+
+struct SafetyConfig {
+    uint64_t arming_delay_ns = ms_to_ns(3000);     // as the board firmware did
+    uint64_t command_timeout_ns = ms_to_ns(500);
+};
+
+// What the owner must do after an event. The flags are idempotent: acting on them twice
+// is harmless, missing one is not.
+struct SafetyAction {
+    SafetyError error = SafetyError::None;
+    std::string message;          // the reason, for logs and D-Bus error text
+    bool state_changed = false;
+    bool zero_outputs = false;    // order zero to every thruster now, not at the next tick
+    bool clear_commands = false;  // drop stored commands so nothing resumes by itself
+    bool command_stale = false;   // the watchdog expired on this call (not a kill)
+    bool ok() const { return error == SafetyError::None; }
+};
+
+class SafetyMachine {
+public:
+    static constexpr uint64_t kNoDeadline = std::numeric_limits<uint64_t>::max();
+
+    // Starts in Arming, or Killed (source Switch) when the kill switch is already set.
+    SafetyMachine(SafetyConfig config, bool kill_switch_set, uint64_t now);
+
+    // Always accepted: from Arming/Ready it latches Killed with this source; when already
+    // killed the first source is kept; after power-off it only repeats the zeroing.
+    SafetyAction kill(KillSource source, uint64_t now, std::string_view reason = {});
+    // Killed -> Arming. Refused with NotKilled, KillSwitchSet or PoweredOff.
+    SafetyAction clear_kill(uint64_t now);
+    // set -> kill (source Switch); released -> recorded only: clearing stays explicit.
+    SafetyAction switch_changed(bool set, uint64_t now);
+    // Irreversible. Refused with PoweredOff when already powered off.
+    SafetyAction power_off(uint64_t now);
+    // Ends the arming delay and runs the command watchdog; call at least at next_deadline().
+    SafetyAction tick(uint64_t now);
+    // A thrust/motion command from `client` (e.g. a D-Bus unique name). Accepted only in
+    // Ready (NotReady while arming or killed, PoweredOff after power-off); it (re)starts
+    // the watchdog and makes `client` the commanding client.
+    SafetyAction accept_command(uint64_t now, std::string_view client = {});
+    // A client left the bus: if it was the commanding client, zero and drop its commands.
+    SafetyAction client_left(std::string_view client, uint64_t now);
+
+    SafetyState state() const { return state_; }
+    KillSource kill_source() const { return kill_source_; }
+    const std::string& kill_reason() const { return kill_reason_; }
+    uint64_t killed_at() const { return killed_at_; }
+    bool kill_switch_set() const { return switch_set_; }
+    // Commands may drive the thrusters (state Ready); otherwise the output is zero.
+    bool may_drive() const { return state_ == SafetyState::Ready; }
+    // Ready and a command stream is live (not stale, client present).
+    bool command_active() const { return may_drive() && command_active_; }
+    // The kill output de-energizes the thrusters while killed or powered off. It is
+    // released on entering Arming so the controllers power up and settle at zero order.
+    bool kill_output_asserted() const {
+        return state_ == SafetyState::Killed || state_ == SafetyState::PoweredOff;
+    }
+    const std::string& commanding_client() const { return client_; }
+    uint64_t last_command_at() const { return last_command_; }
+    uint64_t arming_remaining_ns(uint64_t now) const;
+    // The next time tick() has work (end of arming, watchdog expiry), or kNoDeadline.
+    uint64_t next_deadline() const;
+    const SafetyConfig& config() const { return config_; }
+
+private:
+    void enter_killed(KillSource source, uint64_t now, std::string_view reason);
+    void drop_commands();
+
+    SafetyConfig config_;
+    SafetyState state_ = SafetyState::Arming;
+    KillSource kill_source_ = KillSource::None;
+    std::string kill_reason_;
+    uint64_t killed_at_ = 0;
+    bool switch_set_ = false;
+    uint64_t arming_started_ = 0;
+    bool command_active_ = false;
+    uint64_t last_command_ = 0;
+    std::string client_;
+};
+
+} // namespace caracara

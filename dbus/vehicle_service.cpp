@@ -1,0 +1,533 @@
+#include "vehicle_service.hpp"
+
+#include "seabotix.hpp"
+
+#include <cstring>
+#include <memory>
+
+namespace caracara::dbus {
+
+namespace {
+
+Controller& ctl(void* userdata) { return static_cast<VehicleService*>(userdata)->controller(); }
+VehicleService::ThrusterObject& tobj(void* userdata) { return *static_cast<VehicleService::ThrusterObject*>(userdata); }
+const ThrusterDriver& thr(void* userdata) {
+    auto& o = tobj(userdata);
+    return o.service->controller().thruster(o.index);
+}
+
+// Status fields of either controller variant, as the Thruster interface presents them.
+uint8_t actual_speed(const ThrusterStatus& s) {
+    if (s.variant == Variant::SeaBotix)
+        return s.seabotix.speed;
+    return s.legacy.max_power_meaning == MaxPowerMeaning::PowerSpeed ? s.legacy.max_power : uint8_t{0x80};
+}
+double current_amps(const ThrusterStatus& s) { return s.current_deciamps ? *s.current_deciamps / 10.0 : 0.0; }
+double temperature_c(const ThrusterStatus& s) {
+    return s.variant == Variant::SeaBotix ? static_cast<double>(s.seabotix.temperature_c) : 0.0;
+}
+uint8_t firmware_revision(const ThrusterStatus& s) {
+    return s.variant == Variant::SeaBotix ? s.seabotix.firmware_revision : s.legacy.revision_code;
+}
+std::string thruster_error_text(const ThrusterDriver& t) {
+    if (t.last_error() == IoError::None)
+        return "";
+    if (t.last_error() == IoError::BadReply)
+        return std::string(codec_error_name(t.last_reply_error()));
+    return std::string(io_error_name(t.last_error()));
+}
+
+int reply_result(sd_bus_message* m, const Result& r, sd_bus_error* err) {
+    if (!r.ok()) {
+        const std::string name = std::string(kErrorPrefix) + std::string(status_name(r.status));
+        return sd_bus_error_set(err, name.c_str(), r.message.c_str());
+    }
+    return sd_bus_reply_method_return(m, "");
+}
+
+std::string sender(sd_bus_message* m) {
+    const char* s = sd_bus_message_get_sender(m);
+    return s ? s : "";
+}
+
+int read_int_array(sd_bus_message* m, std::vector<int32_t>& out) {
+    const void* p = nullptr;
+    size_t n = 0;
+    int r = sd_bus_message_read_array(m, 'i', &p, &n);
+    if (r < 0)
+        return r;
+    out.resize(n / sizeof(int32_t));
+    if (n)
+        std::memcpy(out.data(), p, n);
+    return 0;
+}
+
+int append_ints(sd_bus_message* reply, const MotorValues& v) {
+    return sd_bus_message_append_array(reply, 'i', v.data(), v.size() * sizeof(int32_t));
+}
+
+#define PROP(name) \
+    int name(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*)
+
+// --- Vehicle -------------------------------------------------------------------------------
+
+int m_set_thrust(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    std::vector<int32_t> v;
+    if (int r = read_int_array(m, v); r < 0)
+        return r;
+    return reply_result(m, ctl(userdata).set_thrust(v, sender(m)), err);
+}
+
+int m_set_motion(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    AxisDemand d{};
+    int r = sd_bus_message_read(m, "dddddd", &d[0], &d[1], &d[2], &d[3], &d[4], &d[5]);
+    if (r < 0)
+        return r;
+    return reply_result(m, ctl(userdata).set_motion(d, sender(m)), err);
+}
+
+int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    std::vector<int32_t> v;
+    if (int r = read_int_array(m, v); r < 0)
+        return r;
+    return reply_result(m, ctl(userdata).apply_packet(v, sender(m)), err);
+}
+
+int m_kill(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    return reply_result(m, ctl(userdata).kill(KillSource::DBus, "Kill() from " + sender(m)), err);
+}
+
+int m_clear_kill(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    return reply_result(m, ctl(userdata).clear_kill(), err);
+}
+
+int m_power_off(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    const char* confirmation = nullptr;
+    int r = sd_bus_message_read(m, "s", &confirmation);
+    if (r < 0)
+        return r;
+    return reply_result(m, ctl(userdata).power_off(confirmation), err);
+}
+
+int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    uint8_t red = 0, green = 0, blue = 0;
+    int r = sd_bus_message_read(m, "yyy", &red, &green, &blue);
+    if (r < 0)
+        return r;
+    return reply_result(m, ctl(userdata).set_leds(red, green, blue), err);
+}
+
+PROP(p_state) { return sd_bus_message_append(reply, "s", std::string(ctl(userdata).state_name()).c_str()); }
+PROP(p_kill_source) { return sd_bus_message_append(reply, "s", std::string(ctl(userdata).kill_source_name()).c_str()); }
+PROP(p_motor_values) { return append_ints(reply, ctl(userdata).motor_values()); }
+PROP(p_requested_values) { return append_ints(reply, ctl(userdata).requested_values()); }
+PROP(p_budget_limit) { return sd_bus_message_append(reply, "i", ctl(userdata).budget_limit()); }
+PROP(p_saturated) { return sd_bus_message_append(reply, "b", static_cast<int>(ctl(userdata).saturated())); }
+PROP(p_policy) {
+    return sd_bus_message_append(reply, "s", std::string(policy_name(ctl(userdata).config().control.budget_policy)).c_str());
+}
+PROP(p_leds) {
+    auto l = ctl(userdata).leds();
+    return sd_bus_message_append(reply, "(yyy)", l[0], l[1], l[2]);
+}
+PROP(p_command_age) { return sd_bus_message_append(reply, "x", ctl(userdata).command_age_ms()); }
+PROP(p_controller) { return sd_bus_message_append(reply, "s", ctl(userdata).controller_client().c_str()); }
+PROP(p_timeout) { return sd_bus_message_append(reply, "u", ctl(userdata).config().control.command_timeout_ms); }
+PROP(p_arming) { return sd_bus_message_append(reply, "u", ctl(userdata).config().control.arming_delay_ms); }
+PROP(p_rate) { return sd_bus_message_append(reply, "d", static_cast<double>(ctl(userdata).config().control.loop_rate_hz)); }
+PROP(p_cycles) { return sd_bus_message_append(reply, "t", ctl(userdata).cycles()); }
+
+constexpr uint64_t kUnpriv = SD_BUS_VTABLE_UNPRIVILEGED; // access is the bus policy's job
+constexpr uint64_t kChange = SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE;
+constexpr uint64_t kConst = SD_BUS_VTABLE_PROPERTY_CONST;
+
+const sd_bus_vtable kVehicleVtable[] = {
+    SD_BUS_VTABLE_START(0),
+    SD_BUS_METHOD_WITH_ARGS("SetThrust", SD_BUS_ARGS("ai", values), SD_BUS_NO_RESULT, m_set_thrust, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("SetMotion", SD_BUS_ARGS("d", x, "d", y, "d", z, "d", yaw, "d", pitch, "d", roll),
+                            SD_BUS_NO_RESULT, m_set_motion, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("ApplyPacket", SD_BUS_ARGS("ai", packet), SD_BUS_NO_RESULT, m_apply_packet, kUnpriv),
+    SD_BUS_METHOD("Kill", "", "", m_kill, kUnpriv),
+    SD_BUS_METHOD("ClearKill", "", "", m_clear_kill, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("PowerOff", SD_BUS_ARGS("s", confirmation), SD_BUS_NO_RESULT, m_power_off, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds, kUnpriv),
+    SD_BUS_PROPERTY("State", "s", p_state, 0, kChange),
+    SD_BUS_PROPERTY("KillSource", "s", p_kill_source, 0, kChange),
+    SD_BUS_PROPERTY("MotorValues", "ai", p_motor_values, 0, kChange),
+    SD_BUS_PROPERTY("RequestedValues", "ai", p_requested_values, 0, kChange),
+    SD_BUS_PROPERTY("BudgetLimit", "i", p_budget_limit, 0, kChange),
+    SD_BUS_PROPERTY("Saturated", "b", p_saturated, 0, kChange),
+    SD_BUS_PROPERTY("BudgetPolicy", "s", p_policy, 0, kConst),
+    SD_BUS_PROPERTY("Leds", "(yyy)", p_leds, 0, kChange),
+    SD_BUS_PROPERTY("CommandAgeMs", "x", p_command_age, 0, kChange),
+    SD_BUS_PROPERTY("Controller", "s", p_controller, 0, kChange),
+    SD_BUS_PROPERTY("CommandTimeoutMs", "u", p_timeout, 0, kConst),
+    SD_BUS_PROPERTY("ArmingDelayMs", "u", p_arming, 0, kConst),
+    SD_BUS_PROPERTY("LoopRateHz", "d", p_rate, 0, kConst),
+    SD_BUS_PROPERTY("Cycles", "t", p_cycles, 0, kChange),
+    SD_BUS_VTABLE_END,
+};
+
+// --- Thruster ------------------------------------------------------------------------------
+
+PROP(t_index) { return sd_bus_message_append(reply, "u", static_cast<uint32_t>(tobj(userdata).index)); }
+PROP(t_address) { return sd_bus_message_append(reply, "y", thr(userdata).config().mt); }
+PROP(t_variant) { return sd_bus_message_append(reply, "s", std::string(variant_name(thr(userdata).config().variant)).c_str()); }
+PROP(t_mux_address) {
+    const auto& mux = thr(userdata).config().mux;
+    return sd_bus_message_append(reply, "q", static_cast<uint16_t>(mux ? mux->addr7 : 0));
+}
+PROP(t_mux_channel) {
+    const auto& mux = thr(userdata).config().mux;
+    return sd_bus_message_append(reply, "i", mux ? static_cast<int32_t>(mux->channel) : -1);
+}
+PROP(t_reversed) { return sd_bus_message_append(reply, "b", static_cast<int>(thr(userdata).config().reversed)); }
+PROP(t_online) { return sd_bus_message_append(reply, "b", static_cast<int>(thr(userdata).online())); }
+PROP(t_ordered_value) {
+    auto& o = tobj(userdata);
+    return sd_bus_message_append(reply, "i", o.service->controller().ordered_value(o.index));
+}
+PROP(t_ordered_speed) { return sd_bus_message_append(reply, "y", thr(userdata).last_speed().value_or(0x80)); }
+PROP(t_actual_speed) {
+    const auto& s = thr(userdata).last_status();
+    return sd_bus_message_append(reply, "y", s ? actual_speed(*s) : uint8_t{0x80});
+}
+PROP(t_current) {
+    const auto& s = thr(userdata).last_status();
+    return sd_bus_message_append(reply, "d", s ? current_amps(*s) : 0.0);
+}
+PROP(t_temperature) {
+    const auto& s = thr(userdata).last_status();
+    return sd_bus_message_append(reply, "d", s ? temperature_c(*s) : 0.0);
+}
+PROP(t_faults) {
+    int r = sd_bus_message_open_container(reply, 'a', "s");
+    const auto& s = thr(userdata).last_status();
+    if (s)
+        for (Fault f : kAllFaults)
+            if (r >= 0 && s->faults.has(f))
+                r = sd_bus_message_append(reply, "s", std::string(fault_name(f)).c_str());
+    return r < 0 ? r : sd_bus_message_close_container(reply);
+}
+PROP(t_firmware) {
+    const auto& s = thr(userdata).last_status();
+    return sd_bus_message_append(reply, "y", s ? firmware_revision(*s) : uint8_t{0});
+}
+PROP(t_orders) { return sd_bus_message_append(reply, "t", thr(userdata).counters().orders_sent); }
+PROP(t_failures) { return sd_bus_message_append(reply, "t", thr(userdata).counters().order_failures); }
+PROP(t_reads) { return sd_bus_message_append(reply, "t", thr(userdata).counters().status_reads); }
+PROP(t_nacks) { return sd_bus_message_append(reply, "t", thr(userdata).counters().nacks); }
+PROP(t_timeouts) { return sd_bus_message_append(reply, "t", thr(userdata).counters().timeouts); }
+PROP(t_bad) { return sd_bus_message_append(reply, "t", thr(userdata).counters().bad_replies); }
+PROP(t_last_error) { return sd_bus_message_append(reply, "s", thruster_error_text(thr(userdata)).c_str()); }
+
+const sd_bus_vtable kThrusterVtable[] = {
+    SD_BUS_VTABLE_START(0),
+    SD_BUS_PROPERTY("Index", "u", t_index, 0, kConst),
+    SD_BUS_PROPERTY("Address", "y", t_address, 0, kConst),
+    SD_BUS_PROPERTY("Variant", "s", t_variant, 0, kConst),
+    SD_BUS_PROPERTY("MuxAddress", "q", t_mux_address, 0, kConst),
+    SD_BUS_PROPERTY("MuxChannel", "i", t_mux_channel, 0, kConst),
+    SD_BUS_PROPERTY("Reversed", "b", t_reversed, 0, kConst),
+    SD_BUS_PROPERTY("Online", "b", t_online, 0, kChange),
+    SD_BUS_PROPERTY("OrderedValue", "i", t_ordered_value, 0, kChange),
+    SD_BUS_PROPERTY("OrderedSpeed", "y", t_ordered_speed, 0, kChange),
+    SD_BUS_PROPERTY("ActualSpeed", "y", t_actual_speed, 0, kChange),
+    SD_BUS_PROPERTY("Current", "d", t_current, 0, kChange),
+    SD_BUS_PROPERTY("Temperature", "d", t_temperature, 0, kChange),
+    SD_BUS_PROPERTY("Faults", "as", t_faults, 0, kChange),
+    SD_BUS_PROPERTY("FirmwareRevision", "y", t_firmware, 0, kChange),
+    SD_BUS_PROPERTY("OrdersSent", "t", t_orders, 0, kChange),
+    SD_BUS_PROPERTY("OrderFailures", "t", t_failures, 0, kChange),
+    SD_BUS_PROPERTY("StatusReads", "t", t_reads, 0, kChange),
+    SD_BUS_PROPERTY("Nacks", "t", t_nacks, 0, kChange),
+    SD_BUS_PROPERTY("Timeouts", "t", t_timeouts, 0, kChange),
+    SD_BUS_PROPERTY("BadReplies", "t", t_bad, 0, kChange),
+    SD_BUS_PROPERTY("LastError", "s", t_last_error, 0, kChange),
+    SD_BUS_VTABLE_END,
+};
+
+// --- Teensy --------------------------------------------------------------------------------
+
+int m_t_set_speed(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    int32_t l = 0, r2 = 0;
+    int r = sd_bus_message_read(m, "ii", &l, &r2);
+    if (r < 0)
+        return r;
+    return reply_result(m, ctl(userdata).teensy_set_speed(l, r2), err);
+}
+
+int m_t_stop(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    uint8_t duty = 0;
+    int r = sd_bus_message_read(m, "y", &duty);
+    if (r < 0)
+        return r;
+    return reply_result(m, ctl(userdata).teensy_stop(duty), err);
+}
+
+int m_t_servo(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    uint8_t id = 0, deg = 0;
+    int r = sd_bus_message_read(m, "yy", &id, &deg);
+    if (r < 0)
+        return r;
+    return reply_result(m, ctl(userdata).teensy_servo(id, deg), err);
+}
+
+int m_t_distance(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    uint8_t id = 0;
+    int r = sd_bus_message_read(m, "y", &id);
+    if (r < 0)
+        return r;
+    uint16_t mm = 0;
+    Result res = ctl(userdata).teensy_distance(id, mm);
+    if (!res.ok())
+        return reply_result(m, res, err);
+    return sd_bus_reply_method_return(m, "q", mm);
+}
+
+int turn(sd_bus_message* m, void* userdata, sd_bus_error* err, bool absolute) {
+    double rad = 0;
+    int r = sd_bus_message_read(m, "d", &rad);
+    if (r < 0)
+        return r;
+    // Reply later, when the Teensy confirms; other calls are served meanwhile.
+    sd_bus_message_ref(m);
+    auto pending = std::shared_ptr<sd_bus_message>(m, sd_bus_message_unref);
+    Result res = ctl(userdata).teensy_turn(rad, absolute, [pending](const Result& done) {
+        if (done.ok()) {
+            sd_bus_reply_method_return(pending.get(), "");
+        } else {
+            const std::string name = std::string(kErrorPrefix) + std::string(status_name(done.status));
+            sd_bus_reply_method_errorf(pending.get(), name.c_str(), "%s", done.message.c_str());
+        }
+    });
+    if (!res.ok())
+        return reply_result(m, res, err);
+    return 1;
+}
+
+int m_t_turn(sd_bus_message* m, void* userdata, sd_bus_error* err) { return turn(m, userdata, err, false); }
+int m_t_turn_to(sd_bus_message* m, void* userdata, sd_bus_error* err) { return turn(m, userdata, err, true); }
+
+PROP(te_orientation) {
+    const auto& o = ctl(userdata).teensy().orientation;
+    return sd_bus_message_append(reply, "(ddd)", o[0], o[1], o[2]);
+}
+PROP(te_distances) {
+    const auto& d = ctl(userdata).teensy().distances;
+    return sd_bus_message_append_array(reply, 'q', d.data(), d.size() * sizeof(uint16_t));
+}
+PROP(te_servos) {
+    const auto& s = ctl(userdata).teensy().servos;
+    return sd_bus_message_append_array(reply, 'y', s.data(), s.size());
+}
+PROP(te_task) { return sd_bus_message_append(reply, "s", ctl(userdata).teensy().turning ? "turning" : "idle"); }
+PROP(te_online) { return sd_bus_message_append(reply, "b", static_cast<int>(ctl(userdata).teensy().online)); }
+PROP(te_frames) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy_counters().frames); }
+PROP(te_busy) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy_counters().busy_retries); }
+PROP(te_errors) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy_counters().link_errors); }
+
+const sd_bus_vtable kTeensyVtable[] = {
+    SD_BUS_VTABLE_START(0),
+    SD_BUS_METHOD_WITH_ARGS("SetSpeed", SD_BUS_ARGS("i", left, "i", right), SD_BUS_NO_RESULT, m_t_set_speed, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("Turn", SD_BUS_ARGS("d", radians), SD_BUS_NO_RESULT, m_t_turn, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("TurnTo", SD_BUS_ARGS("d", heading), SD_BUS_NO_RESULT, m_t_turn_to, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("Stop", SD_BUS_ARGS("y", brake_duty), SD_BUS_NO_RESULT, m_t_stop, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("SetServo", SD_BUS_ARGS("y", id, "y", degrees), SD_BUS_NO_RESULT, m_t_servo, kUnpriv),
+    SD_BUS_METHOD_WITH_ARGS("GetDistance", SD_BUS_ARGS("y", sensor), SD_BUS_RESULT("q", millimeters), m_t_distance, kUnpriv),
+    SD_BUS_PROPERTY("Orientation", "(ddd)", te_orientation, 0, kChange),
+    SD_BUS_PROPERTY("Distances", "aq", te_distances, 0, kChange),
+    SD_BUS_PROPERTY("Servos", "ay", te_servos, 0, kChange),
+    SD_BUS_PROPERTY("Task", "s", te_task, 0, kChange),
+    SD_BUS_PROPERTY("Online", "b", te_online, 0, kChange),
+    SD_BUS_PROPERTY("Frames", "t", te_frames, 0, kChange),
+    SD_BUS_PROPERTY("BusyRetries", "t", te_busy, 0, kChange),
+    SD_BUS_PROPERTY("LinkErrors", "t", te_errors, 0, kChange),
+    SD_BUS_VTABLE_END,
+};
+
+// --- Bus -------------------------------------------------------------------------------------
+
+PROP(b_device) { return sd_bus_message_append(reply, "s", ctl(userdata).config().i2c.device.c_str()); }
+PROP(b_state) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().state.c_str()); }
+PROP(b_transactions) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().transactions); }
+PROP(b_errors) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().errors); }
+PROP(b_last_error) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().last_error.c_str()); }
+
+const sd_bus_vtable kBusVtable[] = {
+    SD_BUS_VTABLE_START(0),
+    SD_BUS_PROPERTY("Device", "s", b_device, 0, kConst),
+    SD_BUS_PROPERTY("State", "s", b_state, 0, kChange),
+    SD_BUS_PROPERTY("Transactions", "t", b_transactions, 0, kChange),
+    SD_BUS_PROPERTY("Errors", "t", b_errors, 0, kChange),
+    SD_BUS_PROPERTY("LastError", "s", b_last_error, 0, kChange),
+    SD_BUS_VTABLE_END,
+};
+
+#undef PROP
+
+} // namespace
+
+VehicleService::~VehicleService() {
+    if (bus_)
+        sd_bus_release_name(bus_, kBusName);
+}
+
+int VehicleService::start() {
+    sd_bus_slot* slot = nullptr;
+    auto keep = [&](int r) {
+        if (r >= 0)
+            slots_.emplace_back(slot);
+        return r;
+    };
+    int r = keep(sd_bus_add_object_manager(bus_, &slot, kRootPath));
+    if (r >= 0)
+        r = keep(sd_bus_add_object_vtable(bus_, &slot, kRootPath, kVehicleIface, kVehicleVtable, this));
+    for (size_t i = 0; r >= 0 && i < controller_.thruster_count(); ++i) {
+        auto obj = std::make_unique<ThrusterObject>(
+            ThrusterObject{this, i, std::string(kRootPath) + "/thruster/" + std::to_string(i)});
+        r = keep(sd_bus_add_object_vtable(bus_, &slot, obj->path.c_str(), kThrusterIface, kThrusterVtable, obj.get()));
+        thruster_objects_.push_back(std::move(obj));
+    }
+    if (r >= 0)
+        r = keep(sd_bus_add_object_vtable(bus_, &slot, (std::string(kRootPath) + "/teensy").c_str(), kTeensyIface,
+                                          kTeensyVtable, this));
+    if (r >= 0)
+        r = keep(sd_bus_add_object_vtable(bus_, &slot, (std::string(kRootPath) + "/bus").c_str(), kBusIface,
+                                          kBusVtable, this));
+    // Track every disconnect from the start, so a controlling client that leaves right after
+    // its command cannot slip past an asynchronously installed match.
+    if (r >= 0)
+        r = keep(sd_bus_add_match(bus_, &slot,
+                                  "type='signal',sender='org.freedesktop.DBus',path='/org/freedesktop/DBus',"
+                                  "interface='org.freedesktop.DBus',member='NameOwnerChanged'",
+                                  on_name_owner_changed, this));
+    if (r < 0)
+        return r;
+    for (size_t i = 0; i < controller_.thruster_count(); ++i)
+        published_.push_back(snapshot(i));
+    return sd_bus_request_name(bus_, kBusName, 0);
+}
+
+int VehicleService::on_name_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    const char *name = nullptr, *old_owner = nullptr, *new_owner = nullptr;
+    if (sd_bus_message_read(m, "sss", &name, &old_owner, &new_owner) < 0)
+        return 0;
+    if (name && name[0] == ':' && new_owner && new_owner[0] == '\0')
+        static_cast<VehicleService*>(userdata)->controller_.client_left(name);
+    return 0;
+}
+
+void VehicleService::vehicle_changed(uint32_t changes) {
+    std::vector<const char*> names;
+    if (changes & kChangeState) {
+        names.push_back("State");
+        names.push_back("KillSource");
+    }
+    if (changes & kChangeMotors) {
+        names.push_back("MotorValues");
+        names.push_back("RequestedValues");
+        names.push_back("BudgetLimit");
+        names.push_back("Saturated");
+    }
+    if (changes & kChangeLeds)
+        names.push_back("Leds");
+    if (changes & kChangeController)
+        names.push_back("Controller");
+    if (names.empty())
+        return;
+    names.push_back(nullptr);
+    sd_bus_emit_properties_changed_strv(bus_, kRootPath, kVehicleIface, const_cast<char**>(names.data()));
+}
+
+VehicleService::ThrusterSnapshot VehicleService::snapshot(size_t i) const {
+    const ThrusterDriver& t = controller_.thruster(i);
+    ThrusterSnapshot s;
+    s.online = t.online();
+    s.ordered_value = controller_.ordered_value(i);
+    s.ordered_speed = t.last_speed().value_or(0x80);
+    if (const auto& st = t.last_status()) {
+        s.actual_speed = actual_speed(*st);
+        s.current = current_amps(*st);
+        s.temperature = temperature_c(*st);
+        s.faults = st->faults.bits;
+        s.firmware = firmware_revision(*st);
+    }
+    const auto& c = t.counters();
+    s.orders = c.orders_sent;
+    s.failures = c.order_failures;
+    s.reads = c.status_reads;
+    s.nacks = c.nacks;
+    s.timeouts = c.timeouts;
+    s.bad = c.bad_replies;
+    s.last_error = thruster_error_text(t);
+    return s;
+}
+
+void VehicleService::telemetry() {
+    const char* vehicle_names[] = {"CommandAgeMs", "Cycles", nullptr};
+    sd_bus_emit_properties_changed_strv(bus_, kRootPath, kVehicleIface, const_cast<char**>(vehicle_names));
+
+    for (size_t i = 0; i < thruster_objects_.size(); ++i) {
+        ThrusterSnapshot now = snapshot(i);
+        const ThrusterSnapshot& was = published_[i];
+        if (now == was)
+            continue;
+        std::vector<const char*> n;
+        if (now.online != was.online) n.push_back("Online");
+        if (now.ordered_value != was.ordered_value) n.push_back("OrderedValue");
+        if (now.ordered_speed != was.ordered_speed) n.push_back("OrderedSpeed");
+        if (now.actual_speed != was.actual_speed) n.push_back("ActualSpeed");
+        if (now.current != was.current) n.push_back("Current");
+        if (now.temperature != was.temperature) n.push_back("Temperature");
+        if (now.faults != was.faults) n.push_back("Faults");
+        if (now.firmware != was.firmware) n.push_back("FirmwareRevision");
+        if (now.orders != was.orders) n.push_back("OrdersSent");
+        if (now.failures != was.failures) n.push_back("OrderFailures");
+        if (now.reads != was.reads) n.push_back("StatusReads");
+        if (now.nacks != was.nacks) n.push_back("Nacks");
+        if (now.timeouts != was.timeouts) n.push_back("Timeouts");
+        if (now.bad != was.bad) n.push_back("BadReplies");
+        if (now.last_error != was.last_error) n.push_back("LastError");
+        n.push_back(nullptr);
+        sd_bus_emit_properties_changed_strv(bus_, thruster_objects_[i]->path.c_str(), kThrusterIface,
+                                            const_cast<char**>(n.data()));
+        published_[i] = std::move(now);
+    }
+
+    const TeensyTelemetry& te = controller_.teensy();
+    const auto& tc = controller_.teensy_counters();
+    std::vector<const char*> tn;
+    if (te.orientation != published_teensy_.orientation) tn.push_back("Orientation");
+    if (te.distances != published_teensy_.distances) tn.push_back("Distances");
+    if (te.servos != published_teensy_.servos) tn.push_back("Servos");
+    if (te.turning != published_teensy_.turning) tn.push_back("Task");
+    if (te.online != published_teensy_.online) tn.push_back("Online");
+    if (tc.frames != published_teensy_frames_) tn.push_back("Frames");
+    if (tc.busy_retries != published_teensy_busy_) tn.push_back("BusyRetries");
+    if (tc.link_errors != published_teensy_errors_) tn.push_back("LinkErrors");
+    if (!tn.empty()) {
+        tn.push_back(nullptr);
+        sd_bus_emit_properties_changed_strv(bus_, (std::string(kRootPath) + "/teensy").c_str(), kTeensyIface,
+                                            const_cast<char**>(tn.data()));
+        published_teensy_ = te;
+        published_teensy_frames_ = tc.frames;
+        published_teensy_busy_ = tc.busy_retries;
+        published_teensy_errors_ = tc.link_errors;
+    }
+
+    const BusTelemetry& b = controller_.bus();
+    std::vector<const char*> bn;
+    if (b.state != published_bus_.state) bn.push_back("State");
+    if (b.transactions != published_bus_.transactions) bn.push_back("Transactions");
+    if (b.errors != published_bus_.errors) bn.push_back("Errors");
+    if (b.last_error != published_bus_.last_error) bn.push_back("LastError");
+    if (!bn.empty()) {
+        bn.push_back(nullptr);
+        sd_bus_emit_properties_changed_strv(bus_, (std::string(kRootPath) + "/bus").c_str(), kBusIface,
+                                            const_cast<char**>(bn.data()));
+        published_bus_ = b;
+    }
+}
+
+} // namespace caracara::dbus

@@ -1,0 +1,236 @@
+// The simulated Teensy I/O microcontroller: an SPI slave speaking the seed protocol
+// (seeds/raspi-teensy-spi-protocol.md) plus this vehicle's extension (0x09 Set LEDs).
+//
+// It works byte by byte, as the Teensy's SPI interrupt does: a frame is
+// [command][data 0-4][answer 0-4][ack]; the command byte alone tells the slave how many data
+// and answer bytes follow. While byte k is shifted in, the slave shifts out what it loaded after
+// byte k-1: zeros during the command and data slots, the answer once all data has arrived, and
+// the ack (= command id) last. Frames may come as one transfer or as one transfer per byte;
+// releasing chip select (end_message) always returns the slave to "expect a command".
+//
+// Decisions the seed leaves open (documented in the protocol docs as well):
+// - Confirm (0x01) has no data byte and one answer byte. The slave answers 0xFF there when the
+//   running task has finished, else 0. The host acknowledges a finished task by transmitting a
+//   non-zero byte (uint8 "positive") on MOSI during that same answer slot; the slave reads it
+//   there, and the task becomes idle when the frame completes.
+// - Invalid arguments (servo id or sensor id out of range, servo angle > 180, axis > 2,
+//   non-finite turn angle): the frame is not executed, its answer slots are zero and the ack
+//   slot carries 0x00 ("not acknowledged"), which the host sees as an error. Counted.
+// - Unknown command: the slave cannot know the frame length, so it shifts out 0x00 until chip
+//   select is released (the host sees ack 0x00, a link error). Logged as Unknown.
+// - A frame takes effect only once its ack slot has been shifted out: a frame cut short by
+//   chip select is discarded, so the host's resend never doubles a relative Turn.
+// - Turn / Turn to: the Teensy turns by its drive wheels, which the attitude model does not
+//   know about; the reported heading is the body's yaw plus an internal offset that a running
+//   turn task moves at the configured rate. The remaining angle is fixed when the task starts
+//   (Turn to takes the shortest way); body motion during the task is not compensated.
+// - Stop ends a running turn where it is and marks it finished, so a host polling Confirm
+//   is not left waiting for a turn that will never complete.
+//
+// Fault injection, decided when the command byte arrives (frames of known commands only;
+// the first matching rule wins):
+//   no answer  (N frames): MISO all 0x00; models a Teensy that is not listening (resetting,
+//                          hung interrupt), so the frame is not executed;
+//   garbage ack (N frames): the ack slot carries command ^ 0xA5 (never the command, 0x00 or
+//                          0xFF for a valid id); models corruption on MISO only, so the frame
+//                          IS executed and its answer bytes are real;
+//   busy        (N frames, then with probability p from a seeded RNG): answer slots 0x00,
+//                          ack 0xFF, not executed (the host resends).
+//
+// Not thread-safe: the simulator drives all models from one thread.
+#pragma once
+
+#include "slave.hpp"
+#include "vehicle_body.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <string_view>
+#include <vector>
+
+namespace caracara::sim {
+
+namespace teensy {
+inline constexpr uint8_t kConfirm = 0x01;
+inline constexpr uint8_t kSetSpeed = 0x02;
+inline constexpr uint8_t kTurn = 0x03;
+inline constexpr uint8_t kTurnTo = 0x04;
+inline constexpr uint8_t kStop = 0x05;
+inline constexpr uint8_t kServo = 0x06;
+inline constexpr uint8_t kGetDistance = 0x07;
+inline constexpr uint8_t kGetOrientation = 0x08;
+inline constexpr uint8_t kSetLeds = 0x09;
+
+inline constexpr uint8_t kAckBusy = 0xFF;       // in the ack slot
+inline constexpr uint8_t kAckNone = 0x00;       // invalid argument / unknown command / not listening
+inline constexpr uint8_t kTaskFinished = 0xFF;  // in Confirm's answer slot
+inline constexpr uint8_t kGarbageXor = 0xA5;
+inline constexpr std::size_t kMaxServoDegrees = 180;
+} // namespace teensy
+
+struct TeensyConfig {
+    // Rear-wheel formula v3/4 = k * Df/Db * ((v1 + v2)/2 +- (v2 - v1)).
+    double wheel_k = 0.8;
+    double front_circumference = 1.0; // Df, any unit (only the ratio matters)
+    double back_circumference = 1.0;  // Db
+    double turn_rate_rad_s = 1.0;
+    std::size_t servo_count = 4;
+    std::size_t distance_sensor_count = 4;
+    uint8_t servo_initial_degrees = 90;
+    uint16_t distance_initial_mm = 1000;
+    std::size_t log_capacity = 256;
+};
+
+// Front speeds as commanded (int8), back speeds from the formula (may exceed int8 range).
+struct TeensyWheels {
+    double front_left = 0.0;
+    double front_right = 0.0;
+    double back_left = 0.0;
+    double back_right = 0.0;
+};
+
+enum class TeensyTaskState : uint8_t { Idle, Running, FinishedAwaitingAck };
+
+enum class TeensyFrameOutcome : uint8_t {
+    Ok,         // executed, ack = command
+    Busy,       // ack 0xFF, not executed
+    GarbageAck, // executed, ack corrupted
+    NoAnswer,   // all zeros, not executed
+    Invalid,    // bad argument, ack 0x00, not executed
+    Unknown,    // unknown command id, zeros until chip select release
+    Incomplete, // chip select released before the ack slot, not executed
+};
+
+struct TeensyFrameRecord {
+    uint64_t seq = 0; // running number over the model's lifetime, for incremental readers
+    uint64_t start_ns = 0;
+    uint64_t end_ns = 0;
+    uint8_t command = 0;
+    std::string_view name;
+    TeensyFrameOutcome outcome = TeensyFrameOutcome::Ok;
+    std::vector<uint8_t> mosi;
+    std::vector<uint8_t> miso;
+};
+
+std::string_view teensy_command_name(uint8_t command);
+std::string_view to_string(TeensyFrameOutcome o);
+std::string_view to_string(TeensyTaskState s);
+
+class TeensyModel : public SpiSlave, public Stepped {
+public:
+    using AttitudeSource = std::function<BodyAttitude()>;
+
+    TeensyModel(TeensyConfig cfg, AttitudeSource attitude);
+    // The body must outlive the model.
+    TeensyModel(TeensyConfig cfg, const VehicleBody& body);
+
+    void transfer(std::span<const uint8_t> tx, std::span<uint8_t> rx, const SpiTransferParams& p,
+                  uint64_t now_ns) override;
+    void end_message(uint64_t now_ns) override;
+    void step(double dt_s, uint64_t now_ns) override;
+
+    // --- fault injection ---
+    void inject_busy(unsigned frames) { busy_frames_ = frames; }
+    // false (and nothing changes) unless 0 <= probability <= 1.
+    bool set_random_busy(double probability, uint64_t seed);
+    void inject_garbage_ack(unsigned frames) { garbage_frames_ = frames; }
+    void inject_no_answer(unsigned frames) { no_answer_frames_ = frames; }
+    void clear_faults();
+    unsigned pending_busy() const { return busy_frames_; }
+    unsigned pending_garbage_ack() const { return garbage_frames_; }
+    unsigned pending_no_answer() const { return no_answer_frames_; }
+    double random_busy_probability() const { return busy_probability_; }
+
+    // --- settable sensor values ---
+    bool set_distance_mm(std::size_t sensor, uint16_t mm);
+
+    // --- observation ---
+    std::vector<TeensyFrameRecord> frame_log() const; // oldest first
+    uint64_t frames_total() const { return next_seq_; }
+    // Frames whose command byte was seen / that were executed (Ok or GarbageAck).
+    uint64_t commands_received(uint8_t command) const { return received_[command]; }
+    uint64_t commands_executed(uint8_t command) const { return executed_[command]; }
+    uint64_t outcome_count(TeensyFrameOutcome o) const { return outcomes_[static_cast<std::size_t>(o)]; }
+
+    TeensyWheels wheels() const { return wheels_; }
+    uint8_t stop_duty() const { return stop_duty_; }
+    float last_turn_rad() const { return last_turn_; }       // argument of the last Turn
+    float last_turn_to_rad() const { return last_turn_to_; } // argument of the last Turn to
+    double turn_target_heading() const { return target_heading_; }
+    double turn_remaining_rad() const { return remaining_; }
+    TeensyTaskState task_state() const { return task_; }
+    uint64_t acknowledgements() const { return acks_; }
+    const std::vector<uint8_t>& servo_degrees() const { return servos_; }
+    const std::vector<uint16_t>& distances_mm() const { return distances_; }
+    std::array<uint8_t, 3> leds() const { return leds_; }
+    // What Get orientation answers: body attitude with the heading offset applied to yaw.
+    BodyAttitude orientation() const;
+    double heading_offset() const { return heading_offset_; }
+    const TeensyConfig& config() const { return cfg_; }
+
+private:
+    enum class Plan : uint8_t { Normal, Busy, Garbage, NoAnswer };
+
+    struct Frame {
+        bool active = false;
+        bool known = false;
+        uint8_t cmd = 0;
+        std::size_t data_len = 0;
+        std::size_t answer_len = 0;
+        std::size_t pos = 0; // slot index of the next byte
+        Plan plan = Plan::Normal;
+        bool invalid = false;
+        std::array<uint8_t, 4> data{};
+        std::array<uint8_t, 4> answer{};
+        uint8_t host_answer0 = 0; // what the host sent in the first answer slot
+        uint64_t start_ns = 0;
+        std::vector<uint8_t> mosi;
+        std::vector<uint8_t> miso;
+    };
+
+    uint8_t on_byte(uint8_t in, uint64_t now_ns);
+    void begin_frame(uint8_t cmd, uint64_t now_ns);
+    Plan choose_plan();
+    void prepare_answer();
+    uint8_t slot_output() const;
+    uint8_t ack_byte() const;
+    void finish_frame(uint64_t now_ns);
+    void execute();
+    void log_frame(TeensyFrameOutcome o, uint64_t now_ns);
+    double heading() const;
+    bool next_random_busy();
+
+    TeensyConfig cfg_;
+    AttitudeSource attitude_;
+    Frame f_;
+
+    unsigned busy_frames_ = 0;
+    unsigned garbage_frames_ = 0;
+    unsigned no_answer_frames_ = 0;
+    double busy_probability_ = 0.0;
+    uint64_t rng_state_ = 0;
+
+    std::deque<TeensyFrameRecord> log_;
+    uint64_t next_seq_ = 0;
+    std::array<uint64_t, 256> received_{};
+    std::array<uint64_t, 256> executed_{};
+    std::array<uint64_t, 7> outcomes_{};
+
+    TeensyWheels wheels_{};
+    uint8_t stop_duty_ = 0;
+    float last_turn_ = 0.0f;
+    float last_turn_to_ = 0.0f;
+    double target_heading_ = 0.0;
+    double remaining_ = 0.0;
+    double heading_offset_ = 0.0;
+    TeensyTaskState task_ = TeensyTaskState::Idle;
+    uint64_t acks_ = 0;
+    std::vector<uint8_t> servos_;
+    std::vector<uint16_t> distances_;
+    std::array<uint8_t, 3> leds_{};
+};
+
+} // namespace caracara::sim

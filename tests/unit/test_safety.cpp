@@ -1,0 +1,296 @@
+#include "safety.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace caracara;
+
+namespace {
+
+constexpr uint64_t kT0 = 1'000'000'000'000;  // an arbitrary monotonic start time
+constexpr uint64_t ms(uint64_t v) { return ms_to_ns(v); }
+
+// A machine past its arming delay.
+SafetyMachine ready_machine(uint64_t& now) {
+    SafetyMachine s(SafetyConfig{}, false, kT0);
+    now = kT0 + ms(3000);
+    s.tick(now);
+    REQUIRE(s.state() == SafetyState::Ready);
+    return s;
+}
+
+} // namespace
+
+TEST_CASE("startup arms for 3 s with zero output, then becomes ready") {
+    SafetyMachine s(SafetyConfig{}, false, kT0);
+    CHECK(s.state() == SafetyState::Arming);
+    CHECK_FALSE(s.may_drive());
+    CHECK_FALSE(s.kill_output_asserted());
+    CHECK(s.arming_remaining_ns(kT0) == ms(3000));
+    CHECK(s.next_deadline() == kT0 + ms(3000));
+
+    const SafetyAction refused = s.accept_command(kT0 + ms(1000));
+    CHECK(refused.error == SafetyError::NotReady);
+    CHECK(error_name(refused.error) == "NotReady");
+    CHECK_THAT(refused.message, Catch::Contains("arming") && Catch::Contains("2000 ms"));
+
+    SafetyAction a = s.tick(kT0 + ms(2999));
+    CHECK_FALSE(a.state_changed);
+    CHECK(s.state() == SafetyState::Arming);
+    CHECK_FALSE(s.may_drive());
+
+    a = s.tick(kT0 + ms(3000));
+    CHECK(a.state_changed);
+    CHECK(s.state() == SafetyState::Ready);
+    CHECK(s.may_drive());
+    CHECK(s.accept_command(kT0 + ms(3001)).ok());
+    CHECK(s.command_active());
+}
+
+TEST_CASE("a timestamp from before the arming start does not end arming") {
+    SafetyMachine s(SafetyConfig{}, false, kT0);
+    s.tick(kT0 - ms(10000));
+    CHECK(s.state() == SafetyState::Arming);
+}
+
+TEST_CASE("the arming delay is configurable") {
+    SafetyConfig cfg;
+    cfg.arming_delay_ns = ms(100);
+    SafetyMachine s(cfg, false, kT0);
+    s.tick(kT0 + ms(99));
+    CHECK(s.state() == SafetyState::Arming);
+    s.tick(kT0 + ms(100));
+    CHECK(s.state() == SafetyState::Ready);
+}
+
+TEST_CASE("starting with the kill switch set starts killed") {
+    SafetyMachine s(SafetyConfig{}, true, kT0);
+    CHECK(s.state() == SafetyState::Killed);
+    CHECK(s.kill_source() == KillSource::Switch);
+    CHECK(s.kill_output_asserted());
+    CHECK(s.next_deadline() == SafetyMachine::kNoDeadline);
+    s.tick(kT0 + ms(60000));
+    CHECK(s.state() == SafetyState::Killed);
+
+    const SafetyAction a = s.clear_kill(kT0 + ms(1));
+    CHECK(a.error == SafetyError::KillSwitchSet);
+    CHECK(error_name(a.error) == "KillSwitchSet");
+    CHECK(s.state() == SafetyState::Killed);
+
+    s.switch_changed(false, kT0 + ms(2));
+    CHECK(s.state() == SafetyState::Killed);  // releasing the switch does not clear the kill
+    CHECK(s.clear_kill(kT0 + ms(3)).ok());
+    CHECK(s.state() == SafetyState::Arming);
+}
+
+TEST_CASE("a kill zeroes at once, drops commands and latches") {
+    for (KillSource src : {KillSource::DBus, KillSource::Switch, KillSource::Packet, KillSource::Fault}) {
+        INFO(kill_source_name(src));
+        uint64_t now = 0;
+        SafetyMachine s = ready_machine(now);
+        REQUIRE(s.accept_command(now, ":1.42").ok());
+        const SafetyAction a = src == KillSource::Switch ? s.switch_changed(true, now + 1)
+                                                         : s.kill(src, now + 1, "test");
+        CHECK(a.ok());
+        CHECK(a.state_changed);
+        CHECK(a.zero_outputs);
+        CHECK(a.clear_commands);
+        CHECK(s.state() == SafetyState::Killed);
+        CHECK(s.kill_source() == src);
+        CHECK(s.killed_at() == now + 1);
+        CHECK(s.kill_output_asserted());
+        CHECK_FALSE(s.may_drive());
+        CHECK_FALSE(s.command_active());
+        CHECK(s.commanding_client().empty());
+
+        // Latched: time passing changes nothing, commands are refused.
+        s.tick(now + ms(600000));
+        CHECK(s.state() == SafetyState::Killed);
+        const SafetyAction r = s.accept_command(now + ms(600001));
+        CHECK(r.error == SafetyError::NotReady);
+        CHECK_THAT(r.message, Catch::Contains("killed"));
+    }
+    CHECK(kill_source_name(KillSource::DBus) == "dbus");
+    CHECK(kill_source_name(KillSource::Switch) == "switch");
+    CHECK(kill_source_name(KillSource::Packet) == "packet");
+    CHECK(kill_source_name(KillSource::Fault) == "fault");
+}
+
+TEST_CASE("a second kill keeps the first source and still asks for zero") {
+    uint64_t now = 0;
+    SafetyMachine s = ready_machine(now);
+    s.kill(KillSource::Packet, now);
+    const SafetyAction a = s.kill(KillSource::Fault, now + 1, "bus recovery failed");
+    CHECK(a.ok());
+    CHECK_FALSE(a.state_changed);
+    CHECK(a.zero_outputs);
+    CHECK(s.kill_source() == KillSource::Packet);
+    CHECK(s.killed_at() == now);
+}
+
+TEST_CASE("a kill during arming stops the arming") {
+    SafetyMachine s(SafetyConfig{}, false, kT0);
+    s.kill(KillSource::DBus, kT0 + ms(1000));
+    s.tick(kT0 + ms(5000));
+    CHECK(s.state() == SafetyState::Killed);
+}
+
+TEST_CASE("clearing needs a kill, the switch released, then a full arming delay") {
+    uint64_t now = 0;
+    SafetyMachine s = ready_machine(now);
+
+    SafetyAction a = s.clear_kill(now);
+    CHECK(a.error == SafetyError::NotKilled);
+    CHECK(error_name(a.error) == "NotKilled");
+    CHECK(s.state() == SafetyState::Ready);
+
+    s.kill(KillSource::DBus, now);
+    s.switch_changed(true, now + 1);  // switch set while already killed
+    CHECK(s.kill_source() == KillSource::DBus);
+    a = s.clear_kill(now + 2);
+    CHECK(a.error == SafetyError::KillSwitchSet);
+    CHECK(s.state() == SafetyState::Killed);
+
+    s.switch_changed(false, now + 3);
+    const uint64_t cleared = now + ms(10);
+    a = s.clear_kill(cleared);
+    CHECK(a.ok());
+    CHECK(a.state_changed);
+    CHECK(a.zero_outputs);
+    CHECK(s.state() == SafetyState::Arming);
+    CHECK(s.kill_source() == KillSource::None);
+    CHECK_FALSE(s.kill_output_asserted());
+    CHECK_FALSE(s.may_drive());
+    CHECK(s.accept_command(cleared + ms(2999)).error == SafetyError::NotReady);
+
+    s.tick(cleared + ms(2999));
+    CHECK(s.state() == SafetyState::Arming);
+    s.tick(cleared + ms(3000));
+    CHECK(s.state() == SafetyState::Ready);
+    // Nothing resumes by itself: no command is active until a new one arrives.
+    CHECK_FALSE(s.command_active());
+}
+
+TEST_CASE("the kill switch kills from ready and keeps the vehicle killed while set") {
+    uint64_t now = 0;
+    SafetyMachine s = ready_machine(now);
+    s.switch_changed(true, now);
+    CHECK(s.state() == SafetyState::Killed);
+    CHECK(s.kill_source() == KillSource::Switch);
+    CHECK(s.kill_switch_set());
+    CHECK(s.clear_kill(now + ms(1)).error == SafetyError::KillSwitchSet);
+    s.switch_changed(false, now + ms(2));
+    CHECK_FALSE(s.kill_switch_set());
+    CHECK(s.state() == SafetyState::Killed);
+    CHECK(s.clear_kill(now + ms(3)).ok());
+}
+
+TEST_CASE("power-off is irreversible") {
+    uint64_t now = 0;
+    SafetyMachine s = ready_machine(now);
+    REQUIRE(s.accept_command(now).ok());
+    SafetyAction a = s.power_off(now + 1);
+    CHECK(a.ok());
+    CHECK(a.state_changed);
+    CHECK(a.zero_outputs);
+    CHECK(a.clear_commands);
+    CHECK(s.state() == SafetyState::PoweredOff);
+    CHECK(s.kill_output_asserted());
+    CHECK_FALSE(s.may_drive());
+
+    a = s.power_off(now + 2);
+    CHECK(a.error == SafetyError::PoweredOff);
+    CHECK(error_name(a.error) == "PoweredOff");
+    CHECK(s.clear_kill(now + 3).error == SafetyError::PoweredOff);
+    CHECK(s.accept_command(now + 4).error == SafetyError::PoweredOff);
+    a = s.kill(KillSource::DBus, now + 5);
+    CHECK(a.ok());
+    CHECK(a.zero_outputs);
+    CHECK_FALSE(a.state_changed);
+    s.switch_changed(true, now + 6);
+    s.switch_changed(false, now + 7);
+    s.tick(now + ms(100000));
+    CHECK(s.state() == SafetyState::PoweredOff);
+
+    // Also from killed and from arming.
+    SafetyMachine k(SafetyConfig{}, true, kT0);
+    CHECK(k.power_off(kT0).ok());
+    CHECK(k.state() == SafetyState::PoweredOff);
+    SafetyMachine arming(SafetyConfig{}, false, kT0);
+    CHECK(arming.power_off(kT0).ok());
+    arming.tick(kT0 + ms(5000));
+    CHECK(arming.state() == SafetyState::PoweredOff);
+}
+
+TEST_CASE("a silent command stream zeroes the output without killing") {
+    uint64_t now = 0;
+    SafetyMachine s = ready_machine(now);
+    REQUIRE(s.accept_command(now, ":1.7").ok());
+    CHECK(s.next_deadline() == now + ms(500));
+
+    SafetyAction a = s.tick(now + ms(499));
+    CHECK_FALSE(a.zero_outputs);
+    CHECK(s.command_active());
+
+    REQUIRE(s.accept_command(now + ms(400), ":1.7").ok());  // a fresh command restarts the watchdog
+    a = s.tick(now + ms(899));
+    CHECK_FALSE(a.command_stale);
+
+    a = s.tick(now + ms(900));
+    CHECK(a.ok());
+    CHECK(a.command_stale);
+    CHECK(a.zero_outputs);
+    CHECK(a.clear_commands);
+    CHECK_FALSE(a.state_changed);
+    CHECK(s.state() == SafetyState::Ready);  // not a kill
+    CHECK(s.kill_source() == KillSource::None);
+    CHECK_FALSE(s.kill_output_asserted());
+    CHECK_FALSE(s.command_active());
+
+    // Reported once, and the next command drives again without any clear.
+    CHECK_FALSE(s.tick(now + ms(2000)).command_stale);
+    CHECK(s.accept_command(now + ms(2001)).ok());
+    CHECK(s.command_active());
+}
+
+TEST_CASE("the command timeout is configurable") {
+    SafetyConfig cfg;
+    cfg.arming_delay_ns = 0;
+    cfg.command_timeout_ns = ms(50);
+    SafetyMachine s(cfg, false, kT0);
+    s.tick(kT0);
+    REQUIRE(s.accept_command(kT0).ok());
+    CHECK_FALSE(s.tick(kT0 + ms(49)).command_stale);
+    CHECK(s.tick(kT0 + ms(50)).command_stale);
+}
+
+TEST_CASE("the commanding client leaving zeroes the output without killing") {
+    uint64_t now = 0;
+    SafetyMachine s = ready_machine(now);
+    REQUIRE(s.accept_command(now, ":1.7").ok());
+    CHECK(s.commanding_client() == ":1.7");
+
+    SafetyAction a = s.client_left(":1.9", now + 1);  // someone else
+    CHECK_FALSE(a.zero_outputs);
+    CHECK(s.command_active());
+
+    a = s.client_left(":1.7", now + 2);
+    CHECK(a.ok());
+    CHECK(a.zero_outputs);
+    CHECK(a.clear_commands);
+    CHECK(s.state() == SafetyState::Ready);
+    CHECK_FALSE(s.command_active());
+    CHECK(s.next_deadline() == SafetyMachine::kNoDeadline);
+
+    // The latest commander takes over.
+    REQUIRE(s.accept_command(now + 3, ":1.7").ok());
+    REQUIRE(s.accept_command(now + 4, ":1.8").ok());
+    CHECK_FALSE(s.client_left(":1.7", now + 5).zero_outputs);
+    CHECK(s.client_left(":1.8", now + 6).zero_outputs);
+}
+
+TEST_CASE("state names") {
+    CHECK(state_name(SafetyState::Arming) == "arming");
+    CHECK(state_name(SafetyState::Ready) == "ready");
+    CHECK(state_name(SafetyState::Killed) == "killed");
+    CHECK(state_name(SafetyState::PoweredOff) == "powered-off");
+}
