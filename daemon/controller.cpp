@@ -226,8 +226,13 @@ void Controller::zero_now() {
 
 void Controller::note_bus_result(IoError e) {
     ++bus_tm_.transactions;
-    if (e == IoError::None)
+    if (e == IoError::None) {
+        if (bus_tm_.state != "ok") {
+            bus_tm_.state = "ok";
+            notify(kChangeState);
+        }
         return;
+    }
     ++bus_tm_.errors;
     bus_tm_.last_error = std::string(io_error_name(e));
     if (e == IoError::BadReply)
@@ -235,7 +240,11 @@ void Controller::note_bus_result(IoError e) {
     bool all_down = true;
     for (const auto& t : thrusters_)
         all_down = all_down && !t->online();
-    bus_tm_.state = all_down ? "lost" : "ok";
+    const char* state = all_down ? "lost" : "ok";
+    if (bus_tm_.state != state) {
+        bus_tm_.state = state;
+        notify(kChangeState); // State reads "fault" while no thruster answers
+    }
 }
 
 void Controller::handle(const SafetyAction& a) {
@@ -423,7 +432,13 @@ void Controller::client_left(std::string_view unique_name) {
     notify(kChangeController);
 }
 
-std::string_view Controller::state_name() const { return caracara::state_name(safety_.state()); }
+std::string_view Controller::state_name() const {
+    // A vehicle that could run but reaches none of its thrusters is in fault, whatever it was asked.
+    const SafetyState s = safety_.state();
+    if ((s == SafetyState::Ready || s == SafetyState::Arming) && bus_tm_.state == "lost")
+        return "fault";
+    return caracara::state_name(s);
+}
 
 std::string_view Controller::kill_source_name() const {
     if (safety_.state() != SafetyState::Killed)

@@ -18,7 +18,7 @@ std::string_view kill_source_name(KillSource s) {
     case KillSource::DBus: return "dbus";
     case KillSource::Switch: return "switch";
     case KillSource::Packet: return "packet";
-    case KillSource::Fault: return "fault";
+    case KillSource::Fault: return "bus"; // the escalated fault is the I2C bus that could not be recovered
     }
     return "?";
 }

@@ -70,6 +70,7 @@ public:
 
     // Always accepted: from Arming/Ready it latches Killed with this source; when already
     // killed the first source is kept; after power-off it only repeats the zeroing.
+    // KillSource::None is recorded as Fault: a kill is never ignored for a missing source.
     SafetyAction kill(KillSource source, uint64_t now, std::string_view reason = {});
     // Killed -> Arming. Refused with NotKilled, KillSwitchSet or PoweredOff.
     SafetyAction clear_kill(uint64_t now);

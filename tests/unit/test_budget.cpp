@@ -157,8 +157,11 @@ TEST_CASE("scale policy never exceeds the limit over a sweep of inputs") {
 TEST_CASE("reject policy refuses an over-budget set for every count and changes nothing") {
     for (int n = 1; n <= 8; ++n) {
         INFO(n << " running motors");
-        MotorValues in = full(n);
-        in[0] = expected_limit(n) + 1;  // one over the limit is enough to refuse
+        // Every motor at its limit and motor 0 one over: enough to refuse.
+        MotorValues in{};
+        for (int i = 0; i < n; ++i)
+            in[static_cast<std::size_t>(i)] = (i % 2 == 0) ? expected_limit(n) : -expected_limit(n);
+        in[0] = expected_limit(n) + 1;
         const BudgetResult r = apply_budget(in, BudgetPolicy::Reject);
         CHECK(r.error == BudgetError::OverBudget);
         CHECK(error_name(r.error) == "OverBudget");

@@ -1,0 +1,1 @@
+caracara_integration_test(test_teensy_sim SOURCES integration/test_teensy_sim.cpp LIBS caracara_drivers DEPENDS caracara-sim)
