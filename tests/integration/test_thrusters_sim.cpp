@@ -208,3 +208,62 @@ TEST_CASE("reversed thrusters get the opposite direction on the wire") {
     REQUIRE(b.thrusters[5]->send_order(3000) == IoError::None);
     CHECK(f.thruster_byte(5, "OrderedSpeed") == speed_byte(-3000));
 }
+
+TEST_CASE("same-address thrusters behind two muxes: only one mux channel is ever enabled") {
+    const std::string cfg = R"(
+[[thruster]]
+address = 0x52
+mux_address = 0x70
+mux_channel = 0
+[[thruster]]
+address = 0x52
+mux_address = 0x71
+mux_channel = 0
+)";
+    SimFixture probe;
+    SimFixture f({"--config", probe.write_file("vehicle.toml", cfg)});
+    ThrusterConfig a;
+    a.mt = 0x52;
+    a.mux = MuxRoute{0x70, 0};
+    ThrusterConfig c = a;
+    c.mux = MuxRoute{0x71, 0};
+    Bench b(f, {a, c});
+    REQUIRE(b.thrusters[0]->send_order(1500) == IoError::None);
+    REQUIRE(b.thrusters[1]->send_order(-1500) == IoError::None);
+    // Had both muxes been left on, both thrusters would have taken the second order.
+    CHECK(f.thruster_byte(0, "OrderedSpeed") == speed_byte(1500));
+    CHECK(f.thruster_byte(1, "OrderedSpeed") == speed_byte(-1500));
+    CHECK(f.thruster_u64(0, "OrdersReceived") == 1);
+    CHECK(f.thruster_u64(1, "OrdersReceived") == 1);
+}
+
+TEST_CASE("a NACK on one thruster does not disturb the mux state of the others") {
+    const std::string cfg = R"(
+[[thruster]]
+address = 0x52
+mux_address = 0x70
+mux_channel = 0
+[[thruster]]
+address = 0x52
+mux_address = 0x70
+mux_channel = 1
+)";
+    SimFixture probe;
+    SimFixture f({"--config", probe.write_file("vehicle.toml", cfg)});
+    ThrusterConfig a;
+    a.mt = 0x52;
+    a.mux = MuxRoute{0x70, 0};
+    ThrusterConfig c = a;
+    c.mux = MuxRoute{0x70, 1};
+    Bench b(f, {a, c});
+    REQUIRE(f.call(f.thruster_path(0), "org.caracara.Simulator1.Thruster", "SetNack", "b", 1) == "");
+    CHECK(b.thrusters[0]->send_order(1000) == IoError::Nack);
+    CHECK(b.thrusters[0]->counters().nacks == 1);
+    REQUIRE(b.thrusters[1]->send_order(2000) == IoError::None);
+    CHECK(f.thruster_byte(1, "OrderedSpeed") == speed_byte(2000));
+    REQUIRE(f.call(f.thruster_path(0), "org.caracara.Simulator1.Thruster", "SetNack", "b", 0) == "");
+    // After the NACK the tracker re-selects channel 0 before talking to thruster 0 again.
+    REQUIRE(b.thrusters[0]->send_order(1000) == IoError::None);
+    CHECK(f.thruster_byte(0, "OrderedSpeed") == speed_byte(1000));
+    CHECK(f.thruster_byte(1, "OrderedSpeed") == speed_byte(2000));
+}

@@ -2,6 +2,7 @@
 // (section 8) and the Caracara packet seed; the arithmetic is next to each one. The driver is
 // exercised over a scripted DeviceIo that records the i2c_msg arrays of every I2C_RDWR, the
 // same arrays the kernel (or caracara-sim) would receive.
+#include "device_io.hpp"
 #include "i2c_dev.hpp"
 #include "seabotix.hpp"
 #include "thruster.hpp"
@@ -447,66 +448,10 @@ TEST_CASE("variant names and fault semantics") {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Driver over a scripted device: records every I2C_RDWR and answers from a script.
+// Thruster configuration checks (pure). The driver's bus behaviour is tested against the real
+// simulator in tests/integration/test_thrusters_sim.cpp, not against a scripted stand-in.
 
 namespace {
-
-struct Msg {
-    uint16_t addr;
-    uint16_t flags;
-    Bytes data;  // written bytes, or the bytes handed back for a read
-};
-
-class ScriptedIo final : public DeviceIo {
-public:
-    std::vector<std::vector<Msg>> transfers;  // one entry per I2C_RDWR
-    std::deque<int> results;                  // per I2C_RDWR: 0 = success, else -errno
-    std::deque<Bytes> replies;                // data for read messages, in order
-
-    int open(const char*, int) override { return 3; }
-    int close(int) override { return 0; }
-    int ioctl(int, unsigned long request, void* arg) override {
-        if (request == I2C_FUNCS) {
-            *static_cast<unsigned long*>(arg) = I2C_FUNC_I2C;
-            return 0;
-        }
-        if (request != I2C_RDWR)
-            return -ENOTTY;
-        auto* d = static_cast<i2c_rdwr_ioctl_data*>(arg);
-        int r = 0;
-        if (!results.empty()) {
-            r = results.front();
-            results.pop_front();
-        }
-        std::vector<Msg> log;
-        for (__u32 i = 0; i < d->nmsgs; ++i) {
-            i2c_msg& m = d->msgs[i];
-            Msg rec{m.addr, m.flags, {}};
-            if (m.flags & I2C_M_RD) {
-                if (r == 0) {
-                    Bytes reply = replies.empty() ? Bytes(m.len, 0xFF) : replies.front();
-                    if (!replies.empty())
-                        replies.pop_front();
-                    reply.resize(m.len, 0xFF);
-                    std::copy(reply.begin(), reply.end(), m.buf);
-                    rec.data = reply;
-                }
-            } else {
-                rec.data.assign(m.buf, m.buf + m.len);
-            }
-            log.push_back(rec);
-        }
-        transfers.push_back(log);
-        return r < 0 ? r : static_cast<int>(d->nmsgs);
-    }
-};
-
-struct Bench {
-    ScriptedIo io;
-    I2cDev bus{io, "/dev/i2c-test"};
-    MuxTracker mux;
-    Bench() { REQUIRE(bus.open() == 0); }
-};
 
 ThrusterConfig seabotix_at(uint8_t mt) {
     ThrusterConfig c;
@@ -521,255 +466,7 @@ ThrusterConfig behind_mux(uint8_t mt, uint16_t mux7, uint8_t channel) {
     return c;
 }
 
-void check_write(const std::vector<Msg>& t, uint16_t addr, const Bytes& data) {
-    REQUIRE(t.size() == 1);
-    CHECK(t[0].addr == addr);
-    CHECK(t[0].flags == 0);
-    CHECK(t[0].data == data);
-}
-
 } // namespace
-
-TEST_CASE("driver sends one write message per order") {
-    Bench b;
-    ThrusterDriver t(b.bus, b.mux, seabotix_at(0x52));
-    CHECK_FALSE(t.online());
-    CHECK(t.addr7() == 0x29);
-    REQUIRE(t.send_order(8850) == IoError::None);
-    REQUIRE(b.io.transfers.size() == 1);
-    // 0x52 + 0xE6 + 0x64 = 0x19C -> 0x9C, to 7-bit address 0x52 >> 1 = 0x29
-    check_write(b.io.transfers[0], 0x29, {0xE6, 0x64, 0x9C});
-    CHECK(t.online());
-    CHECK(t.last_speed() == uint8_t{0xE6});
-    CHECK(t.last_motor_value() == 8850);
-    CHECK(t.counters().orders_sent == 1);
-
-    // Out of range: refused, nothing on the bus, the last order stands.
-    CHECK(t.send_order(8851) == IoError::Other);
-    CHECK(t.send_order(std::numeric_limits<int32_t>::min()) == IoError::Other);
-    CHECK(b.io.transfers.size() == 1);
-    CHECK(t.counters().rejected_orders == 2);
-    CHECK(t.last_speed() == uint8_t{0xE6});
-    CHECK(t.online());
-}
-
-TEST_CASE("driver applies reversal before encoding") {
-    Bench b;
-    ThrusterConfig c = seabotix_at(0x52);
-    c.reversed = true;
-    ThrusterDriver t(b.bus, b.mux, c);
-    REQUIRE(t.send_order(44) == IoError::None);
-    // 44 -> -44 -> 1 step reverse = 0x7E; 82 + 126 + 100 = 308 = 0x134 -> 0x34
-    check_write(b.io.transfers[0], 0x29, {0x7E, 0x64, 0x34});
-    CHECK(t.last_motor_value() == 44);
-    CHECK(t.last_speed() == uint8_t{0x7E});
-    // Full reverse request on a reversed thruster is full forward on the wire.
-    REQUIRE(t.send_order(-8850) == IoError::None);
-    check_write(b.io.transfers[1], 0x29, {0xE6, 0x64, 0x9C});
-}
-
-TEST_CASE("driver counts NACKs and errors and comes back online") {
-    Bench b;
-    ThrusterDriver t(b.bus, b.mux, seabotix_at(0x52));
-    b.io.results = {-EREMOTEIO, -ETIMEDOUT, -EIO, -EAGAIN, 0};
-    CHECK(t.send_order(0) == IoError::Nack);
-    CHECK_FALSE(t.online());
-    CHECK(t.last_error() == IoError::Nack);
-    CHECK(t.last_errno() == EREMOTEIO);
-    CHECK_FALSE(t.last_speed().has_value());
-    CHECK(t.send_order(0) == IoError::Timeout);
-    CHECK(t.send_order(0) == IoError::ClockStretch);
-    CHECK(t.send_order(0) == IoError::Arbitration);
-    CHECK(t.send_order(0) == IoError::None);
-    CHECK(t.online());
-    CHECK(t.last_error() == IoError::Arbitration);  // kept for telemetry
-    const auto& n = t.counters();
-    CHECK(n.order_failures == 4);
-    CHECK(n.orders_sent == 1);
-    CHECK(n.nacks == 1);
-    CHECK(n.timeouts == 1);
-    CHECK(n.clock_stretch == 1);
-    CHECK(n.other_errors == 1);
-    CHECK(b.io.transfers.size() == 5);
-    // The stop order: 82 + 128 + 100 = 310 = 0x136 -> 0x36
-    check_write(b.io.transfers[4], 0x29, {0x80, 0x64, 0x36});
-    CHECK(t.last_speed() == uint8_t{0x80});
-
-    // A closed bus is an error, not a crash.
-    b.bus.close();
-    CHECK(t.send_order(0) == IoError::NoDevice);
-    CHECK(t.counters().other_errors == 2);
-}
-
-TEST_CASE("driver reads status with one read message and discards bad replies") {
-    Bench b;
-    ThrusterDriver t(b.bus, b.mux, seabotix_at(0x52));
-    b.io.replies = {
-        {0x53, 0x03, 0x00, 0x0C, 0x81, 0x19, 0xFC},  // good (sum 0xFC, see codec tests)
-        {0x52, 0x03, 0x00, 0x0C, 0x81, 0x19, 0xFB},  // bad first byte
-        {0x53, 0x03, 0x00, 0x0C, 0x81, 0x19, 0xFD},  // bad checksum
-        {0x53, 0x02, 0x10, 0x00, 0x80, 0x14, 0xF9},  // good, water detect (sum 0xF9)
-    };
-    REQUIRE(t.read_status() == IoError::None);
-    REQUIRE(b.io.transfers.size() == 1);
-    REQUIRE(b.io.transfers[0].size() == 1);
-    CHECK(b.io.transfers[0][0].addr == 0x29);
-    CHECK(b.io.transfers[0][0].flags == I2C_M_RD);
-    CHECK(b.io.transfers[0][0].data.size() == 7);
-    REQUIRE(t.last_status().has_value());
-    CHECK(t.last_status()->seabotix.current_deciamps == uint8_t{12});
-    CHECK(t.online());
-
-    CHECK(t.read_status() == IoError::BadReply);
-    CHECK_FALSE(t.online());
-    CHECK(t.last_reply_error() == CodecError::BadFirstByte);
-    CHECK(t.last_errno() == EBADMSG);
-    CHECK(t.last_reply().size() == 7);
-    CHECK(t.last_reply()[0] == 0x52);
-    // The bad reply is not believed: the last good status stands.
-    CHECK(t.last_status()->seabotix.speed == 0x81);
-
-    CHECK(t.read_status() == IoError::BadReply);
-    CHECK(t.last_reply_error() == CodecError::BadChecksum);
-
-    REQUIRE(t.read_status() == IoError::None);
-    CHECK(t.online());
-    CHECK(t.last_status()->faults.has(Fault::WaterDetect));
-
-    const auto& n = t.counters();
-    CHECK(n.status_reads == 2);
-    CHECK(n.status_failures == 2);
-    CHECK(n.bad_replies == 2);
-    CHECK(n.bad_first_byte == 1);
-    CHECK(n.bad_checksum == 1);
-    CHECK(n.nacks == 0);
-
-    // A NACKed read.
-    b.io.results = {-EREMOTEIO};
-    CHECK(t.read_status() == IoError::Nack);
-    CHECK(t.counters().nacks == 1);
-    CHECK(t.counters().status_failures == 3);
-    CHECK(t.last_status()->faults.has(Fault::WaterDetect));
-}
-
-TEST_CASE("legacy driver reads four bytes") {
-    Bench b;
-    ThrusterConfig c = seabotix_at(0x54);
-    c.variant = Variant::Legacy;
-    ThrusterDriver t(b.bus, b.mux, c);
-    b.io.replies = {{0x55, 0x40, 0xE6, 0x7B}};  // sum 0x17B -> 0x7B
-    REQUIRE(t.read_status() == IoError::None);
-    CHECK(b.io.transfers[0][0].addr == 0x2A);
-    CHECK(b.io.transfers[0][0].data.size() == 4);
-    CHECK(t.last_status()->legacy.power_motor == 8850);
-    // Legacy full-reverse order: 84 + 25 + 100 = 209 = 0xD1
-    REQUIRE(t.send_order(-8850) == IoError::None);
-    check_write(b.io.transfers[1], 0x2A, {0x19, 0x64, 0xD1});
-}
-
-TEST_CASE("mux channel is selected only when it changes") {
-    Bench b;
-    ThrusterDriver a(b.bus, b.mux, behind_mux(0x52, 0x70, 2));
-    ThrusterDriver c(b.bus, b.mux, behind_mux(0x52, 0x70, 3));
-    REQUIRE(a.send_order(0) == IoError::None);
-    REQUIRE(b.io.transfers.size() == 2);
-    check_write(b.io.transfers[0], 0x70, {0x06});  // enable (0x04) | channel 2
-    check_write(b.io.transfers[1], 0x29, {0x80, 0x64, 0x36});
-    REQUIRE(a.send_order(0) == IoError::None);
-    REQUIRE(b.io.transfers.size() == 3);  // no select: channel 2 is still on
-    check_write(b.io.transfers[2], 0x29, {0x80, 0x64, 0x36});
-    REQUIRE(c.read_status() == IoError::BadReply);  // the script answers 0xFF: not believed
-    check_write(b.io.transfers[3], 0x70, {0x07});  // channel 3
-    CHECK(b.io.transfers[4][0].flags == I2C_M_RD);
-    // The bad reply made the mux state unknown, so thruster a re-selects channel 2.
-    REQUIRE(a.send_order(0) == IoError::None);
-    check_write(b.io.transfers[5], 0x70, {0x06});
-    CHECK(b.mux.selected_channel(0x70) == uint8_t{2});
-    CHECK(b.mux.control_writes() == 3);
-}
-
-TEST_CASE("only one mux has a channel enabled at a time") {
-    Bench b;
-    ThrusterDriver a(b.bus, b.mux, behind_mux(0x52, 0x70, 0));
-    ThrusterDriver c(b.bus, b.mux, behind_mux(0x52, 0x71, 1));
-    REQUIRE(a.send_order(0) == IoError::None);
-    // 0x71's state is unknown at start: disable it, then select 0x70 channel 0.
-    REQUIRE(b.io.transfers.size() == 3);
-    check_write(b.io.transfers[0], 0x71, {0x00});
-    check_write(b.io.transfers[1], 0x70, {0x04});
-    check_write(b.io.transfers[2], 0x29, {0x80, 0x64, 0x36});
-    REQUIRE(c.send_order(0) == IoError::None);
-    REQUIRE(b.io.transfers.size() == 6);
-    check_write(b.io.transfers[3], 0x70, {0x00});
-    check_write(b.io.transfers[4], 0x71, {0x05});
-    check_write(b.io.transfers[5], 0x29, {0x80, 0x64, 0x36});
-    CHECK(b.mux.known_disabled(0x70));
-    CHECK(b.mux.selected_channel(0x71) == uint8_t{1});
-}
-
-TEST_CASE("mux failures are counted and force a new select") {
-    Bench b;
-    ThrusterDriver t(b.bus, b.mux, behind_mux(0x52, 0x70, 1));
-    b.io.results = {-EREMOTEIO};  // the mux NACKs its control byte
-    CHECK(t.send_order(0) == IoError::Nack);
-    REQUIRE(b.io.transfers.size() == 1);  // no order after a failed select
-    CHECK(t.counters().mux_failures == 1);
-    CHECK(t.counters().nacks == 1);
-    CHECK(t.counters().order_failures == 1);
-    CHECK_FALSE(t.online());
-    CHECK(b.mux.control_failures() == 1);
-
-    REQUIRE(t.send_order(0) == IoError::None);
-    REQUIRE(b.io.transfers.size() == 3);
-    check_write(b.io.transfers[1], 0x70, {0x05});  // enable | channel 1
-    check_write(b.io.transfers[2], 0x29, {0x80, 0x64, 0x36});
-    CHECK(t.online());
-
-    // The thruster NACKs: its mux may have reset, so the next order re-selects.
-    b.io.results = {-EREMOTEIO};  // no select needed (channel 1 is on); the order NACKs
-    CHECK(t.send_order(0) == IoError::Nack);
-    REQUIRE(b.io.transfers.size() == 4);
-    check_write(b.io.transfers[3], 0x29, {0x80, 0x64, 0x36});
-    CHECK(t.counters().mux_failures == 1);  // the thruster NACKed, not the mux
-    CHECK(t.counters().nacks == 2);
-    REQUIRE(t.send_order(0) == IoError::None);
-    check_write(b.io.transfers[4], 0x70, {0x05});
-    check_write(b.io.transfers[5], 0x29, {0x80, 0x64, 0x36});
-
-    // After a bus reopen the owner invalidates: the next order re-selects.
-    b.mux.invalidate();
-    REQUIRE(t.send_order(0) == IoError::None);
-    check_write(b.io.transfers[6], 0x70, {0x05});
-}
-
-TEST_CASE("a bus error on any thruster invalidates every mux") {
-    Bench b;
-    ThrusterDriver direct(b.bus, b.mux, seabotix_at(0x5A));
-    ThrusterDriver muxed(b.bus, b.mux, behind_mux(0x52, 0x70, 0));
-    REQUIRE(muxed.send_order(0) == IoError::None);
-    CHECK(b.mux.selected_channel(0x70) == uint8_t{0});
-    b.io.results = {-ETIMEDOUT};
-    CHECK(direct.send_order(0) == IoError::Timeout);
-    CHECK_FALSE(b.mux.selected_channel(0x70).has_value());
-    // A NACK on a direct thruster says nothing about the mux.
-    REQUIRE(muxed.send_order(0) == IoError::None);
-    b.io.results = {-EREMOTEIO};
-    CHECK(direct.send_order(0) == IoError::Nack);
-    CHECK(b.mux.selected_channel(0x70) == uint8_t{0});
-}
-
-TEST_CASE("mux tracker refuses impossible selects without bus traffic") {
-    Bench b;
-    CHECK(b.mux.select(b.bus, 0x6F, 0) == IoError::Other);
-    CHECK(b.mux.select(b.bus, 0x70, 4) == IoError::Other);
-    CHECK(b.io.transfers.empty());
-    CHECK_FALSE(b.mux.known(0x70));
-    CHECK(mux_control_byte(0) == 0x04);
-    CHECK(mux_control_byte(3) == 0x07);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Configuration checks
 
 TEST_CASE("thruster configuration validation") {
     CHECK(validate_thruster_config(seabotix_at(0x52)).empty());
@@ -780,8 +477,10 @@ TEST_CASE("thruster configuration validation") {
     CHECK_FALSE(validate_thruster_config(behind_mux(0x52, 0x6F, 0)).empty());
     CHECK_FALSE(validate_thruster_config(behind_mux(0x52, 0x70, 4)).empty());
 
-    Bench b;
-    CHECK_THROWS_AS(ThrusterDriver(b.bus, b.mux, seabotix_at(0x53)), std::invalid_argument);
+    LinuxDeviceIo io;
+    I2cDev bus(io, "/dev/null");
+    MuxTracker mux;
+    CHECK_THROWS_AS(ThrusterDriver(bus, mux, seabotix_at(0x53)), std::invalid_argument);
 
     const std::vector<ThrusterConfig> fine{behind_mux(0x52, 0x70, 0), behind_mux(0x52, 0x70, 1),
                                            behind_mux(0x52, 0x71, 0), seabotix_at(0x54)};
