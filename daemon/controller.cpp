@@ -1,5 +1,6 @@
 #include "controller.hpp"
 
+#include "i2c_recovery.hpp"
 #include "log.hpp"
 #include "packet.hpp"
 
@@ -13,6 +14,21 @@ namespace {
 constexpr int64_t kWorkPriority = SD_EVENT_PRIORITY_NORMAL + 10;
 constexpr uint64_t kTelemetryPeriodNs = 200'000'000; // 5 Hz of PropertiesChanged
 constexpr const char* kPowerOffConfirmation = "power-off";
+// A locked bus shows as several bus-level errors in a row (timeouts, EIO, a vanished adapter),
+// or as every thruster failing at once; one absent thruster is neither.
+constexpr uint32_t kLockupBusErrors = 3;
+constexpr uint32_t kLockupFailures = 2 * kMotorCount;
+constexpr uint64_t kNodePollNs = 5'000'000;
+constexpr uint64_t kBackgroundRetryNs = 5'000'000'000ull;
+
+GpioLineSpec line_spec(const GpioLineSettings& s) {
+    GpioLineSpec spec;
+    spec.chip = s.chip;
+    spec.name = s.name;
+    spec.offset = s.offset;
+    spec.active_low = s.active_low;
+    return spec;
+}
 
 Status teensy_status(teensy::TeensyError e) {
     using E = teensy::TeensyError;
@@ -65,9 +81,10 @@ std::string_view status_name(Status s) {
     return "Hardware";
 }
 
-Controller::Controller(sd_event* event, DeviceIo& io, DaemonConfig config)
+Controller::Controller(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config)
     : event_(event),
       io_(io),
+      gpio_(gpio),
       config_(std::move(config)),
       i2c_(io_, config_.i2c.device),
       spi_(io_, config_.spi.device, config_.spi.spi),
@@ -92,6 +109,8 @@ std::string Controller::start() {
         return "cannot open I2C bus " + config_.i2c.device + ": " + errno_name(-r);
     // Zero before anything else: a previous instance may have died with orders standing.
     zero_now();
+    if (std::string e = open_gpio(); !e.empty())
+        return e;
     if (int r = spi_.open(); r < 0) {
         log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
                     errno_name(-r).c_str());
@@ -123,11 +142,14 @@ std::string Controller::start() {
 }
 
 void Controller::shutdown() {
-    if (!i2c_.is_open())
+    if (!started_)
         return;
+    started_ = false;
     tick_source_.reset();
     work_source_.reset();
     turn_source_.reset();
+    recovery_timer_.reset();
+    kill_switch_source_.reset();
     zero_now();
     if (turn_done_)
         finish_turn({Status::Hardware, "the daemon is shutting down"});
@@ -163,6 +185,7 @@ int Controller::on_work(sd_event_source*, void* userdata) {
 
 void Controller::cycle() {
     const uint64_t t = now();
+    poll_kill_switch(); // a backstop for a lost edge event
     handle(safety_.tick(t));
     if (in_cycle_) {
         // The bus did not finish the last cycle in one period: refresh what is left rather
@@ -186,14 +209,14 @@ void Controller::mark_orders_due() {
 }
 
 bool Controller::work_one() {
-    for (size_t i = 0; i < thrusters_.size(); ++i) {
+    for (size_t i = 0; i < thrusters_.size() && !recovering_; ++i) {
         if (order_due_[i]) {
             order_due_[i] = false;
             send_order(i);
             return true;
         }
     }
-    if (status_due_ > 0) {
+    if (status_due_ > 0 && !recovering_) {
         --status_due_;
         const size_t i = status_next_;
         status_next_ = (status_next_ + 1) % thrusters_.size();
@@ -226,25 +249,234 @@ void Controller::zero_now() {
 
 void Controller::note_bus_result(IoError e) {
     ++bus_tm_.transactions;
-    if (e == IoError::None) {
+    if (recovering_)
+        return; // the bus is closed on purpose; failures now say nothing new
+    if (e == IoError::None || e == IoError::BadReply) {
+        // A bad reply still crossed the bus: the thruster is at fault, not the wire.
+        consecutive_bus_errors_ = 0;
+        consecutive_failures_ = 0;
+        if (e == IoError::BadReply) {
+            ++bus_tm_.errors;
+            bus_tm_.last_error = std::string(io_error_name(e));
+        }
         if (bus_tm_.state != "ok") {
             bus_tm_.state = "ok";
-            notify(kChangeState);
+            notify(kChangeState | kChangeBus);
         }
         return;
     }
     ++bus_tm_.errors;
     bus_tm_.last_error = std::string(io_error_name(e));
-    if (e == IoError::BadReply)
-        return; // the bus worked; the thruster's reply was bad
-    bool all_down = true;
-    for (const auto& t : thrusters_)
-        all_down = all_down && !t->online();
-    const char* state = all_down ? "lost" : "ok";
-    if (bus_tm_.state != state) {
-        bus_tm_.state = state;
-        notify(kChangeState); // State reads "fault" while no thruster answers
+    ++consecutive_failures_;
+    consecutive_bus_errors_ = bus_level_error(e) ? consecutive_bus_errors_ + 1 : 0;
+    if (consecutive_bus_errors_ >= kLockupBusErrors || consecutive_failures_ >= kLockupFailures)
+        start_recovery(consecutive_bus_errors_ >= kLockupBusErrors
+                           ? std::to_string(consecutive_bus_errors_) + " bus errors in a row, last " + bus_tm_.last_error
+                           : "every thruster failing, last " + bus_tm_.last_error);
+}
+
+bool Controller::bus_level_error(IoError e) const {
+    return e == IoError::Timeout || e == IoError::ClockStretch || e == IoError::Arbitration || e == IoError::NoDevice;
+}
+
+// --- I2C bus lockup recovery ------------------------------------------------------------
+
+void Controller::start_recovery(const std::string& reason) {
+    if (recovering_ || bus_tm_.state == "lost")
+        return;
+    if (!config_.recovery.enabled) {
+        // Nothing to clear the bus with: report it and keep trying the transfers each tick.
+        bus_tm_.state = "lost";
+        bus_tm_.last_recovery_error = reason;
+        log_error("I2C bus %s lost (%s); recovery is not configured", config_.i2c.device.c_str(), reason.c_str());
+        if (observer_)
+            observer_->bus_lost(reason);
+        notify(kChangeState | kChangeBus);
+        return;
     }
+    recovering_ = true;
+    attempt_ = 0;
+    recovery_started_ns_ = now();
+    bus_tm_.state = "recovering";
+    bus_tm_.last_recovery_error = reason;
+    order_due_.fill(false);
+    status_due_ = 0;
+    log_warning("I2C bus %s locked up (%s): recovering", config_.i2c.device.c_str(), reason.c_str());
+    if (observer_)
+        observer_->bus_lost(reason);
+    notify(kChangeBus);
+    // From the event loop, not from inside the transfer that noticed it.
+    schedule_recovery(0);
+}
+
+void Controller::schedule_recovery(uint64_t delay_ns) {
+    const uint64_t at_us = (now() + delay_ns) / 1000;
+    if (!recovery_timer_) {
+        sd_event_source* s = nullptr;
+        if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, at_us, 0, on_recovery_timer, this) < 0) {
+            log_error("cannot schedule the bus recovery");
+            return;
+        }
+        recovery_timer_.reset(s);
+    }
+    sd_event_source_set_time(recovery_timer_.get(), at_us);
+    sd_event_source_set_enabled(recovery_timer_.get(), SD_EVENT_ONESHOT);
+}
+
+int Controller::on_recovery_timer(sd_event_source*, uint64_t, void* userdata) {
+    auto* self = static_cast<Controller*>(userdata);
+    if (self->recovery_phase_ == RecoveryPhase::WaitingNode)
+        self->recovery_wait_node();
+    else
+        self->recovery_attempt();
+    return 0;
+}
+
+void Controller::recovery_attempt() {
+    const RecoverySettings& rc = config_.recovery;
+    ++attempt_;
+    recovery_phase_ = RecoveryPhase::Idle;
+    i2c_.close(); // before unbinding: the driver cannot go while the node is open
+    mux_.invalidate();
+    const bool rebind = !rc.driver_id.empty();
+    if (rebind) {
+        if (int r = sysfs_write(io_, rc.unbind_path, rc.driver_id); r < 0 && r != -ENODEV)
+            log_warning("unbinding %s via %s: %s", rc.driver_id.c_str(), rc.unbind_path.c_str(), errno_name(-r).c_str());
+    }
+    BusClearResult bc = i2c_bus_clear(gpio_, line_spec(*config_.gpio.scl), line_spec(*config_.gpio.sda));
+    last_pulses_ = bc.pulses;
+    if (rebind) {
+        // Even after a failed clear: the node must come back for the next attempt.
+        if (int r = sysfs_write(io_, rc.bind_path, rc.driver_id); r < 0 && r != -EBUSY)
+            log_warning("binding %s via %s: %s", rc.driver_id.c_str(), rc.bind_path.c_str(), errno_name(-r).c_str());
+    }
+    if (!bc.ok()) {
+        recovery_failed(bc.message);
+        return;
+    }
+    log_info("bus clear: SDA released after %u clock pulses, STOP sent", bc.pulses);
+    node_deadline_ns_ = now() + ms_to_ns(rc.device_wait_ms);
+    recovery_phase_ = RecoveryPhase::WaitingNode;
+    recovery_wait_node();
+}
+
+void Controller::recovery_wait_node() {
+    int r = i2c_.open();
+    if (r == 0) {
+        recovery_finish();
+        return;
+    }
+    if (now() >= node_deadline_ns_) {
+        recovery_failed("the I2C device node did not come back: " + errno_name(-r));
+        return;
+    }
+    schedule_recovery(kNodePollNs);
+}
+
+void Controller::recovery_finish() {
+    recovering_ = false;
+    recovery_phase_ = RecoveryPhase::Idle;
+    consecutive_bus_errors_ = 0;
+    consecutive_failures_ = 0;
+    const bool was_lost = bus_tm_.state == "lost";
+    bus_tm_.state = "ok";
+    ++bus_tm_.recoveries;
+    bus_tm_.last_pulses = last_pulses_;
+    // The current orders go out at once, a pending kill first: zeros while the vehicle may not drive.
+    if (safety_.may_drive())
+        for (size_t i = 0; i < thrusters_.size(); ++i)
+            send_order(i);
+    else
+        zero_now();
+    bus_tm_.last_recovery_ms = static_cast<double>(now() - recovery_started_ns_) / 1e6;
+    log_notice("I2C bus recovered after %u pulse(s), %.1f ms, attempt %u; orders re-sent", last_pulses_,
+               bus_tm_.last_recovery_ms, attempt_);
+    if (observer_)
+        observer_->bus_restored(last_pulses_, bus_tm_.last_recovery_ms);
+    notify(kChangeBus | (was_lost ? kChangeState : 0u));
+}
+
+void Controller::recovery_failed(const std::string& why) {
+    const RecoverySettings& rc = config_.recovery;
+    ++bus_tm_.recovery_failures;
+    bus_tm_.last_recovery_error = why;
+    recovery_phase_ = RecoveryPhase::Backoff;
+    log_error("I2C bus recovery attempt %u failed: %s", attempt_, why.c_str());
+    if (attempt_ == rc.attempts) {
+        bus_tm_.state = "lost";
+        kill(KillSource::Fault, "I2C bus recovery failed: " + why);
+        notify(kChangeState);
+    }
+    notify(kChangeBus);
+    // Bounded attempts with exponential backoff, then slow retries in the background.
+    uint64_t delay = kBackgroundRetryNs;
+    if (attempt_ < rc.attempts)
+        delay = std::min<uint64_t>(ms_to_ns(rc.backoff_ms) << std::min<uint32_t>(attempt_ - 1, 16), kBackgroundRetryNs);
+    schedule_recovery(delay);
+}
+
+// --- GPIO lines ---------------------------------------------------------------------------
+
+std::string Controller::open_gpio() {
+    const GpioSettings& g = config_.gpio;
+    std::string err;
+    if (g.kill_output) {
+        kill_out_ = gpio_.request(line_spec(*g.kill_output), GpioMode::Output, safety_.kill_output_asserted() ? 1 : 0, err);
+        if (!kill_out_)
+            return "gpio.kill_output: " + err;
+    }
+    if (g.power_off_output) {
+        power_off_out_ = gpio_.request(line_spec(*g.power_off_output), GpioMode::Output, 0, err);
+        if (!power_off_out_)
+            return "gpio.power_off_output: " + err;
+    }
+    if (g.kill_switch) {
+        kill_switch_ = gpio_.request(line_spec(*g.kill_switch), GpioMode::InputEdges, 0, err);
+        if (!kill_switch_)
+            return "gpio.kill_switch: " + err;
+        sd_event_source* s = nullptr;
+        // Above D-Bus and the bus work: the switch is the operator's hand on the vehicle.
+        if (int fd = kill_switch_->event_fd(); fd >= 0) {
+            if (int r = sd_event_add_io(event_, &s, fd, EPOLLIN, on_kill_switch, this); r < 0)
+                return "gpio.kill_switch: cannot watch edges: " + errno_name(-r);
+            kill_switch_source_.reset(s);
+            sd_event_source_set_priority(s, SD_EVENT_PRIORITY_IMPORTANT);
+        }
+        poll_kill_switch();
+    }
+    return {};
+}
+
+int Controller::on_kill_switch(sd_event_source*, int, uint32_t, void* userdata) {
+    auto* self = static_cast<Controller*>(userdata);
+    if (self->kill_switch_->drain_events() < 0)
+        log_error("kill switch events: the line went away");
+    self->poll_kill_switch();
+    return 0;
+}
+
+void Controller::poll_kill_switch() {
+    if (!kill_switch_)
+        return;
+    const int v = kill_switch_->get();
+    if (v < 0)
+        return;
+    const bool set = v == 1;
+    if (set == safety_.kill_switch_set())
+        return;
+    const bool was_killed = safety_.state() == SafetyState::Killed;
+    handle(safety_.switch_changed(set, now()));
+    if (set && !was_killed)
+        log_warning("KILLED by the kill switch");
+    else if (!set)
+        log_notice("kill switch released; ClearKill re-arms the vehicle");
+    if (set && turn_done_)
+        finish_turn({Status::Killed, "the kill switch was set during the turn"});
+}
+
+void Controller::update_outputs() {
+    if (kill_out_)
+        kill_out_->set(safety_.kill_output_asserted() ? 1 : 0);
 }
 
 void Controller::handle(const SafetyAction& a) {
@@ -258,8 +490,10 @@ void Controller::handle(const SafetyAction& a) {
     }
     if (a.zero_outputs)
         zero_now();
-    if (a.state_changed)
+    if (a.state_changed) {
         changes |= kChangeState;
+        update_outputs(); // the kill output follows the state, after the zero orders
+    }
     if (a.command_stale)
         log_info("command stream silent for %llu ms: thrusters to zero",
                  static_cast<unsigned long long>(config_.control.command_timeout_ms));
@@ -402,7 +636,9 @@ Result Controller::power_off(std::string_view confirmation) {
         return {Status::PoweredOff, a.message};
     handle(a);
     zero_now(); // thrusters first, whatever handle() decided
-    log_warning("POWER-OFF confirmed: thrusters zeroed");
+    if (power_off_out_)
+        power_off_out_->set(1);
+    log_warning("POWER-OFF confirmed: thrusters zeroed%s", power_off_out_ ? ", power-off line asserted" : "");
     if (turn_done_)
         finish_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
@@ -428,8 +664,7 @@ void Controller::client_left(std::string_view unique_name) {
         return;
     log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
     SafetyAction a = safety_.client_left(unique_name, now());
-    handle(a);
-    notify(kChangeController);
+    handle(a); // clear_commands announces Controller with the motors
 }
 
 std::string_view Controller::state_name() const {
@@ -456,7 +691,8 @@ int64_t Controller::command_age_ms() const {
 bool Controller::healthy(uint64_t now_ns) const {
     const uint64_t period = config_.control.loop_rate_hz ? 1'000'000'000ull / config_.control.loop_rate_hz : 0;
     const uint64_t allowed = std::max<uint64_t>(1'000'000'000ull, 5 * period);
-    return started_ && i2c_.is_open() && now_ns - last_cycle_ns_ <= allowed;
+    // A bus under recovery is not an unhealthy loop: restarting the daemon would not help it.
+    return started_ && now_ns - last_cycle_ns_ <= allowed;
 }
 
 void Controller::publish_telemetry_if_due() {

@@ -10,6 +10,7 @@
 #include "budget.hpp"
 #include "config.hpp"
 #include "device_io.hpp"
+#include "gpio.hpp"
 #include "i2c_dev.hpp"
 #include "mixing.hpp"
 #include "safety.hpp"
@@ -61,6 +62,7 @@ enum VehicleChange : uint32_t {
     kChangeMotors = 1u << 1,     // MotorValues, RequestedValues, BudgetLimit, Saturated
     kChangeLeds = 1u << 2,
     kChangeController = 1u << 3, // Controller
+    kChangeBus = 1u << 4,        // the Bus object's State and recovery figures
 };
 
 class ControllerObserver {
@@ -69,6 +71,9 @@ public:
     virtual void vehicle_changed(uint32_t changes) = 0;
     // Periodic: thruster, Teensy and bus telemetry, command age, cycles.
     virtual void telemetry() = 0;
+    // The I2C bus was found locked up / came back after a recovery.
+    virtual void bus_lost(const std::string& reason) = 0;
+    virtual void bus_restored(uint32_t pulses, double milliseconds) = 0;
 };
 
 struct ThrusterTelemetry {
@@ -85,21 +90,27 @@ struct TeensyTelemetry {
 };
 
 struct BusTelemetry {
-    std::string state = "ok";
+    std::string state = "ok";     // "ok", "recovering", "lost"
     uint64_t transactions = 0;
     uint64_t errors = 0;
     std::string last_error;
+    uint64_t recoveries = 0;       // completed bus recoveries
+    uint64_t recovery_failures = 0;
+    uint32_t last_pulses = 0;      // SCL pulses the last bus clear needed
+    double last_recovery_ms = 0;   // time from detection to orders re-sent
+    std::string last_recovery_error;
 };
 
 class Controller {
 public:
-    Controller(sd_event* event, DeviceIo& io, DaemonConfig config);
+    Controller(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config);
     ~Controller();
     Controller(const Controller&) = delete;
     Controller& operator=(const Controller&) = delete;
 
-    // Opens the devices and orders zero to every thruster. Returns "" or a reason the
-    // daemon cannot run (the I2C bus cannot be opened). A missing Teensy is not fatal.
+    // Opens the devices and the GPIO lines and orders zero to every thruster. Returns "" or a
+    // reason the daemon cannot run (the I2C bus or a configured GPIO line cannot be had).
+    // A missing Teensy is not fatal.
     std::string start();
     // Orders zero to every thruster (SIGTERM, fatal errors). Safe to call more than once.
     void shutdown();
@@ -148,6 +159,20 @@ private:
     static int on_tick(sd_event_source*, uint64_t usec, void* userdata);
     static int on_work(sd_event_source*, void* userdata);
     static int on_turn_step(sd_event_source*, uint64_t usec, void* userdata);
+    static int on_kill_switch(sd_event_source*, int fd, uint32_t revents, void* userdata);
+    static int on_recovery_timer(sd_event_source*, uint64_t usec, void* userdata);
+
+    std::string open_gpio();
+    void poll_kill_switch();
+    void update_outputs();
+    // Bus lockup: detection from transfer errors, then the recovery sequence (DESIGN.md).
+    bool bus_level_error(IoError e) const;
+    void start_recovery(const std::string& reason);
+    void recovery_attempt();
+    void recovery_wait_node();
+    void recovery_finish();
+    void recovery_failed(const std::string& why);
+    void schedule_recovery(uint64_t delay_ns);
 
     uint64_t now() const;
     void cycle();
@@ -167,6 +192,7 @@ private:
 
     sd_event* event_;
     DeviceIo& io_;
+    GpioBackend& gpio_;
     DaemonConfig config_;
     I2cDev i2c_;
     MuxTracker mux_;
@@ -204,6 +230,22 @@ private:
 
     TeensyTelemetry teensy_tm_;
     BusTelemetry bus_tm_;
+
+    std::unique_ptr<GpioLine> kill_switch_;
+    std::unique_ptr<GpioLine> kill_out_;
+    std::unique_ptr<GpioLine> power_off_out_;
+    dbus::SourcePtr kill_switch_source_;
+
+    enum class RecoveryPhase { Idle, WaitingNode, Backoff };
+    RecoveryPhase recovery_phase_ = RecoveryPhase::Idle;
+    bool recovering_ = false;           // the bus is down: no bus work until it is back
+    uint32_t consecutive_bus_errors_ = 0;
+    uint32_t consecutive_failures_ = 0;
+    uint32_t attempt_ = 0;
+    uint64_t recovery_started_ns_ = 0;
+    uint64_t node_deadline_ns_ = 0;
+    uint32_t last_pulses_ = 0;
+    dbus::SourcePtr recovery_timer_;
 };
 
 } // namespace caracara

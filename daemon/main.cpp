@@ -1,7 +1,7 @@
 // caracarad: the Caracara vehicle daemon. One sd-event loop; see DESIGN.md.
 #include "config.hpp"
 #include "controller.hpp"
-#include "device_io.hpp"
+#include "hardware.hpp"
 #include "errors.hpp"
 #include "log.hpp"
 #include "sdbus.hpp"
@@ -108,8 +108,8 @@ int main(int argc, char** argv) {
     }
 
     std::string err;
-    auto io = make_device_io(hardware, err);
-    if (!io) {
+    Hardware hw;
+    if (!make_hardware(hardware, hw, err)) {
         log_error("%s", err.c_str());
         return 1;
     }
@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
     sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
     sd_event_add_signal(event.get(), nullptr, SIGHUP, on_signal, nullptr);
 
-    Controller controller(event.get(), *io, *cr.config);
+    Controller controller(event.get(), *hw.io, *hw.gpio, *cr.config);
     if (std::string e = controller.start(); !e.empty()) {
         log_error("%s", e.c_str());
         sd_notifyf(0, "STATUS=%s", e.c_str());

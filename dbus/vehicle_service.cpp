@@ -353,6 +353,11 @@ PROP(b_state) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().sta
 PROP(b_transactions) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().transactions); }
 PROP(b_errors) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().errors); }
 PROP(b_last_error) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().last_error.c_str()); }
+PROP(b_recoveries) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().recoveries); }
+PROP(b_failures) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().recovery_failures); }
+PROP(b_pulses) { return sd_bus_message_append(reply, "u", ctl(userdata).bus().last_pulses); }
+PROP(b_recovery_ms) { return sd_bus_message_append(reply, "d", ctl(userdata).bus().last_recovery_ms); }
+PROP(b_recovery_error) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().last_recovery_error.c_str()); }
 
 const sd_bus_vtable kBusVtable[] = {
     SD_BUS_VTABLE_START(0),
@@ -361,6 +366,13 @@ const sd_bus_vtable kBusVtable[] = {
     SD_BUS_PROPERTY("Transactions", "t", b_transactions, 0, kChange),
     SD_BUS_PROPERTY("Errors", "t", b_errors, 0, kChange),
     SD_BUS_PROPERTY("LastError", "s", b_last_error, 0, kChange),
+    SD_BUS_PROPERTY("Recoveries", "t", b_recoveries, 0, kChange),
+    SD_BUS_PROPERTY("RecoveryFailures", "t", b_failures, 0, kChange),
+    SD_BUS_PROPERTY("LastPulses", "u", b_pulses, 0, kChange),
+    SD_BUS_PROPERTY("LastRecoveryMs", "d", b_recovery_ms, 0, kChange),
+    SD_BUS_PROPERTY("LastRecoveryError", "s", b_recovery_error, 0, kChange),
+    SD_BUS_SIGNAL_WITH_ARGS("BusLost", SD_BUS_ARGS("s", reason), 0),
+    SD_BUS_SIGNAL_WITH_ARGS("BusRestored", SD_BUS_ARGS("u", pulses, "d", milliseconds), 0),
     SD_BUS_VTABLE_END,
 };
 
@@ -434,6 +446,8 @@ void VehicleService::vehicle_changed(uint32_t changes) {
         names.push_back("Leds");
     if (changes & kChangeController)
         names.push_back("Controller");
+    if (changes & kChangeBus)
+        emit_bus_changes();
     if (names.empty())
         return;
     names.push_back(nullptr);
@@ -516,18 +530,36 @@ void VehicleService::telemetry() {
         published_teensy_errors_ = tc.link_errors;
     }
 
+    emit_bus_changes();
+}
+
+void VehicleService::emit_bus_changes() {
     const BusTelemetry& b = controller_.bus();
     std::vector<const char*> bn;
     if (b.state != published_bus_.state) bn.push_back("State");
     if (b.transactions != published_bus_.transactions) bn.push_back("Transactions");
     if (b.errors != published_bus_.errors) bn.push_back("Errors");
     if (b.last_error != published_bus_.last_error) bn.push_back("LastError");
-    if (!bn.empty()) {
-        bn.push_back(nullptr);
-        sd_bus_emit_properties_changed_strv(bus_, (std::string(kRootPath) + "/bus").c_str(), kBusIface,
-                                            const_cast<char**>(bn.data()));
-        published_bus_ = b;
-    }
+    if (b.recoveries != published_bus_.recoveries) bn.push_back("Recoveries");
+    if (b.recovery_failures != published_bus_.recovery_failures) bn.push_back("RecoveryFailures");
+    if (b.last_pulses != published_bus_.last_pulses) bn.push_back("LastPulses");
+    if (b.last_recovery_ms != published_bus_.last_recovery_ms) bn.push_back("LastRecoveryMs");
+    if (b.last_recovery_error != published_bus_.last_recovery_error) bn.push_back("LastRecoveryError");
+    if (bn.empty())
+        return;
+    bn.push_back(nullptr);
+    sd_bus_emit_properties_changed_strv(bus_, (std::string(kRootPath) + "/bus").c_str(), kBusIface,
+                                        const_cast<char**>(bn.data()));
+    published_bus_ = b;
+}
+
+void VehicleService::bus_lost(const std::string& reason) {
+    sd_bus_emit_signal(bus_, (std::string(kRootPath) + "/bus").c_str(), kBusIface, "BusLost", "s", reason.c_str());
+}
+
+void VehicleService::bus_restored(uint32_t pulses, double milliseconds) {
+    sd_bus_emit_signal(bus_, (std::string(kRootPath) + "/bus").c_str(), kBusIface, "BusRestored", "ud", pulses,
+                       milliseconds);
 }
 
 } // namespace caracara::dbus

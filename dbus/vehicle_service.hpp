@@ -29,6 +29,8 @@ public:
 
     void vehicle_changed(uint32_t changes) override;
     void telemetry() override;
+    void bus_lost(const std::string& reason) override;
+    void bus_restored(uint32_t pulses, double milliseconds) override;
 
     Controller& controller() { return controller_; }
     sd_bus* bus() { return bus_; }
@@ -51,6 +53,7 @@ private:
         bool operator==(const ThrusterSnapshot&) const = default;
     };
     ThrusterSnapshot snapshot(size_t i) const;
+    void emit_bus_changes();
     static int on_name_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*);
 
     sd_bus* bus_;

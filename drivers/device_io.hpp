@@ -3,8 +3,8 @@
 // receives the very i2c_msg / spi_ioc_transfer arrays the driver built.
 #pragma once
 
+#include <cstddef>
 #include <memory>
-#include <string>
 
 namespace caracara {
 
@@ -17,6 +17,8 @@ public:
     // the value cast to a pointer for value ioctls (I2C_TIMEOUT, I2C_RETRIES).
     virtual int ioctl(int fd, unsigned long request, void* arg) = 0;
     virtual int close(int fd) = 0;
+    // For sysfs attribute files (driver bind/unbind during bus recovery). Bytes written or -errno.
+    virtual int write(int fd, const void* buf, size_t len) = 0;
 };
 
 class LinuxDeviceIo final : public DeviceIo {
@@ -24,10 +26,7 @@ public:
     int open(const char* path, int flags) override;
     int ioctl(int fd, unsigned long request, void* arg) override;
     int close(int fd) override;
+    int write(int fd, const void* buf, size_t len) override;
 };
-
-// Parses a --hardware=linux|sim:SOCKET argument. Returns nullptr and sets `error` on a bad spec
-// or when the simulator cannot be reached.
-std::unique_ptr<DeviceIo> make_device_io(const std::string& spec, std::string& error);
 
 } // namespace caracara

@@ -1,6 +1,4 @@
 #include "device_io.hpp"
-#include "errors.hpp"
-#include "sim_device_io.hpp"
 
 #include <cerrno>
 #include <fcntl.h>
@@ -22,24 +20,16 @@ int LinuxDeviceIo::ioctl(int fd, unsigned long request, void* arg) {
     return r < 0 ? -errno : r;
 }
 
-int LinuxDeviceIo::close(int fd) {
-    return ::close(fd) < 0 ? -errno : 0;
+int LinuxDeviceIo::write(int fd, const void* buf, size_t len) {
+    ssize_t n;
+    do {
+        n = ::write(fd, buf, len);
+    } while (n < 0 && errno == EINTR);
+    return n < 0 ? -errno : static_cast<int>(n);
 }
 
-std::unique_ptr<DeviceIo> make_device_io(const std::string& spec, std::string& error) {
-    if (spec == "linux")
-        return std::make_unique<LinuxDeviceIo>();
-    if (spec.rfind("sim:", 0) == 0 && spec.size() > 4) {
-        auto io = std::make_unique<SimDeviceIo>();
-        int r = io->connect(spec.substr(4));
-        if (r < 0) {
-            error = "cannot connect to caracara-sim at " + spec.substr(4) + ": " + errno_name(-r);
-            return nullptr;
-        }
-        return io;
-    }
-    error = "hardware must be 'linux' or 'sim:SOCKET', got '" + spec + "'";
-    return nullptr;
+int LinuxDeviceIo::close(int fd) {
+    return ::close(fd) < 0 ? -errno : 0;
 }
 
 } // namespace caracara

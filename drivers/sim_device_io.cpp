@@ -44,6 +44,7 @@ int SimDeviceIo::connect(const std::string& socket_path) {
         return -e;
     }
     sock_ = s;
+    path_ = socket_path;
     return 0;
 }
 
@@ -100,6 +101,48 @@ int SimDeviceIo::close(int fd) {
     Reader r({});
     return roundtrip(w.size(), Op::Close, r);
 }
+
+int SimDeviceIo::write(int fd, const void* buf, size_t len) {
+    Writer w(tx_);
+    w.header(Op::Write, ++seq_);
+    w.i32(fd);
+    w.u32(static_cast<uint32_t>(len));
+    w.bytes(buf, len);
+    if (!w.ok())
+        return -EMSGSIZE;
+    Reader r({});
+    return roundtrip(w.size(), Op::Write, r);
+}
+
+int SimDeviceIo::gpio_request(const std::string& chip, const std::string& name, int offset, simproto::GpioMode mode,
+                              bool active_low, int initial) {
+    Writer w(tx_);
+    w.header(Op::GpioRequest, ++seq_);
+    w.str(chip);
+    w.str(name);
+    w.i32(offset);
+    w.u8(static_cast<uint8_t>(mode));
+    w.u8(active_low ? 1 : 0);
+    w.u8(initial ? 1 : 0);
+    if (!w.ok())
+        return -ENAMETOOLONG;
+    Reader r({});
+    return roundtrip(w.size(), Op::GpioRequest, r);
+}
+
+int SimDeviceIo::simple(Op op, int32_t a, int32_t b) {
+    Writer w(tx_);
+    w.header(op, ++seq_);
+    w.i32(a);
+    if (op == Op::GpioSet)
+        w.u8(b ? 1 : 0);
+    Reader r({});
+    return roundtrip(w.size(), op, r);
+}
+
+int SimDeviceIo::gpio_get(int line) { return simple(Op::GpioGet, line); }
+int SimDeviceIo::gpio_set(int line, int value) { return simple(Op::GpioSet, line, value); }
+int SimDeviceIo::gpio_release(int line) { return simple(Op::GpioRelease, line); }
 
 int SimDeviceIo::ioctl(int fd, unsigned long request, void* arg) {
     if (request == I2C_RDWR)

@@ -22,6 +22,15 @@ public:
     int open(const char* path, int flags) override;
     int ioctl(int fd, unsigned long request, void* arg) override;
     int close(int fd) override;
+    int write(int fd, const void* buf, size_t len) override;
+
+    // GPIO lines of the simulated vehicle (see GpioBackend); results as the ops above.
+    int gpio_request(const std::string& chip, const std::string& name, int offset, simproto::GpioMode mode,
+                     bool active_low, int initial);
+    int gpio_get(int line);
+    int gpio_set(int line, int value);
+    int gpio_release(int line);
+    const std::string& socket_path() const { return path_; }
 
 private:
     // Sends tx_[0..len) and waits for the matching reply in rx_; returns the reply's result
@@ -31,7 +40,9 @@ private:
     int spi_message(int fd, unsigned long request, void* arg);
     int small_ioctl(int fd, unsigned long request, void* arg);
 
+    int simple(simproto::Op op, int32_t a, int32_t b = -1); // ops carrying one or two i32
     int sock_ = -1;
+    std::string path_;
     uint32_t seq_ = 0;
     size_t rx_len_ = 0;
     std::array<uint8_t, simproto::kMaxMessage> tx_{};

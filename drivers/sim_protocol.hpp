@@ -14,6 +14,12 @@
 //                                                  u8 bits_per_word, u8 cs_change, u8 has_tx, u8 has_rx,
 //                                                  [len bytes if has_tx] }
 //            Ioctl       i32 handle, u64 request, u64 value-in     (value and small pointer ioctls)
+//            Write       i32 handle, u32 n, n bytes                (sysfs attributes: bind/unbind)
+//            GpioRequest str chip, str name, i32 offset (-1: by name), u8 mode, u8 active_low, u8 initial
+//            GpioGet     i32 line;   GpioSet  i32 line, u8 value;   GpioRelease i32 line
+//            GpioWatch   str chip, str name, i32 offset (on a connection of its own: from then on the simulator only
+//                                      pushes GpioEvent messages there: header op GpioEvent|reply,
+//                                      seq 0, i32 new logical value, u64 timestamp ns)
 //   reply    header with op | 0x8000 and the request's seq, i32 result, then
 //            I2cRdwr: the bytes of every read message in order; SpiMessage: the rx bytes of every
 //            transfer with has_rx in order; Ioctl: u64 value-out; others: nothing.
@@ -38,6 +44,21 @@ enum class Op : uint16_t {
     I2cRdwr = 3,
     SpiMessage = 4,
     Ioctl = 5,
+    Write = 6,
+    GpioRequest = 7,
+    GpioGet = 8,
+    GpioSet = 9,
+    GpioRelease = 10,
+    GpioWatch = 11,
+    GpioEvent = 12,
+};
+
+// GPIO request modes, shared by the daemon's GpioLine and the simulator's line model.
+enum class GpioMode : uint8_t {
+    Input = 0,
+    InputEdges = 1, // input with both-edge events
+    Output = 2,     // push-pull
+    OpenDrain = 3,  // drives low or releases; reading returns the wire
 };
 
 struct Header {

@@ -26,7 +26,25 @@ uint64_t now_ns() {
 constexpr unsigned long kI2cFuncs = I2C_FUNC_I2C | I2C_FUNC_SMBUS_EMUL;
 } // namespace
 
+DeviceServer::DeviceServer(sd_event* event, SimVehicle& vehicle) : event_(event), vehicle_(vehicle) {
+    vehicle_.gpio().on_change = [this](int line, int value) { push_gpio_event(line, value); };
+}
+
+void DeviceServer::push_gpio_event(int line, int value) {
+    uint8_t buf[32];
+    for (auto& [key, c] : clients_) {
+        if (c->watched_line != line)
+            continue;
+        simproto::Writer w(buf);
+        w.header(Op::GpioEvent, 0, true);
+        w.i32(value);
+        w.u64(now_ns());
+        ::send(c->fd, buf, w.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+    }
+}
+
 DeviceServer::~DeviceServer() {
+    vehicle_.gpio().on_change = nullptr;
     clients_.clear();
     accept_source_.reset();
     if (listen_fd_ >= 0) {
@@ -80,6 +98,9 @@ int DeviceServer::on_accept(sd_event_source*, int fd, uint32_t, void* userdata) 
 }
 
 void DeviceServer::drop(Client* c) {
+    // Like the kernel, a process that goes away releases its GPIO lines.
+    for (auto& [h, line] : c->gpio_lines)
+        vehicle_.gpio().release(line, now_ns());
     ::close(c->fd);
     clients_.erase(c); // destroys the event sources with the client
 }
@@ -163,7 +184,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         r.i32(); // flags: the simulated nodes ignore O_* like a char device mostly does
         if (!r.ok() || !r.at_end())
             return bad(-EBADMSG);
-        auto kind = vehicle_.node_kind(std::string(path));
+        auto kind = vehicle_.node_kind(std::string(path), now_ns());
         if (kind == SimVehicle::NodeKind::None)
             return bad(-ENOENT);
         int hnd = c.next_handle++;
@@ -194,6 +215,8 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
             return bad(-ENOTTY);
         if (n == 0 || n > I2C_RDWR_IOCTL_MAX_MSGS)
             return bad(-EINVAL);
+        if (!vehicle_.i2c_present(now_ns()))
+            return bad(-ENODEV); // the adapter was unbound under an open file
         std::vector<I2cMessage> msgs(n);
         for (auto& m : msgs) {
             m.addr = r.u16();
@@ -278,7 +301,9 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
             return bad(-EBADF);
         uint64_t out = 0;
         int result = 0;
-        if (it->second.kind == SimVehicle::NodeKind::I2c) {
+        if (it->second.kind == SimVehicle::NodeKind::Unbind || it->second.kind == SimVehicle::NodeKind::Bind) {
+            result = -ENOTTY;
+        } else if (it->second.kind == SimVehicle::NodeKind::I2c) {
             switch (request) {
             case I2C_FUNCS: out = kI2cFuncs; break;
             case I2C_TIMEOUT:
@@ -312,6 +337,83 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         finish(result);
         return 0;
     }
+    case Op::Write: {
+        int32_t hnd = r.i32();
+        uint32_t n = r.u32();
+        auto data = r.bytes(n);
+        if (!r.ok() || !r.at_end())
+            return bad(-EBADMSG);
+        auto it = c.handles.find(hnd);
+        if (it == c.handles.end())
+            return bad(-EBADF);
+        if (it->second.kind != SimVehicle::NodeKind::Unbind && it->second.kind != SimVehicle::NodeKind::Bind)
+            return bad(-EINVAL);
+        int res = vehicle_.sysfs_write(it->second.kind,
+                                       {reinterpret_cast<const char*>(data.data()), data.size()}, now_ns());
+        begin(res);
+        finish(res);
+        return 0;
+    }
+    case Op::GpioRequest: {
+        auto chip = std::string(r.str(256));
+        auto name = std::string(r.str(256));
+        int32_t offset = r.i32();
+        uint8_t mode = r.u8();
+        uint8_t active_low = r.u8();
+        uint8_t initial = r.u8();
+        if (!r.ok() || !r.at_end() || mode > static_cast<uint8_t>(GpioMode::OpenDrain))
+            return bad(-EBADMSG);
+        int line = vehicle_.gpio().find(chip, name, offset);
+        if (line < 0)
+            return bad(line);
+        int res = vehicle_.gpio().request(line, static_cast<GpioMode>(mode), active_low, initial, now_ns());
+        if (res < 0)
+            return bad(res);
+        int hnd = c.next_handle++;
+        c.gpio_lines[hnd] = line;
+        begin(hnd);
+        finish(hnd);
+        return 0;
+    }
+    case Op::GpioGet:
+    case Op::GpioSet:
+    case Op::GpioRelease: {
+        int32_t hnd = r.i32();
+        uint8_t value = op == Op::GpioSet ? r.u8() : 0;
+        if (!r.ok() || !r.at_end())
+            return bad(-EBADMSG);
+        auto it = c.gpio_lines.find(hnd);
+        if (it == c.gpio_lines.end())
+            return bad(-EBADF);
+        int res = 0;
+        if (op == Op::GpioGet)
+            res = vehicle_.gpio().get(it->second);
+        else if (op == Op::GpioSet)
+            res = vehicle_.gpio().set(it->second, value, now_ns());
+        else {
+            vehicle_.gpio().release(it->second, now_ns());
+            c.gpio_lines.erase(it);
+        }
+        begin(res);
+        finish(res);
+        return 0;
+    }
+    case Op::GpioWatch: {
+        auto chip = std::string(r.str(256));
+        auto name = std::string(r.str(256));
+        int32_t offset = r.i32();
+        if (!r.ok() || !r.at_end())
+            return bad(-EBADMSG);
+        int line = vehicle_.gpio().find(chip, name, offset);
+        if (line < 0)
+            return bad(line);
+        c.watched_line = line;
+        begin(0);
+        finish(0);
+        return 0;
+    }
+    case Op::GpioEvent:
+        break;
     }
     return bad(-EBADMSG); // unknown op
 }

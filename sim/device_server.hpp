@@ -15,7 +15,7 @@ namespace caracara::sim {
 
 class DeviceServer {
 public:
-    DeviceServer(sd_event* event, SimVehicle& vehicle) : event_(event), vehicle_(vehicle) {}
+    DeviceServer(sd_event* event, SimVehicle& vehicle);
     ~DeviceServer();
     int listen(const std::string& path); // -errno
     uint64_t bad_requests() const { return bad_requests_; }
@@ -32,6 +32,8 @@ private:
         dbus::SourcePtr io;
         dbus::SourcePtr reply_timer;
         std::map<int, Handle> handles;
+        std::map<int, int> gpio_lines; // handle -> line index in the GPIO model
+        int watched_line = -1;         // a GpioWatch connection: pushes edges of this line
         int next_handle = 3;
         std::vector<uint8_t> reply;
     };
@@ -43,6 +45,7 @@ private:
     // Builds the reply into c.reply; returns the wire time the request occupied.
     uint64_t handle(Client& c, std::span<const uint8_t> req);
     void send_reply(Client& c);
+    void push_gpio_event(int line, int value);
 
     sd_event* event_;
     SimVehicle& vehicle_;

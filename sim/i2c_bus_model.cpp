@@ -47,10 +47,32 @@ I2cSlave* I2cBusModel::find(uint16_t addr7) const {
     return nullptr;
 }
 
+void I2cBusModel::on_scl_rising(uint64_t) {
+    if (hang_ != Hang::SdaLow)
+        return;
+    // The stuck slave finishes the byte it thought it was sending, then lets SDA go.
+    if (++hang_pulses_seen_ >= hang_pulses_needed_)
+        hang_ = Hang::None;
+}
+
 I2cBusModel::Result I2cBusModel::transfer(std::vector<I2cMessage>& msgs, uint64_t start_ns) {
     ++transactions_;
     const uint64_t txn = log_.new_transaction();
     const uint64_t bit = bit_time_ns();
+    if (!i2c_function_ || hang_ != Hang::None) {
+        // The controller cannot make a START: with SDA held low (or the pins muxed away) it
+        // times out; with SCL held low the clock-stretch timeout reports EIO.
+        WireEntry e;
+        e.transaction = txn;
+        e.bus = "i2c";
+        e.addr = msgs.empty() ? 0 : msgs.front().addr;
+        e.read = !msgs.empty() && (msgs.front().flags & I2C_M_RD);
+        e.result = !i2c_function_ ? "pins-not-i2c" : (hang_ == Hang::SclLow ? "scl-held-low" : "sda-held-low");
+        const uint64_t timeout_ns = 10 * 9 * bit; // the controller gives up after a few byte times
+        e.time_ns = start_ns + timeout_ns;
+        log_.append(std::move(e));
+        return {hang_ == Hang::SclLow ? -EIO : -ETIMEDOUT, timeout_ns};
+    }
     uint64_t t = start_ns;
     Result res{static_cast<int>(msgs.size()), 0};
     for (auto& m : msgs) {

@@ -48,6 +48,26 @@ public:
     // the end of each message.
     Result transfer(std::vector<I2cMessage>& msgs, uint64_t start_ns);
 
+    // --- The open-drain wire (bus lockup and its recovery) ---
+    // SDA and SCL are the wired-AND of every driver. A slave that lost sync holds SDA low
+    // until it has seen `pulses` more SCL clocks (1..9); a broken one holds SCL low for good.
+    enum class Hang { None, SdaLow, SclLow };
+    void hang_sda(uint32_t pulses) { hang_ = Hang::SdaLow; hang_pulses_needed_ = pulses; hang_pulses_seen_ = 0; }
+    void hang_scl() { hang_ = Hang::SclLow; }
+    void clear_hang() { hang_ = Hang::None; }
+    Hang hang() const { return hang_; }
+    uint32_t hang_pulses_seen() const { return hang_pulses_seen_; }
+    uint32_t hang_pulses_needed() const { return hang_pulses_needed_; }
+    bool slaves_release_sda() const { return hang_ != Hang::SdaLow; }
+    bool slaves_release_scl() const { return hang_ != Hang::SclLow; }
+    // Called by the GPIO model on every rising edge of the physical SCL line.
+    void on_scl_rising(uint64_t now_ns);
+    // The SoC pins carry either the I2C controller or GPIO; taking them as GPIO takes them
+    // away from I2C until the controller's driver is bound again (as on a Raspberry Pi).
+    void set_pins_to_gpio() { i2c_function_ = false; }
+    void restore_i2c_function() { i2c_function_ = true; }
+    bool i2c_function() const { return i2c_function_; }
+
     uint32_t clock_hz() const { return clock_hz_; }
     void set_clock_hz(uint32_t hz) { clock_hz_ = hz; }
     uint64_t transactions() const { return transactions_; }
@@ -60,6 +80,10 @@ private:
     WireLog& log_;
     uint32_t clock_hz_;
     uint64_t transactions_ = 0;
+    Hang hang_ = Hang::None;
+    uint32_t hang_pulses_needed_ = 0;
+    uint32_t hang_pulses_seen_ = 0;
+    bool i2c_function_ = true;
     uint64_t wire_time_ns_ = 0;
     std::map<uint16_t, std::unique_ptr<Pca9544>> muxes_;
     struct Attached {

@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <string>
+#include <ctime>
 
 namespace caracara::sim {
 
@@ -28,6 +29,21 @@ GETTER(get_thruster_count, "u", static_cast<uint32_t>(insp(userdata).vehicle().t
 GETTER(get_bad_requests, "t", static_cast<uint64_t>(insp(userdata).server().bad_requests()))
 GETTER(get_clients, "u", static_cast<uint32_t>(insp(userdata).server().clients()))
 
+GETTER(get_kill_switch, "b", static_cast<int>(insp(userdata).vehicle().gpio().kill_switch_engaged()))
+GETTER(get_kill_output, "b", static_cast<int>(insp(userdata).vehicle().gpio().level(GpioModel::kKillOut)))
+GETTER(get_power_off_output, "b", static_cast<int>(insp(userdata).vehicle().gpio().level(GpioModel::kPowerOff)))
+GETTER(get_scl, "b", static_cast<int>(insp(userdata).vehicle().gpio().level(GpioModel::kScl)))
+GETTER(get_sda, "b", static_cast<int>(insp(userdata).vehicle().gpio().level(GpioModel::kSda)))
+GETTER(get_i2c_function, "b", static_cast<int>(insp(userdata).vehicle().i2c().i2c_function()))
+GETTER(get_bound, "b", static_cast<int>(insp(userdata).vehicle().driver_bound()))
+GETTER(get_unbinds, "t", static_cast<uint64_t>(insp(userdata).vehicle().unbinds()))
+GETTER(get_binds, "t", static_cast<uint64_t>(insp(userdata).vehicle().binds()))
+GETTER(get_scl_pulses, "t", static_cast<uint64_t>(insp(userdata).vehicle().gpio().scl_pulses()))
+GETTER(get_stops, "t", static_cast<uint64_t>(insp(userdata).vehicle().gpio().stops()))
+GETTER(get_min_scl_period, "t", static_cast<uint64_t>(insp(userdata).vehicle().gpio().min_scl_period_ns()))
+GETTER(get_hang_seen, "u", insp(userdata).vehicle().i2c().hang_pulses_seen())
+GETTER(get_hang_needed, "u", insp(userdata).vehicle().i2c().hang_pulses_needed())
+
 GETTER(t_address, "y", thruster(userdata).spec().mt)
 GETTER(t_variant, "s", thruster(userdata).spec().variant == ThrusterVariant::SeaBotix ? "seabotix" : "legacy")
 GETTER(t_mux_address, "q", static_cast<uint16_t>(thruster(userdata).spec().mux_addr.value_or(0)))
@@ -44,6 +60,51 @@ GETTER(t_reads, "t", static_cast<uint64_t>(thruster(userdata).status_reads()))
 GETTER(t_zero_orders, "t", static_cast<uint64_t>(thruster(userdata).zero_orders()))
 GETTER(t_last_order_time, "t", static_cast<uint64_t>(thruster(userdata).last_order_time_ns()))
 #undef GETTER
+
+int get_hang(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
+    switch (insp(userdata).vehicle().i2c().hang()) {
+    case I2cBusModel::Hang::None: return sd_bus_message_append(reply, "s", "none");
+    case I2cBusModel::Hang::SdaLow: return sd_bus_message_append(reply, "s", "sda-low");
+    case I2cBusModel::Hang::SclLow: return sd_bus_message_append(reply, "s", "scl-low");
+    }
+    return -EINVAL;
+}
+
+uint64_t mono_ns() {
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
+}
+
+int m_set_kill_switch(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    int on = 0;
+    int r = sd_bus_message_read(m, "b", &on);
+    if (r < 0)
+        return r;
+    insp(userdata).vehicle().gpio().set_kill_switch(on, mono_ns());
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_hang_bus(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    uint32_t pulses = 0;
+    int r = sd_bus_message_read(m, "u", &pulses);
+    if (r < 0)
+        return r;
+    if (pulses < 1 || pulses > 9)
+        return sd_bus_error_setf(err, kErrInvalid, "a slave holds SDA for 1..9 clock pulses, got %u", pulses);
+    insp(userdata).vehicle().i2c().hang_sda(pulses);
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_hold_scl(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    insp(userdata).vehicle().i2c().hang_scl();
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_release_bus(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    insp(userdata).vehicle().i2c().clear_hang();
+    return sd_bus_reply_method_return(m, "");
+}
 
 int t_last_order(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
     const auto& raw = thruster(userdata).last_order_raw();
@@ -169,6 +230,25 @@ const sd_bus_vtable kRootVtable[] = {
     SD_BUS_METHOD("ClearWireLog", "", "", m_clear_log, 0),
     SD_BUS_METHOD_WITH_ARGS("SetRealisticTiming", SD_BUS_ARGS("b", enabled), SD_BUS_NO_RESULT, m_set_realistic, 0),
     SD_BUS_METHOD_WITH_ARGS("SetClock", SD_BUS_ARGS("u", hz), SD_BUS_NO_RESULT, m_set_clock, 0),
+    SD_BUS_PROPERTY("KillSwitch", "b", get_kill_switch, 0, 0),
+    SD_BUS_PROPERTY("KillOutput", "b", get_kill_output, 0, 0),
+    SD_BUS_PROPERTY("PowerOffOutput", "b", get_power_off_output, 0, 0),
+    SD_BUS_PROPERTY("Scl", "b", get_scl, 0, 0),
+    SD_BUS_PROPERTY("Sda", "b", get_sda, 0, 0),
+    SD_BUS_PROPERTY("I2cFunction", "b", get_i2c_function, 0, 0),
+    SD_BUS_PROPERTY("DriverBound", "b", get_bound, 0, 0),
+    SD_BUS_PROPERTY("Unbinds", "t", get_unbinds, 0, 0),
+    SD_BUS_PROPERTY("Binds", "t", get_binds, 0, 0),
+    SD_BUS_PROPERTY("BusHang", "s", get_hang, 0, 0),
+    SD_BUS_PROPERTY("HangPulsesSeen", "u", get_hang_seen, 0, 0),
+    SD_BUS_PROPERTY("HangPulsesNeeded", "u", get_hang_needed, 0, 0),
+    SD_BUS_PROPERTY("SclPulses", "t", get_scl_pulses, 0, 0),
+    SD_BUS_PROPERTY("Stops", "t", get_stops, 0, 0),
+    SD_BUS_PROPERTY("MinSclPeriodNs", "t", get_min_scl_period, 0, 0),
+    SD_BUS_METHOD_WITH_ARGS("SetKillSwitch", SD_BUS_ARGS("b", engaged), SD_BUS_NO_RESULT, m_set_kill_switch, 0),
+    SD_BUS_METHOD_WITH_ARGS("HangBus", SD_BUS_ARGS("u", pulses), SD_BUS_NO_RESULT, m_hang_bus, 0),
+    SD_BUS_METHOD("HoldScl", "", "", m_hold_scl, 0),
+    SD_BUS_METHOD("ReleaseBus", "", "", m_release_bus, 0),
     SD_BUS_VTABLE_END,
 };
 
@@ -213,6 +293,13 @@ TGET(te_stop_duty, "y", teensy(userdata).stop_duty())
 TGET(te_last_turn, "d", static_cast<double>(teensy(userdata).last_turn_rad()))
 TGET(te_last_turn_to, "d", static_cast<double>(teensy(userdata).last_turn_to_rad()))
 TGET(te_heading_offset, "d", teensy(userdata).heading_offset())
+TGET(te_spi_mode, "y", insp(userdata).vehicle().teensy_port().mode)
+TGET(te_spi_bits, "y", insp(userdata).vehicle().teensy_port().bits_per_word)
+TGET(te_spi_speed, "u", insp(userdata).vehicle().teensy_port().max_speed_hz)
+TGET(te_spi_mismatch, "t", static_cast<uint64_t>(insp(userdata).vehicle().teensy_port().mode_mismatches))
+TGET(te_spi_last_transfers, "u", insp(userdata).vehicle().teensy_port().last_transfers)
+TGET(te_spi_last_speed, "u", insp(userdata).vehicle().teensy_port().last_speed_hz)
+TGET(te_spi_last_delay, "q", insp(userdata).vehicle().teensy_port().last_delay_usecs)
 #undef TGET
 
 int te_orientation(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
@@ -331,6 +418,13 @@ const sd_bus_vtable kTeensyVtable[] = {
     SD_BUS_PROPERTY("LastTurn", "d", te_last_turn, 0, 0),
     SD_BUS_PROPERTY("LastTurnTo", "d", te_last_turn_to, 0, 0),
     SD_BUS_PROPERTY("HeadingOffset", "d", te_heading_offset, 0, 0),
+    SD_BUS_PROPERTY("SpiMode", "y", te_spi_mode, 0, 0),
+    SD_BUS_PROPERTY("SpiBitsPerWord", "y", te_spi_bits, 0, 0),
+    SD_BUS_PROPERTY("SpiMaxSpeedHz", "u", te_spi_speed, 0, 0),
+    SD_BUS_PROPERTY("SpiModeMismatches", "t", te_spi_mismatch, 0, 0),
+    SD_BUS_PROPERTY("SpiLastTransfers", "u", te_spi_last_transfers, 0, 0),
+    SD_BUS_PROPERTY("SpiLastSpeedHz", "u", te_spi_last_speed, 0, 0),
+    SD_BUS_PROPERTY("SpiLastDelayUsecs", "q", te_spi_last_delay, 0, 0),
     SD_BUS_METHOD_WITH_ARGS("InjectFault", SD_BUS_ARGS("s", fault, "u", frames), SD_BUS_NO_RESULT, m_te_inject, 0),
     SD_BUS_METHOD_WITH_ARGS("SetRandomBusy", SD_BUS_ARGS("d", probability, "t", seed), SD_BUS_NO_RESULT, m_te_random_busy, 0),
     SD_BUS_METHOD("ClearFaults", "", "", m_te_clear, 0),

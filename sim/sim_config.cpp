@@ -53,6 +53,21 @@ bool parse_sim_config(const std::string& text, SimConfig& out, std::string& erro
     if (auto sim = root["sim"].as_table()) {
         if (auto rt = (*sim)["realistic_timing"].value<bool>())
             c.realistic_timing = *rt;
+        if (auto v = (*sim)["driver_id"].value<std::string>())
+            c.driver_id = *v;
+        if (!get_int<uint32_t>(*sim, "rebind_delay_ms", "sim.", 0, 60000, c.rebind_delay_ms, error))
+            return false;
+        if (auto v = (*sim)["kill_switch_active_low"].value<bool>())
+            c.kill_switch_active_low = *v;
+    }
+    if (auto rec = root["recovery"].as_table()) {
+        // Share caracarad's recovery keys so one file describes both sides.
+        if (auto v = (*rec)["unbind_path"].value<std::string>())
+            c.unbind_path = *v;
+        if (auto v = (*rec)["bind_path"].value<std::string>())
+            c.bind_path = *v;
+        if (auto v = (*rec)["driver_id"].value<std::string>())
+            c.driver_id = *v;
     }
     if (auto spi = root["spi"].as_table()) {
         if (auto d = (*spi)["device"].value<std::string>())

@@ -15,6 +15,12 @@ struct SimConfig {
     bool realistic_timing = false;
     std::string spi_device = "/dev/spidev0.0";
     std::vector<ThrusterSpec> thrusters;
+    // The I2C controller's platform driver, as sysfs shows it on the SBC.
+    std::string unbind_path = "/sys/bus/platform/drivers/i2c-bcm2835/unbind";
+    std::string bind_path = "/sys/bus/platform/drivers/i2c-bcm2835/bind";
+    std::string driver_id = "fe804000.i2c";
+    uint32_t rebind_delay_ms = 20; // udev recreating /dev/i2c-N after a bind
+    bool kill_switch_active_low = false;
 };
 
 SimConfig default_sim_config();

@@ -6,7 +6,8 @@
 namespace caracara::sim {
 
 SimVehicle::SimVehicle(const SimConfig& cfg)
-    : cfg_(cfg), i2c_(log_, cfg.i2c_clock_hz), realistic_(cfg.realistic_timing) {
+    : cfg_(cfg), i2c_(log_, cfg.i2c_clock_hz), gpio_(i2c_, log_, cfg.kill_switch_active_low),
+      realistic_(cfg.realistic_timing) {
     for (const auto& spec : cfg_.thrusters) {
         thrusters_.push_back(std::make_unique<ThrusterModel>(spec));
         auto* t = thrusters_.back().get();
@@ -27,9 +28,13 @@ SimVehicle::SimVehicle(const SimConfig& cfg)
     stepped_.push_back(teensy_.get());
 }
 
-SimVehicle::NodeKind SimVehicle::node_kind(const std::string& path) const {
+SimVehicle::NodeKind SimVehicle::node_kind(const std::string& path, uint64_t now_ns) const {
     if (path == cfg_.i2c_device)
-        return NodeKind::I2c;
+        return i2c_present(now_ns) ? NodeKind::I2c : NodeKind::None;
+    if (path == cfg_.unbind_path)
+        return NodeKind::Unbind;
+    if (path == cfg_.bind_path)
+        return NodeKind::Bind;
     if (spi_.count(path))
         return NodeKind::Spi;
     return NodeKind::None;
@@ -40,10 +45,38 @@ SpiPort* SimVehicle::spi_port(const std::string& path) {
     return it == spi_.end() ? nullptr : &it->second;
 }
 
+int SimVehicle::sysfs_write(NodeKind which, std::string_view data, uint64_t now_ns) {
+    std::string_view id = data;
+    while (!id.empty() && (id.back() == '\n' || id.back() == ' '))
+        id.remove_suffix(1);
+    // The kernel answers ENODEV for a device it does not know or that is not in that state.
+    if (id != cfg_.driver_id)
+        return -ENODEV;
+    if (which == NodeKind::Unbind) {
+        if (!bound_)
+            return -ENODEV;
+        bound_ = false;
+        ++unbinds_;
+    } else {
+        if (bound_)
+            return -EBUSY;
+        bound_ = true;
+        ++binds_;
+        // Probing the controller puts the pins back to their I2C function; the node follows
+        // once udev has recreated it.
+        i2c_.restore_i2c_function();
+        node_back_at_ = now_ns + 1'000'000ull * cfg_.rebind_delay_ms;
+    }
+    return static_cast<int>(data.size());
+}
+
 void SimVehicle::attach_spi(const std::string& path, SpiSlave* slave) { spi_[path].slave = slave; }
 
 int SimVehicle::spi_message(SpiPort& port, std::vector<SpiMessageXfer>& xfers, uint64_t start_ns, uint64_t& wire_ns) {
     ++port.messages;
+    port.last_transfers = static_cast<uint32_t>(xfers.size());
+    port.last_speed_hz = xfers.empty() ? 0 : xfers.front().params.speed_hz;
+    port.last_delay_usecs = xfers.empty() ? 0 : xfers.front().params.delay_usecs;
     uint64_t t = start_ns;
     int total = 0;
     WireEntry e;

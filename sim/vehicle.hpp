@@ -2,6 +2,7 @@
 // server and the inspection API both work on this one object.
 #pragma once
 
+#include "gpio_model.hpp"
 #include "i2c_bus_model.hpp"
 #include "sim_config.hpp"
 #include "slave.hpp"
@@ -14,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace caracara::sim {
@@ -34,14 +36,26 @@ struct SpiPort {
     uint8_t lsb_first = 0;
     uint64_t messages = 0;
     uint64_t mode_mismatches = 0;
+    // The shape of the last SPI_IOC_MESSAGE, for tests of the spidev marshalling.
+    uint32_t last_transfers = 0;
+    uint32_t last_speed_hz = 0;
+    uint16_t last_delay_usecs = 0;
 };
 
 class SimVehicle {
 public:
     explicit SimVehicle(const SimConfig& cfg);
 
-    enum class NodeKind { None, I2c, Spi };
-    NodeKind node_kind(const std::string& path) const;
+    enum class NodeKind { None, I2c, Spi, Unbind, Bind };
+    NodeKind node_kind(const std::string& path, uint64_t now_ns) const;
+    // The I2C adapter exists (driver bound and its device node recreated).
+    bool i2c_present(uint64_t now_ns) const { return bound_ && now_ns >= node_back_at_; }
+    // A write to the driver's sysfs bind/unbind attribute. Bytes consumed or -errno.
+    int sysfs_write(NodeKind which, std::string_view data, uint64_t now_ns);
+    bool driver_bound() const { return bound_; }
+    uint64_t unbinds() const { return unbinds_; }
+    uint64_t binds() const { return binds_; }
+    GpioModel& gpio() { return gpio_; }
 
     I2cBusModel& i2c() { return i2c_; }
     const std::string& i2c_path() const { return cfg_.i2c_device; }
@@ -53,6 +67,7 @@ public:
     std::vector<std::unique_ptr<ThrusterModel>>& thrusters() { return thrusters_; }
     VehicleBody& body() { return *body_; }
     TeensyModel& teensy() { return *teensy_; }
+    SpiPort& teensy_port() { return spi_[cfg_.spi_device]; }
     WireLog& log() { return log_; }
     void add_stepped(Stepped* s) { stepped_.push_back(s); }
     void step(double dt_s, uint64_t now_ns);
@@ -71,6 +86,11 @@ private:
     std::unique_ptr<VehicleBody> body_;
     std::unique_ptr<TeensyModel> teensy_;
     std::vector<Stepped*> stepped_;
+    GpioModel gpio_;
+    bool bound_ = true;
+    uint64_t node_back_at_ = 0;
+    uint64_t unbinds_ = 0;
+    uint64_t binds_ = 0;
     bool realistic_ = false;
     uint64_t bus_free_at_ = 0;
 };

@@ -209,3 +209,26 @@ TEST_CASE("invalid inputs are refused before anything reaches the Teensy") {
     CHECK(l.link->set_leds(256, 0, 0) == teensy::TeensyError::LedValueOutOfRange);
     CHECK(prop<uint64_t>(f, "Frames", 't') == frames);
 }
+
+TEST_CASE("spidev is set up as mode 0, 8 bits at the configured speed; per-byte mode splits the frame") {
+    SimFixture f;
+    {
+        Link l(f, SpiConfig{1000000, 0});
+        CHECK(prop<uint8_t>(f, "SpiMode", 'y') == 0);
+        CHECK(prop<uint8_t>(f, "SpiBitsPerWord", 'y') == 8);
+        CHECK(prop<uint32_t>(f, "SpiMaxSpeedHz", 'u') == 1000000);
+        REQUIRE(l.link->set_leds(4, 5, 6) == teensy::TeensyError::None);
+        // One full-duplex spi_ioc_transfer carrying the whole frame.
+        CHECK(prop<uint32_t>(f, "SpiLastTransfers", 'u') == 1);
+        CHECK(prop<uint16_t>(f, "SpiLastDelayUsecs", 'q') == 0);
+    }
+    {
+        Link l(f, SpiConfig{500000, 25});
+        REQUIRE(l.link->set_leds(7, 8, 9) == teensy::TeensyError::None);
+        // Set LEDs is [09 r g b ack]: five 1-byte transfers, each followed by the delay.
+        CHECK(prop<uint32_t>(f, "SpiLastTransfers", 'u') == 5);
+        CHECK(prop<uint16_t>(f, "SpiLastDelayUsecs", 'q') == 25);
+        CHECK(bytes_prop(f, "Leds", "(yyy)") == std::vector<uint8_t>{7, 8, 9});
+    }
+    CHECK(prop<uint64_t>(f, "SpiModeMismatches", 't') == 0);
+}

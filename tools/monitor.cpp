@@ -1,0 +1,123 @@
+#include "monitor.hpp"
+
+#include "render.hpp"
+
+#include <csignal>
+#include <cstring>
+#include <iostream>
+#include <string>
+
+namespace caracaractl {
+
+namespace {
+
+struct Monitor {
+    Client& client;
+    sd_event* event;
+};
+
+void print_line(const std::string& text) { std::cout << timestamp_now() << ' ' << text << std::endl; }
+
+// Runs a callback body; a Failure ends the loop with its exit code (no exception may cross sd-bus).
+template <typename F>
+int guarded(Monitor& mon, F body) {
+    try {
+        body();
+    } catch (const Failure& f) {
+        std::cerr << "caracaractl: " << f.message << '\n';
+        sd_event_exit(mon.event, f.code);
+    }
+    return 0;
+}
+
+int on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto& mon = *static_cast<Monitor*>(userdata);
+    return guarded(mon, [&] {
+        if (sd_bus_message_has_signature(m, "sa{sv}as") <= 0)
+            return;
+        read_value(m); // the interface: each object has one
+        const Value changed = read_value(m);
+        const Value invalidated = read_value(m);
+        std::string line = object_label(sd_bus_message_get_path(m));
+        for (const Value& entry : changed.items)
+            line += ' ' + entry.items[0].s + '=' + render_property(entry.items[0].s, entry.items[1]);
+        for (const Value& name : invalidated.items)
+            line += ' ' + name.s + "=(changed)";
+        print_line(line);
+    });
+}
+
+int on_name_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto& mon = *static_cast<Monitor*>(userdata);
+    const char *name = nullptr, *old_owner = nullptr, *new_owner = nullptr;
+    if (sd_bus_message_read(m, "sss", &name, &old_owner, &new_owner) < 0 || std::strcmp(name, kService) != 0)
+        return 0;
+    if (!new_owner || !*new_owner) {
+        print_line(std::string("caracarad left ") + mon.client.choice().describe());
+        sd_event_exit(mon.event, kExitRefused);
+    }
+    return 0;
+}
+
+// sd-bus synthesizes org.freedesktop.DBus.Local.Disconnected when the bus connection drops.
+int on_message(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto& mon = *static_cast<Monitor*>(userdata);
+    if (sd_bus_message_is_signal(m, "org.freedesktop.DBus.Local", "Disconnected") > 0) {
+        std::cerr << "caracaractl: lost the connection to " << mon.client.choice().describe() << '\n';
+        sd_event_exit(mon.event, kExitUnavailable);
+    }
+    return 0;
+}
+
+int on_signal(sd_event_source* source, const signalfd_siginfo*, void*) {
+    return sd_event_exit(sd_event_source_get_event(source), kExitOk);
+}
+
+void check(int r, const char* what) {
+    if (r < 0)
+        throw Failure{kExitUnavailable, std::string("monitor: ") + what + ": " + std::strerror(-r)};
+}
+
+} // namespace
+
+int run_monitor(Client& client) {
+    sd_bus* bus = client.bus();
+    sd_event* raw_event = nullptr;
+    check(sd_event_new(&raw_event), "cannot create the event loop");
+    caracara::dbus::EventPtr event(raw_event);
+    Monitor mon{client, raw_event};
+
+    sigset_t mask;
+    sigemptyset(&mask);
+    sigaddset(&mask, SIGINT);
+    sigaddset(&mask, SIGTERM);
+    check(sigprocmask(SIG_BLOCK, &mask, nullptr) < 0 ? -errno : 0, "cannot block signals");
+    check(sd_event_add_signal(raw_event, nullptr, SIGINT, on_signal, nullptr), "cannot watch SIGINT");
+    check(sd_event_add_signal(raw_event, nullptr, SIGTERM, on_signal, nullptr), "cannot watch SIGTERM");
+
+    // Subscribe first (sd_bus_add_match waits for the bus to confirm), then read the current
+    // state, so that no change falls between the two.
+    const std::string changes = std::string("type='signal',sender='") + kService +
+                                "',interface='org.freedesktop.DBus.Properties',member='PropertiesChanged',"
+                                "path_namespace='" + kRootPath + "'";
+    const std::string owner = std::string("type='signal',sender='org.freedesktop.DBus',path='/org/freedesktop/DBus',"
+                                          "interface='org.freedesktop.DBus',member='NameOwnerChanged',arg0='") +
+                              kService + "'";
+    sd_bus_slot* raw_slot = nullptr;
+    check(sd_bus_add_match(bus, &raw_slot, changes.c_str(), on_properties_changed, &mon), "cannot subscribe");
+    caracara::dbus::SlotPtr changes_slot(raw_slot);
+    check(sd_bus_add_match(bus, &raw_slot, owner.c_str(), on_name_owner_changed, &mon), "cannot subscribe");
+    caracara::dbus::SlotPtr owner_slot(raw_slot);
+    check(sd_bus_add_filter(bus, &raw_slot, on_message, &mon), "cannot watch the connection");
+    caracara::dbus::SlotPtr filter_slot(raw_slot);
+
+    print_line(summary_line(client.get_objects()));
+
+    check(sd_bus_attach_event(bus, raw_event, SD_EVENT_PRIORITY_NORMAL), "cannot attach the bus");
+    const int r = sd_event_loop(raw_event);
+    sd_bus_detach_event(bus);
+    check(r, "event loop failed");
+    return r;
+}
+
+} // namespace caracaractl
