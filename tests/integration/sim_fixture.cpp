@@ -149,6 +149,32 @@ uint64_t SimFixture::thruster_u64(unsigned i, const char* prop) { GET_PROP(uint6
 double SimFixture::thruster_double(unsigned i, const char* prop) { GET_PROP(double, 'd', static_cast<double>) }
 #undef GET_PROP
 
+#define ROOT_PROP(type, sig, cast)                                                                               \
+    sd_bus_error e = SD_BUS_ERROR_NULL;                                                                         \
+    type v{};                                                                                                   \
+    int r = sd_bus_get_property_trivial(bus_.get(), "org.caracara.Simulator1", "/org/caracara/Simulator1",      \
+                                        "org.caracara.Simulator1", prop, &e, sig, &v);                          \
+    if (r < 0)                                                                                                  \
+        fail(prop, e, r);                                                                                       \
+    return cast(v);
+
+bool SimFixture::root_bool(const char* prop) { ROOT_PROP(int, 'b', static_cast<bool>) }
+uint64_t SimFixture::root_u64(const char* prop) { ROOT_PROP(uint64_t, 't', static_cast<uint64_t>) }
+uint32_t SimFixture::root_u32(const char* prop) { ROOT_PROP(uint32_t, 'u', static_cast<uint32_t>) }
+#undef ROOT_PROP
+
+std::string SimFixture::root_string(const char* prop) {
+    sd_bus_error e = SD_BUS_ERROR_NULL;
+    char* s = nullptr;
+    int r = sd_bus_get_property_string(bus_.get(), "org.caracara.Simulator1", "/org/caracara/Simulator1",
+                                       "org.caracara.Simulator1", prop, &e, &s);
+    if (r < 0)
+        fail(prop, e, r);
+    std::string out = s;
+    free(s);
+    return out;
+}
+
 std::vector<uint8_t> SimFixture::thruster_bytes(unsigned i, const char* prop) {
     sd_bus_error e = SD_BUS_ERROR_NULL;
     sd_bus_message* m = nullptr;

@@ -5,6 +5,7 @@
 #include "sdbus.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <sys/types.h>
 #include <vector>
@@ -59,6 +60,11 @@ public:
     // Calls a method; returns the D-Bus error name, or "" on success.
     std::string call(const std::string& path, const char* iface, const char* method, const char* sig, ...);
     std::vector<WireEntry> wire_log(uint64_t since = 0);
+    // Root object (org.caracara.Simulator1) properties.
+    bool root_bool(const char* prop);
+    uint64_t root_u64(const char* prop);
+    uint32_t root_u32(const char* prop);
+    std::string root_string(const char* prop);
 
     Process sim;
     Process dbus_daemon;
