@@ -528,13 +528,17 @@ Result Controller::accept_motors(const MotorValues& wanted, bool mix_saturated, 
     SafetyAction a = safety_.accept_command(now(), client);
     if (!a.ok())
         return state_error();
+    const int32_t limit = b.running ? b.limit : 0;
+    const bool saturated = b.saturated || mix_saturated;
+    // A stream re-sending the same command changes nothing worth announcing.
+    const bool changed = requested_ != wanted || applied_ != b.motors || limit_ != limit || saturated_ != saturated;
     requested_ = wanted;
     applied_ = b.motors;
-    limit_ = b.running ? b.limit : 0;
-    saturated_ = b.saturated || mix_saturated;
+    limit_ = limit;
+    saturated_ = saturated;
     // The new orders go out now, one transaction per loop iteration, not at the next tick.
     mark_orders_due();
-    notify(kChangeMotors | (previous != safety_.commanding_client() ? kChangeController : 0u));
+    notify((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
     return {};
 }
 

@@ -2,10 +2,13 @@
 // of timedatectl. Arguments are parsed completely before anything is sent; value ranges are the
 // daemon's business (it answers with named errors), only the D-Bus wire types are checked here.
 #include "client.hpp"
+#include "hold.hpp"
 #include "monitor.hpp"
 #include "render.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
@@ -22,7 +25,13 @@ using Args = std::vector<std::string>;
 
 struct Options {
     bool yes_power_off = false;
+    bool all = false;    // monitor --all
+    bool for_given = false;
+    HoldOptions hold;    // thrust, motion, packet: --for SECONDS, --once
 };
+
+// The longest --for: beyond any dive, and far from overflowing the microsecond clock.
+constexpr double kMaxHoldSeconds = 1e9;
 
 // Turn and TurnTo reply only when the Teensy reports the turn finished.
 constexpr uint64_t kTurnTimeoutUsec = 60'000'000;
@@ -69,6 +78,22 @@ Client::Appender int_array(std::vector<int32_t> values) {
     };
 }
 
+// "[1000,0,-500]" for the holding line.
+std::string int_list(const std::vector<int32_t>& values) {
+    std::string out = "[";
+    for (size_t i = 0; i < values.size(); ++i)
+        out += (i ? "," : "") + std::to_string(values[i]);
+    return out + "]";
+}
+
+// --for SECONDS: positive, finite, decimals allowed.
+uint64_t parse_duration(const std::string& text) {
+    const double seconds = parse_double(text, "--for");
+    if (!std::isfinite(seconds) || seconds <= 0 || seconds > kMaxHoldSeconds)
+        usage_error("--for needs a positive number of seconds, not '" + text + "'");
+    return std::max<uint64_t>(1, static_cast<uint64_t>(std::llround(seconds * 1e6)));
+}
+
 // --- commands ----------------------------------------------------------------------------------
 
 int cmd_status(Client& c, const Args&, const Options&) {
@@ -76,25 +101,33 @@ int cmd_status(Client& c, const Args&, const Options&) {
     return kExitOk;
 }
 
-int cmd_monitor(Client& c, const Args&, const Options&) { return run_monitor(c); }
+int cmd_monitor(Client& c, const Args&, const Options& o) { return run_monitor(c, o.all); }
 
-int cmd_thrust(Client& c, const Args& a, const Options&) {
-    c.call(kRootPath, kVehicleIface, "SetThrust", int_array(parse_ints(a, "motor value")));
-    return kExitOk;
+int cmd_thrust(Client& c, const Args& a, const Options& o) {
+    const std::vector<int32_t> values = parse_ints(a, "motor value");
+    return hold_command(c, "SetThrust", int_array(values), "SetThrust(" + int_list(values) + ")", o.hold);
 }
 
-int cmd_motion(Client& c, const Args& a, const Options&) {
+int cmd_motion(Client& c, const Args& a, const Options& o) {
     const char* names[] = {"X", "Y", "Z", "YAW", "PITCH", "ROLL"};
     double v[6];
     for (size_t i = 0; i < 6; ++i)
         v[i] = parse_double(a[i], names[i]);
-    c.call(kRootPath, kVehicleIface, "SetMotion", append_args("dddddd", v[0], v[1], v[2], v[3], v[4], v[5]));
-    return kExitOk;
+    return hold_command(c, "SetMotion", append_args("dddddd", v[0], v[1], v[2], v[3], v[4], v[5]),
+                        strf("SetMotion(%g, %g, %g, %g, %g, %g)", v[0], v[1], v[2], v[3], v[4], v[5]), o.hold);
 }
 
-int cmd_packet(Client& c, const Args& a, const Options&) {
-    c.call(kRootPath, kVehicleIface, "ApplyPacket", int_array(parse_ints(a, "packet word")));
-    return kExitOk;
+// Packet words 8 and 9: killState and powerOffState.
+constexpr size_t kPacketKillWord = 8, kPacketPowerOffWord = 9;
+
+int cmd_packet(Client& c, const Args& a, const Options& o) {
+    const std::vector<int32_t> words = parse_ints(a, "packet word");
+    HoldOptions hold = o.hold;
+    // A kill latches and a power-off is final: there is nothing to keep alive, and a repeated
+    // power-off would only be refused.
+    if (words[kPacketKillWord] != 0 || words[kPacketPowerOffWord] != 0)
+        hold = HoldOptions{true, 0};
+    return hold_command(c, "ApplyPacket", int_array(words), "ApplyPacket(" + int_list(words) + ")", hold);
 }
 
 int cmd_kill(Client& c, const Args&, const Options&) {
@@ -164,6 +197,14 @@ int cmd_stop_wheels(Client& c, const Args& a, const Options&) {
 
 int cmd_help(Client&, const Args&, const Options&);
 
+// Which command options a command takes.
+enum CommandOption : unsigned {
+    kOptNone = 0,
+    kOptHold = 1 << 0,        // --for SECONDS, --once
+    kOptAll = 1 << 1,         // --all
+    kOptYesPowerOff = 1 << 2, // --yes-power-off
+};
+
 struct Command {
     const char* name;
     const char* synopsis;
@@ -171,18 +212,23 @@ struct Command {
     size_t nargs;
     int (*run)(Client&, const Args&, const Options&);
     const char* group = nullptr; // starts a new section of --help
+    unsigned options = kOptNone;
 };
 
 constexpr Command kCommands[] = {
     {"status", "", "Show vehicle, thrusters, Teensy and I2C bus (default)", 0, cmd_status, "Vehicle commands"},
-    {"monitor", "", "Print every property change, timestamped, until ^C", 0, cmd_monitor},
-    {"thrust", "V0 V1 V2 V3 V4 V5 V6 V7", "Set the eight motor values (-8850..8850)", 8, cmd_thrust},
-    {"motion", "X Y Z YAW PITCH ROLL", "Set a 6-axis motion demand (each -1..1)", 6, cmd_motion},
-    {"packet", "W0 ... W12", "Apply a 13-word Caracara packet (motors, kill, power-off, RGB)", 13, cmd_packet},
+    {"monitor", "[--all]", "Print property changes, timestamped, until ^C", 0, cmd_monitor, nullptr, kOptAll},
+    {"thrust", "V0 V1 V2 V3 V4 V5 V6 V7", "Hold the eight motor values (-8850..8850) until ^C", 8, cmd_thrust,
+     nullptr, kOptHold},
+    {"motion", "X Y Z YAW PITCH ROLL", "Hold a 6-axis motion demand (each -1..1) until ^C", 6, cmd_motion, nullptr,
+     kOptHold},
+    {"packet", "W0 ... W12", "Hold a 13-word Caracara packet (motors, kill, power-off, RGB)", 13, cmd_packet,
+     nullptr, kOptHold},
     {"kill", "", "Zero every thruster at once and latch the kill", 0, cmd_kill},
     {"clear-kill", "", "Clear the kill (arming, then ready)", 0, cmd_clear_kill},
     {"leds", "R G B", "Set the LED colour (0..255 each)", 3, cmd_leds},
-    {"power-off", "[--yes-power-off]", "Power the vehicle off, irreversibly (asks to confirm)", 0, cmd_power_off},
+    {"power-off", "[--yes-power-off]", "Power the vehicle off, irreversibly (asks to confirm)", 0, cmd_power_off,
+     nullptr, kOptYesPowerOff},
     {"turn", "RAD", "Turn by RAD radians; returns when done", 1, cmd_turn, "Teensy commands"},
     {"turn-to", "RAD", "Turn to heading RAD radians; returns when done", 1, cmd_turn_to},
     {"servo", "ID DEG", "Set servo ID to DEG degrees", 2, cmd_servo},
@@ -215,6 +261,23 @@ void print_help() {
                  "  --bus-address ADDR               Connect to the bus at ADDR (e.g. unix:path=/tmp/bus)\n"
                  "  --yes-power-off                  Confirm power-off without asking (also after it)\n"
                  "  -h --help                        Show this help\n"
+                 "\nCommand options (after the command, before or after its values):\n"
+                 "  --for SECONDS                    thrust, motion, packet: hold for SECONDS (decimals\n"
+                 "                                   allowed, e.g. 2.5), then let go\n"
+                 "  --once                           thrust, motion, packet: send once and exit; caracarad\n"
+                 "                                   zeroes the thrusters as soon as caracaractl has left\n"
+                 "  --all                            monitor: print every announcement, with the fast\n"
+                 "                                   counters (Cycles, CommandAgeMs, OrdersSent,\n"
+                 "                                   StatusReads, Frames, BusyRetries, Transactions) and\n"
+                 "                                   values announced again unchanged, hidden by default\n"
+                 "\nHolding: caracarad zeroes the thrusters when the client that sent the last thrust,\n"
+                 "motion or packet leaves the bus, or when no command arrives within its\n"
+                 "CommandTimeoutMs (500 ms by default). So thrust, motion and packet stay connected and\n"
+                 "re-send their command every 100 ms (at most a third of CommandTimeoutMs) until Ctrl-C,\n"
+                 "SIGTERM or the end of --for. They then exit without sending a zero themselves: the\n"
+                 "daemon zeroes the thrusters when this client leaves. A re-send the daemon refuses\n"
+                 "(e.g. Killed after a kill) is printed and ends caracaractl at once with status 1.\n"
+                 "A packet that kills or powers off is sent once.\n"
                  "\nCommands wait for the daemon's answer (turn and turn-to up to 60 s, others 25 s).\n"
                  "Changing the vehicle needs root or membership in the caracara group; reading does not.\n"
                  "\nExit status:\n"
@@ -269,17 +332,39 @@ int main(int argc, char** argv) {
         if (!command)
             usage_error("unknown command '" + name + "'");
         Args args;
+        auto takes = [&](unsigned option, const std::string& a) {
+            if (!(command->options & option))
+                usage_error("option '" + a + "' does not apply to " + command->name);
+        };
         for (; i < argc; ++i) {
             const std::string a = argv[i];
             if (a == "-h" || a == "--help") {
                 print_help();
                 return kExitOk;
             }
-            if (a == "--yes-power-off" && command->run == cmd_power_off)
+            if (a == "--yes-power-off") {
+                takes(kOptYesPowerOff, a);
                 options.yes_power_off = true;
-            else
+            } else if (a == "--all") {
+                takes(kOptAll, a);
+                options.all = true;
+            } else if (a == "--once") {
+                takes(kOptHold, a);
+                options.hold.once = true;
+            } else if (a == "--for" || a.starts_with("--for=")) {
+                takes(kOptHold, "--for");
+                if (a == "--for" && i + 1 >= argc)
+                    usage_error("--for needs a number of seconds");
+                options.hold.duration_usec = parse_duration(a == "--for" ? argv[++i] : a.substr(6));
+                options.for_given = true;
+            } else if (a.starts_with("--")) {
+                usage_error("unknown option '" + a + "'"); // values never start with "--"
+            } else {
                 args.push_back(a);
+            }
         }
+        if (options.hold.once && options.for_given)
+            usage_error("--for and --once exclude each other");
         if (args.size() != command->nargs)
             usage_error(strf("%s takes %zu argument%s, got %zu", command->name, command->nargs,
                              command->nargs == 1 ? "" : "s", args.size()));
@@ -289,7 +374,8 @@ int main(int argc, char** argv) {
         std::cerr << "caracaractl: " << f.message << '\n';
         if (f.code == kExitUsage) {
             if (command)
-                std::cerr << "Usage: caracaractl " << synopsis(*command) << '\n';
+                std::cerr << "Usage: caracaractl " << synopsis(*command)
+                          << (command->options & kOptHold ? " [--for SECONDS | --once]" : "") << '\n';
             std::cerr << "Try 'caracaractl --help' for more information.\n";
         }
         return f.code;

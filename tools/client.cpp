@@ -138,21 +138,22 @@ Failure Client::failure_for(const sd_bus_error& error, int r, uint64_t timeout_u
     if (is_one_of(name, {SD_BUS_ERROR_ACCESS_DENIED}) || (!name && (r == -EACCES || r == -EPERM)))
         return {kExitDenied, "permission denied: commanding caracarad needs root or membership in the "
                              "caracara group (" + message + ")"};
+    // Checked before the timeout: sd-bus answers the calls pending on a closed connection with
+    // NoReply ("Connection terminated").
+    if (bus_ && !sd_bus_is_open(bus_.get()))
+        return {kExitUnavailable, "lost the connection to " + choice_.describe() + ": " + message};
     if (is_one_of(name, {SD_BUS_ERROR_NO_REPLY, SD_BUS_ERROR_TIMEOUT}) || r == -ETIMEDOUT) {
         const uint64_t t = timeout_usec ? timeout_usec : kDefaultTimeoutUsec;
         return {kExitUnavailable, "caracarad did not answer within " + std::to_string(t / 1'000'000) +
                                       " s (the request may still take effect)"};
     }
-    if (bus_ && !sd_bus_is_open(bus_.get()))
-        return {kExitUnavailable, "lost the connection to " + choice_.describe() + ": " + message};
     return {kExitRefused, std::string(name ? name : "error") + ": " + message};
 }
 
-caracara::dbus::MessagePtr Client::call(const char* path, const char* iface, const char* member,
-                                        const Appender& append, uint64_t timeout_usec) {
-    sd_bus* b = bus();
+caracara::dbus::MessagePtr Client::new_call(const char* path, const char* iface, const char* member,
+                                            const Appender& append) {
     sd_bus_message* raw = nullptr;
-    int r = sd_bus_message_new_method_call(b, &raw, kService, path, iface, member);
+    int r = sd_bus_message_new_method_call(bus(), &raw, kService, path, iface, member);
     caracara::dbus::MessagePtr request(raw);
     // A query or command must not start the daemon behind the operator's back.
     if (r >= 0)
@@ -161,14 +162,24 @@ caracara::dbus::MessagePtr Client::call(const char* path, const char* iface, con
         r = append(raw);
     if (r < 0)
         throw Failure{kExitUsage, std::string("cannot build the ") + member + " call: " + errno_text(r)};
+    return request;
+}
 
+caracara::dbus::MessagePtr Client::call(const char* path, const char* iface, const char* member,
+                                        const Appender& append, uint64_t timeout_usec) {
+    caracara::dbus::MessagePtr request = new_call(path, iface, member, append);
     ErrorGuard error;
     sd_bus_message* reply = nullptr;
-    r = sd_bus_call(b, raw, timeout_usec, &error.e, &reply);
+    const int r = sd_bus_call(bus(), request.get(), timeout_usec, &error.e, &reply);
     caracara::dbus::MessagePtr result(reply);
     if (r < 0)
         throw failure_for(error.e, r, timeout_usec);
     return result;
+}
+
+Value Client::get_property(const char* path, const char* iface, const char* name) {
+    auto reply = call(path, "org.freedesktop.DBus.Properties", "Get", append_args("ss", iface, name));
+    return read_value(reply.get());
 }
 
 Props Client::get_all(const char* path, const char* iface) {

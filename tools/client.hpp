@@ -74,10 +74,18 @@ public:
     sd_bus* bus();
     const caracara::dbus::BusChoice& choice() const { return choice_; }
 
+    // A method call to `member` on org.caracara.Vehicle1 with its arguments appended, never
+    // auto-starting the daemon; throws Failure when it cannot be built.
+    caracara::dbus::MessagePtr new_call(const char* path, const char* iface, const char* member,
+                                        const Appender& append = {});
+
     // Calls `member` on org.caracara.Vehicle1 (never auto-starting it) and returns the reply;
     // throws Failure with the exit code the error deserves. timeout_usec 0 = sd-bus default.
     caracara::dbus::MessagePtr call(const char* path, const char* iface, const char* member,
                                     const Appender& append = {}, uint64_t timeout_usec = 0);
+
+    // Properties.Get of one property.
+    Value get_property(const char* path, const char* iface, const char* name);
 
     // Properties.GetAll on one object.
     Props get_all(const char* path, const char* iface);

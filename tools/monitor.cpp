@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstring>
 #include <iostream>
+#include <map>
 #include <string>
 
 namespace caracaractl {
@@ -14,6 +15,27 @@ namespace {
 struct Monitor {
     Client& client;
     sd_event* event;
+    bool all;
+    // The last value shown of every property (rendered), keyed by path, interface and name: the
+    // daemon re-announces values that did not change (MotorValues after each re-sent command).
+    std::map<std::string, std::string> last;
+};
+
+std::string property_key(std::string_view path, std::string_view iface, std::string_view name) {
+    return std::string(path) + ' ' + std::string(iface) + ' ' + std::string(name);
+}
+
+struct Counter {
+    std::string_view iface;
+    std::string_view property;
+};
+
+// Counters that move with every control-loop cycle, status read or Teensy frame: printed, they
+// would bury every other change. Error counters (Nacks, Timeouts, Errors, ...) are not here.
+constexpr Counter kFastCounters[] = {
+    {kVehicleIface, "Cycles"},       {kVehicleIface, "CommandAgeMs"}, {kThrusterIface, "OrdersSent"},
+    {kThrusterIface, "StatusReads"}, {kTeensyIface, "Frames"},        {kTeensyIface, "BusyRetries"},
+    {kBusIface, "Transactions"},
 };
 
 void print_line(const std::string& text) { std::cout << timestamp_now() << ' ' << text << std::endl; }
@@ -35,15 +57,28 @@ int on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return guarded(mon, [&] {
         if (sd_bus_message_has_signature(m, "sa{sv}as") <= 0)
             return;
-        read_value(m); // the interface: each object has one
+        const char* path = sd_bus_message_get_path(m);
+        const std::string iface = read_value(m).s;
         const Value changed = read_value(m);
         const Value invalidated = read_value(m);
-        std::string line = object_label(sd_bus_message_get_path(m));
-        for (const Value& entry : changed.items)
-            line += ' ' + entry.items[0].s + '=' + render_property(entry.items[0].s, entry.items[1]);
+        auto shown = [&](const std::string& name) { return mon.all || !is_fast_counter(iface, name); };
+        std::string line;
+        for (const Value& entry : changed.items) {
+            if (entry.items.size() != 2 || !shown(entry.items[0].s))
+                continue;
+            const std::string& name = entry.items[0].s;
+            std::string text = render_property(name, entry.items[1]);
+            std::string& last = mon.last[property_key(path ? path : "", iface, name)];
+            if (!mon.all && text == last)
+                continue;
+            last = text;
+            line += ' ' + name + '=' + text;
+        }
         for (const Value& name : invalidated.items)
-            line += ' ' + name.s + "=(changed)";
-        print_line(line);
+            if (shown(name.s))
+                line += ' ' + name.s + "=(changed)";
+        if (!line.empty())
+            print_line(object_label(path ? path : "") + line);
     });
 }
 
@@ -80,12 +115,19 @@ void check(int r, const char* what) {
 
 } // namespace
 
-int run_monitor(Client& client) {
+bool is_fast_counter(std::string_view iface, std::string_view property) {
+    for (const Counter& c : kFastCounters)
+        if (c.iface == iface && c.property == property)
+            return true;
+    return false;
+}
+
+int run_monitor(Client& client, bool all) {
     sd_bus* bus = client.bus();
     sd_event* raw_event = nullptr;
     check(sd_event_new(&raw_event), "cannot create the event loop");
     caracara::dbus::EventPtr event(raw_event);
-    Monitor mon{client, raw_event};
+    Monitor mon{client, raw_event, all, {}};
 
     sigset_t mask;
     sigemptyset(&mask);
@@ -111,7 +153,12 @@ int run_monitor(Client& client) {
     check(sd_bus_add_filter(bus, &raw_slot, on_message, &mon), "cannot watch the connection");
     caracara::dbus::SlotPtr filter_slot(raw_slot);
 
-    print_line(summary_line(client.get_objects()));
+    const Objects objects = client.get_objects();
+    for (const auto& [path, ifaces] : objects)
+        for (const auto& [iface, props] : ifaces)
+            for (const auto& [name, value] : props)
+                mon.last[property_key(path, iface, name)] = render_property(name, value);
+    print_line(summary_line(objects));
 
     check(sd_bus_attach_event(bus, raw_event, SD_EVENT_PRIORITY_NORMAL), "cannot attach the bus");
     const int r = sd_event_loop(raw_event);
