@@ -68,6 +68,16 @@ int Process::wait_exit(int timeout_ms) {
     return -1;
 }
 
+int Process::terminate() {
+    if (pid_ <= 0)
+        return -1;
+    kill(pid_, SIGTERM);
+    int st = wait_exit(10000);
+    if (st < 0)
+        stop(SIGKILL);
+    return st;
+}
+
 void Process::stop(int sig) {
     if (pid_ <= 0)
         return;

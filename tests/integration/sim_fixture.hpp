@@ -21,6 +21,9 @@ public:
     // Starts argv[0] with the given arguments; stdout/stderr go to `log_path`.
     void start(const std::vector<std::string>& argv, const std::string& log_path);
     void stop(int sig = 15);    // signal, then wait
+    // SIGTERM and wait: the exit status (128 + signal if killed by one), -1 if not running.
+    // A sanitizer report in the child shows up here as a non-zero status.
+    int terminate();
     int wait_exit(int timeout_ms); // exit status, or -1 if still running
     bool running();
     pid_t pid() const { return pid_; }

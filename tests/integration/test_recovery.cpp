@@ -104,6 +104,9 @@ TEST_CASE("a slave holding SDA for k = 1..9 pulses: cleared with exactly k pulse
         CHECK(d.vehicle_string("State") == "ready");
         CHECK(d.vehicle_string("State", "/org/caracara/Vehicle1/bus", "org.caracara.Vehicle1.Bus") == "ok");
     }
+    // Clean exits: a sanitizer report or a crash would show here.
+    CHECK(d.daemon.terminate() == 0);
+    CHECK(f.sim.terminate() == 0);
 }
 
 TEST_CASE("SCL held low cannot be clocked free: the vehicle ends killed by the bus, reported") {
@@ -125,6 +128,9 @@ TEST_CASE("SCL held low cannot be clocked free: the vehicle ends killed by the b
     REQUIRE(d.wait_for([&] { return d.bus_u64("Recoveries") == 1; }, 15000));
     CHECK(f.thruster_byte(0, "OrderedSpeed") == 0x80);
     CHECK(d.vehicle_string("State") == "killed"); // a recovery never clears a kill
+    // Clean exits: a sanitizer report or a crash would show here.
+    CHECK(d.daemon.terminate() == 0);
+    CHECK(f.sim.terminate() == 0);
 }
 
 TEST_CASE("a kill that arrives during recovery reaches every thruster first once the bus is back") {
@@ -155,6 +161,9 @@ TEST_CASE("a kill that arrives during recovery reaches every thruster first once
         CHECK(f.thruster_byte(t, "OrderedSpeed") == 0x80);
     }
     CHECK(d.set_thrust(v) == "org.caracara.Vehicle1.Error.Killed");
+    // Clean exits: a sanitizer report or a crash would show here.
+    CHECK(d.daemon.terminate() == 0);
+    CHECK(f.sim.terminate() == 0);
 }
 
 TEST_CASE("the kill switch kills at its edge, not at the next tick, and blocks arming while set") {
@@ -192,6 +201,9 @@ TEST_CASE("the kill switch kills at its edge, not at the next tick, and blocks a
     REQUIRE(d.wait_for([&] { return d.vehicle_string("State") == "ready"; }, 5000));
     REQUIRE(d.set_thrust(v) == "");
     REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    // Clean exits: a sanitizer report or a crash would show here.
+    CHECK(d.daemon.terminate() == 0);
+    CHECK(f.sim.terminate() == 0);
 }
 
 TEST_CASE("a kill switch already set at start: the daemon comes up killed") {
@@ -201,6 +213,9 @@ TEST_CASE("a kill switch already set at start: the daemon comes up killed") {
     CHECK(d.vehicle_string("State") == "killed");
     CHECK(d.vehicle_string("KillSource") == "switch");
     CHECK(f.root_bool("KillOutput"));
+    // Clean exits: a sanitizer report or a crash would show here.
+    CHECK(d.daemon.terminate() == 0);
+    CHECK(f.sim.terminate() == 0);
 }
 
 TEST_CASE("a confirmed power-off asserts the power-off line after zeroing the thrusters") {
@@ -213,4 +228,7 @@ TEST_CASE("a confirmed power-off asserts the power-off line after zeroing the th
     CHECK(f.root_bool("PowerOffOutput"));
     CHECK(all_at(f, std::vector<int32_t>(8, 0)));
     CHECK(d.vehicle_string("State") == "powered-off");
+    // Clean exits: a sanitizer report or a crash would show here.
+    CHECK(d.daemon.terminate() == 0);
+    CHECK(f.sim.terminate() == 0);
 }
