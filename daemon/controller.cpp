@@ -5,6 +5,7 @@
 #include "packet.hpp"
 
 #include <cmath>
+#include <systemd/sd-daemon.h>
 #include <ctime>
 
 namespace caracara {
@@ -501,6 +502,12 @@ void Controller::handle(const SafetyAction& a) {
 }
 
 void Controller::notify(uint32_t changes) {
+    if (changes & (kChangeState | kChangeBus)) {
+        // What `systemctl status caracarad` shows on its Status: line.
+        std::string ks(kill_source_name());
+        sd_notifyf(0, "STATUS=%s%s%s; I2C bus %s; %zu thrusters", std::string(state_name()).c_str(),
+                   ks.empty() ? "" : " by ", ks.c_str(), bus_tm_.state.c_str(), thrusters_.size());
+    }
     if (changes && observer_)
         observer_->vehicle_changed(changes);
 }
