@@ -2,6 +2,7 @@
 #include "config.hpp"
 #include "controller.hpp"
 #include "hardware.hpp"
+#include "emergency_stop.hpp"
 #include "errors.hpp"
 #include "log.hpp"
 #include "sdbus.hpp"
@@ -137,6 +138,20 @@ int main(int argc, char** argv) {
         return 1;
     }
 
+    // If the daemon itself crashes, zero the thrusters from the signal handler instead of
+    // leaving them at speed until systemd has restarted us.
+    EmergencyStop estop;
+    {
+        Hardware panic_hw;
+        std::string perr;
+        if (!make_hardware(hardware, panic_hw, perr))
+            log_warning("emergency stop not armed: %s", perr.c_str());
+        else if (std::string e = estop.arm(std::move(panic_hw.io), cr.config->i2c.device, cr.config->thrusters); !e.empty())
+            log_warning("emergency stop not armed: %s", e.c_str());
+        else
+            EmergencyStop::install_fatal_handlers(&estop);
+    }
+
     dbus::BusPtr bus;
     if (int r = dbus::open_bus(bus_choice, "caracarad", bus); r < 0) {
         log_error("cannot connect to %s: %s", bus_choice.describe().c_str(), errno_name(-r).c_str());
@@ -173,6 +188,7 @@ int main(int argc, char** argv) {
     int r = sd_event_loop(event.get());
     controller.set_observer(nullptr);
     controller.shutdown();
+    EmergencyStop::install_fatal_handlers(nullptr);
     sd_notify(0, "STOPPING=1\nSTATUS=Thrusters zeroed; stopped");
     if (r < 0) {
         log_error("event loop failed: %s", errno_name(-r).c_str());

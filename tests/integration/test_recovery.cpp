@@ -4,6 +4,7 @@
 #include "sim_fixture.hpp"
 
 #include <catch2/catch.hpp>
+#include <csignal>
 #include <ctime>
 
 using namespace caracara::test;
@@ -231,4 +232,20 @@ TEST_CASE("a confirmed power-off asserts the power-off line after zeroing the th
     // Clean exits: a sanitizer report or a crash would show here.
     CHECK(d.daemon.terminate() == 0);
     CHECK(f.sim.terminate() == 0);
+}
+
+TEST_CASE("a crashing daemon zeroes the thrusters from its fatal-signal handler") {
+    for (int sig : {SIGSEGV, SIGABRT}) {
+        INFO("signal " << sig);
+        SimFixture f;
+        DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"));
+        const std::vector<int32_t> v = {2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000};
+        REQUIRE(d.set_thrust(v) == "");
+        REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+        kill(d.daemon.pid(), sig);
+        const int status = d.daemon.wait_exit(10000);
+        CHECK(status > 128); // died of a signal (ASan may turn SIGSEGV into an abort)
+        CHECK(all_at(f, std::vector<int32_t>(8, 0)));
+        CHECK(f.sim.terminate() == 0);
+    }
 }
