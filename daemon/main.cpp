@@ -13,6 +13,7 @@
 #include <cstring>
 #include <string>
 #include <systemd/sd-daemon.h>
+#include <sysexits.h>
 #include <unistd.h>
 
 using namespace caracara;
@@ -101,7 +102,9 @@ int main(int argc, char** argv) {
         for (const auto& e : cr.errors)
             log_error("  %s", e.c_str());
         sd_notifyf(0, "STATUS=Invalid configuration: %s", cr.errors.empty() ? "?" : cr.errors.front().c_str());
-        return 1;
+        // EX_CONFIG: caracarad.service has RestartPreventExitStatus=78, so systemd does not
+        // restart a daemon that cannot start until someone fixes the file.
+        return EX_CONFIG;
     }
     if (check_only) {
         std::printf("configuration OK\n");

@@ -12,6 +12,9 @@ namespace {
 
 constexpr const char* kRoot = "/org/caracara/Simulator1";
 constexpr const char* kErrInvalid = "org.caracara.Simulator1.Error.InvalidArgument";
+// Who may call what is the bus policy's job (systemd/org.caracara.Simulator1.conf): without
+// this flag sd-bus itself refuses every caller that is neither root nor the service's user.
+constexpr uint64_t kMethod = SD_BUS_VTABLE_UNPRIVILEGED;
 
 ThrusterModel& thruster(void* userdata) { return *static_cast<ThrusterModel*>(userdata); }
 Inspector& insp(void* userdata) { return *static_cast<Inspector*>(userdata); }
@@ -226,10 +229,10 @@ const sd_bus_vtable kRootVtable[] = {
     SD_BUS_PROPERTY("ThrusterCount", "u", get_thruster_count, 0, SD_BUS_VTABLE_PROPERTY_CONST),
     SD_BUS_PROPERTY("BadRequests", "t", get_bad_requests, 0, 0),
     SD_BUS_PROPERTY("Clients", "u", get_clients, 0, 0),
-    SD_BUS_METHOD_WITH_ARGS("GetWireLog", SD_BUS_ARGS("t", since), SD_BUS_RESULT("t", next, "a(tttsqbayays)", entries), m_wire_log, 0),
-    SD_BUS_METHOD("ClearWireLog", "", "", m_clear_log, 0),
-    SD_BUS_METHOD_WITH_ARGS("SetRealisticTiming", SD_BUS_ARGS("b", enabled), SD_BUS_NO_RESULT, m_set_realistic, 0),
-    SD_BUS_METHOD_WITH_ARGS("SetClock", SD_BUS_ARGS("u", hz), SD_BUS_NO_RESULT, m_set_clock, 0),
+    SD_BUS_METHOD_WITH_ARGS("GetWireLog", SD_BUS_ARGS("t", since), SD_BUS_RESULT("t", next, "a(tttsqbayays)", entries), m_wire_log, kMethod),
+    SD_BUS_METHOD("ClearWireLog", "", "", m_clear_log, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("SetRealisticTiming", SD_BUS_ARGS("b", enabled), SD_BUS_NO_RESULT, m_set_realistic, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("SetClock", SD_BUS_ARGS("u", hz), SD_BUS_NO_RESULT, m_set_clock, kMethod),
     SD_BUS_PROPERTY("KillSwitch", "b", get_kill_switch, 0, 0),
     SD_BUS_PROPERTY("KillOutput", "b", get_kill_output, 0, 0),
     SD_BUS_PROPERTY("PowerOffOutput", "b", get_power_off_output, 0, 0),
@@ -245,10 +248,10 @@ const sd_bus_vtable kRootVtable[] = {
     SD_BUS_PROPERTY("SclPulses", "t", get_scl_pulses, 0, 0),
     SD_BUS_PROPERTY("Stops", "t", get_stops, 0, 0),
     SD_BUS_PROPERTY("MinSclPeriodNs", "t", get_min_scl_period, 0, 0),
-    SD_BUS_METHOD_WITH_ARGS("SetKillSwitch", SD_BUS_ARGS("b", engaged), SD_BUS_NO_RESULT, m_set_kill_switch, 0),
-    SD_BUS_METHOD_WITH_ARGS("HangBus", SD_BUS_ARGS("u", pulses), SD_BUS_NO_RESULT, m_hang_bus, 0),
-    SD_BUS_METHOD("HoldScl", "", "", m_hold_scl, 0),
-    SD_BUS_METHOD("ReleaseBus", "", "", m_release_bus, 0),
+    SD_BUS_METHOD_WITH_ARGS("SetKillSwitch", SD_BUS_ARGS("b", engaged), SD_BUS_NO_RESULT, m_set_kill_switch, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("HangBus", SD_BUS_ARGS("u", pulses), SD_BUS_NO_RESULT, m_hang_bus, kMethod),
+    SD_BUS_METHOD("HoldScl", "", "", m_hold_scl, kMethod),
+    SD_BUS_METHOD("ReleaseBus", "", "", m_release_bus, kMethod),
     SD_BUS_VTABLE_END,
 };
 
@@ -271,10 +274,10 @@ const sd_bus_vtable kThrusterVtable[] = {
     SD_BUS_PROPERTY("OrdersRejected", "t", t_rejected, 0, 0),
     SD_BUS_PROPERTY("ZeroOrders", "t", t_zero_orders, 0, 0),
     SD_BUS_PROPERTY("StatusReads", "t", t_reads, 0, 0),
-    SD_BUS_METHOD_WITH_ARGS("SetFault", SD_BUS_ARGS("s", fault, "b", on), SD_BUS_NO_RESULT, m_set_fault, 0),
-    SD_BUS_METHOD_WITH_ARGS("SetNack", SD_BUS_ARGS("b", on), SD_BUS_NO_RESULT, m_set_nack, 0),
-    SD_BUS_METHOD_WITH_ARGS("CorruptReplies", SD_BUS_ARGS("u", count, "s", how), SD_BUS_NO_RESULT, m_corrupt, 0),
-    SD_BUS_METHOD("PowerCycle", "", "", m_power_cycle, 0),
+    SD_BUS_METHOD_WITH_ARGS("SetFault", SD_BUS_ARGS("s", fault, "b", on), SD_BUS_NO_RESULT, m_set_fault, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("SetNack", SD_BUS_ARGS("b", on), SD_BUS_NO_RESULT, m_set_nack, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("CorruptReplies", SD_BUS_ARGS("u", count, "s", how), SD_BUS_NO_RESULT, m_corrupt, kMethod),
+    SD_BUS_METHOD("PowerCycle", "", "", m_power_cycle, kMethod),
     SD_BUS_VTABLE_END,
 };
 
@@ -425,12 +428,12 @@ const sd_bus_vtable kTeensyVtable[] = {
     SD_BUS_PROPERTY("SpiLastTransfers", "u", te_spi_last_transfers, 0, 0),
     SD_BUS_PROPERTY("SpiLastSpeedHz", "u", te_spi_last_speed, 0, 0),
     SD_BUS_PROPERTY("SpiLastDelayUsecs", "q", te_spi_last_delay, 0, 0),
-    SD_BUS_METHOD_WITH_ARGS("InjectFault", SD_BUS_ARGS("s", fault, "u", frames), SD_BUS_NO_RESULT, m_te_inject, 0),
-    SD_BUS_METHOD_WITH_ARGS("SetRandomBusy", SD_BUS_ARGS("d", probability, "t", seed), SD_BUS_NO_RESULT, m_te_random_busy, 0),
-    SD_BUS_METHOD("ClearFaults", "", "", m_te_clear, 0),
-    SD_BUS_METHOD_WITH_ARGS("SetDistance", SD_BUS_ARGS("y", sensor, "q", millimeters), SD_BUS_NO_RESULT, m_te_set_distance, 0),
-    SD_BUS_METHOD_WITH_ARGS("CommandCount", SD_BUS_ARGS("y", command), SD_BUS_RESULT("t", received, "t", executed), m_te_commands, 0),
-    SD_BUS_METHOD_WITH_ARGS("GetFrameLog", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(tttysayay)", frames), m_te_frame_log, 0),
+    SD_BUS_METHOD_WITH_ARGS("InjectFault", SD_BUS_ARGS("s", fault, "u", frames), SD_BUS_NO_RESULT, m_te_inject, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("SetRandomBusy", SD_BUS_ARGS("d", probability, "t", seed), SD_BUS_NO_RESULT, m_te_random_busy, kMethod),
+    SD_BUS_METHOD("ClearFaults", "", "", m_te_clear, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("SetDistance", SD_BUS_ARGS("y", sensor, "q", millimeters), SD_BUS_NO_RESULT, m_te_set_distance, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("CommandCount", SD_BUS_ARGS("y", command), SD_BUS_RESULT("t", received, "t", executed), m_te_commands, kMethod),
+    SD_BUS_METHOD_WITH_ARGS("GetFrameLog", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(tttysayay)", frames), m_te_frame_log, kMethod),
     SD_BUS_VTABLE_END,
 };
 

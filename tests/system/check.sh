@@ -1,0 +1,328 @@
+#!/bin/bash
+# The system test's checks, run inside the booted container by caracara-systest.service
+# (tests/system/run.sh installs both). Every check prints one PASS or FAIL line, to the log
+# and to /systest-out/results.txt; /systest-out/done marks the end. Each wait is bounded.
+set -u
+out=/systest-out
+exec >>"$out/check.log" 2>&1
+
+V=org.caracara.Vehicle1
+VP=/org/caracara/Vehicle1
+VT=org.caracara.Vehicle1.Teensy
+S=org.caracara.Simulator1
+SP=/org/caracara/Simulator1
+ST=org.caracara.Simulator1.Thruster
+STE=org.caracara.Simulator1.Teensy
+CONF=/etc/caracara/caracarad.toml
+
+pass() { echo "PASS: $*" | tee -a "$out/results.txt"; }
+fail() { echo "FAIL: $*" | tee -a "$out/results.txt"; }
+info() { echo "INFO: $*"; }
+# check NAME COMMAND...: PASS if the command succeeds.
+check() {
+  local name=$1
+  shift
+  if "$@"; then pass "$name"; else fail "$name"; fi
+}
+now_ms() { echo $(($(date +%s%N) / 1000000)); }
+# wait_until SECONDS COMMAND...: true as soon as the command succeeds, false after SECONDS.
+wait_until() {
+  local end=$(($(now_ms) + $1 * 1000))
+  shift
+  until "$@"; do
+    [ "$(now_ms)" -lt "$end" ] || return 1
+    sleep 0.1
+  done
+}
+# prop BUS-NAME PATH INTERFACE PROPERTY: the value without its signature and quotes.
+prop() { busctl get-property "$@" 2>/dev/null | sed -E 's/^[^ ]+ //; s/^"(.*)"$/\1/'; }
+unit() { systemctl show -p "$2" --value "$1"; }
+state() { prop $V $VP $V State; }
+speed() { prop $S "$SP/thruster/$1" $ST OrderedSpeed; }
+speeds() { local n s=; for n in 0 1 2 3 4 5 6 7; do s+="$(speed $n) "; done; echo "${s% }"; }
+# The SPEED byte of a stopped thruster is 0x80 (or 0x7F).
+all_zero() {
+  local n v
+  for n in 0 1 2 3 4 5 6 7; do
+    v=$(speed $n)
+    [ "$v" = 128 ] || [ "$v" = 127 ] || return 1
+  done
+}
+speed_is() { [ "$(speed "$1")" = "$2" ]; }
+state_is() { [ "$(state)" = "$1" ]; }
+active() { [ "$(systemctl is-active "$1")" = active ]; }
+# as USER COMMAND...
+as() { local u=$1; shift; runuser -u "$u" -- "$@"; }
+# denied USER ARGS...: `busctl call ARGS` as USER is refused by the bus policy.
+denied() {
+  local u=$1 err
+  shift
+  if err=$(as "$u" busctl --system call "$@" 2>&1); then
+    info "not refused: busctl call $*: $err"
+    return 1
+  fi
+  if echo "$err" | grep -qiE 'access denied|AccessDenied|rejected send message'; then
+    return 0
+  fi
+  info "refused, but not by the policy: busctl call $*: $err"
+  return 1
+}
+# allowed USER ARGS...: `busctl call ARGS` as USER succeeds.
+allowed() {
+  local u=$1 err
+  shift
+  err=$(as "$u" busctl --system call "$@" 2>&1) && return 0
+  info "busctl call $* as $u: $err"
+  return 1
+}
+ctl_pid=
+stop_ctl() {
+  if [ -n "$ctl_pid" ]; then
+    kill -KILL "$ctl_pid" 2>/dev/null
+    wait "$ctl_pid" 2>/dev/null
+    ctl_pid=
+  fi
+}
+# hold V0: caracaractl keeps thruster 0 at V0 (stream refreshed) in the background.
+hold() {
+  caracaractl thrust "$1" 0 0 0 0 0 0 0 --for 60 >>"$out/caracaractl.log" 2>&1 &
+  ctl_pid=$!
+}
+# journal_grep CURSOR PRIORITY PATTERN: caracarad logged PATTERN at exactly PRIORITY (0..7)
+# after CURSOR. The priority is journald's reading of the <N> prefix on the daemon's stderr.
+# (No journalctl match with --after-cursor: it skips the first matching entry when the
+# cursor's own entry does not match.)
+journal_grep() {
+  journalctl --after-cursor="$1" -o export --no-pager 2>/dev/null | awk -v prio="$2" -v pat="$3" '
+    BEGIN { RS = ""; FS = "\n"; found = 0 }
+    {
+      unit = 0; p = -1; msg = ""
+      for (i = 1; i <= NF; i++) {
+        if ($i == "_SYSTEMD_UNIT=caracarad.service") unit = 1
+        else if ($i ~ /^PRIORITY=/) p = substr($i, 10)
+        else if ($i ~ /^MESSAGE=/) msg = substr($i, 9)
+      }
+      if (unit && p == prio && index(msg, pat)) found = 1
+    }
+    END { exit !found }'
+}
+# The cursor of the newest journal entry.
+cursor() { journalctl -n 1 -q -o cat --show-cursor --no-pager 2>/dev/null | sed -n 's/^-- cursor: //p'; }
+
+echo "== caracarad system test, $(date -u +%FT%TZ), systemd $(systemctl --version | sed -n '1s/^systemd \([0-9]*\).*/\1/p')"
+
+# --- 1. the installation, finished as docs/install.md says ----------------------------------
+systemd-sysusers
+check "systemd-sysusers creates the caracara user and group" \
+  bash -c 'getent passwd caracara >/dev/null && getent group caracara >/dev/null'
+systemctl daemon-reload
+check "dbus reloads its configuration with the caracara policies" systemctl reload dbus
+for f in /usr/lib/systemd/system/caracarad.service /usr/lib/systemd/system/caracara-sim.service \
+         /usr/share/dbus-1/system.d/org.caracara.Vehicle1.conf /usr/share/dbus-1/system.d/org.caracara.Simulator1.conf \
+         /usr/lib/sysusers.d/caracara.conf /usr/lib/udev/rules.d/60-caracara.rules \
+         /usr/lib/modules-load.d/caracara.conf /usr/share/caracara/caracarad-sim.conf "$CONF" \
+         /usr/sbin/caracarad /usr/bin/caracara-sim /usr/bin/caracaractl; do
+  [ -e "$f" ] || { fail "cmake --install: $f is missing"; missing=1; }
+done
+[ -n "${missing:-}" ] || pass "cmake --install put the binaries, units, policies, rules and $CONF in place"
+verify=$(systemd-analyze verify caracarad.service caracara-sim.service 2>&1)
+echo "$verify" | sed 's/^/  verify: /'
+check "systemd-analyze verify: no complaint about the units" bash -c '! grep -qi caracara <<<"$1"' _ "$verify"
+
+# Sim mode: the drop-in shipped for running without hardware.
+mkdir -p /etc/systemd/system/caracarad.service.d
+cp /usr/share/caracara/caracarad-sim.conf /etc/systemd/system/caracarad.service.d/sim.conf
+systemctl daemon-reload
+
+# --- 2. systemctl start ----------------------------------------------------------------------
+t=$(now_ms)
+c0=$(cursor)
+if timeout 60 systemctl start caracarad; then
+  pass "systemctl start caracarad (Type=notify: returns at READY=1) in $(($(now_ms) - t)) ms"
+else
+  fail "systemctl start caracarad"
+  systemctl status --no-pager caracara-sim caracarad
+fi
+# READY=1 came after the zeroing and the name: both must hold the moment start returns.
+check "at READY=1 org.caracara.Vehicle1 is owned" busctl status $V >/dev/null
+zero_orders_ok() {
+  local n z
+  for n in 0 1 2 3 4 5 6 7; do
+    z=$(prop $S "$SP/thruster/$n" $ST ZeroOrders)
+    [ "${z:-0}" -ge 1 ] || { info "thruster $n: ZeroOrders=$z"; return 1; }
+  done
+  all_zero
+}
+check "at READY=1 every simulated thruster has received a zero order" zero_orders_ok
+check "caracara-sim.service is active (pulled in by the sim-mode drop-in)" active caracara-sim
+check "caracarad.service is active" active caracarad
+status=$(systemctl status --no-pager caracarad 2>&1)
+echo "$status" | sed 's/^/  | /'
+check "systemctl status: active (running)" grep -q 'Active: active (running)' <<<"$status"
+check "systemctl status: a Status: line" grep -q '^ *Status: "' <<<"$status"
+wait_until 10 state_is ready
+st=$(state)
+stext=$(unit caracarad StatusText)
+info "State=$st StatusText=$stext"
+check "the status line names the vehicle state ($st)" grep -qi -- "$st" <<<"$stext"
+
+pid=$(unit caracarad MainPID)
+check "the daemon runs as user caracara" [ "$(stat -c %U /proc/"$pid")" = caracara ]
+check "the daemon has no capabilities (CapEff 0)" grep -q '^CapEff:[[:space:]]*0000000000000000$' /proc/"$pid"/status
+check "the daemon runs with NoNewPrivs and a seccomp filter" \
+  bash -c 'grep -q "^NoNewPrivs:[[:space:]]*1$" "$1" && grep -q "^Seccomp:[[:space:]]*2$" "$1"' _ /proc/"$pid"/status
+owner_uid=$(busctl status $V 2>/dev/null | sed -n 's/^UID=//p')
+check "the bus name is owned by the caracara user (uid $owner_uid)" [ "$owner_uid" = "$(id -u caracara)" ]
+check "the journal has the daemon's notice at priority notice" \
+  wait_until 5 journal_grep "$c0" 5 "serving $V"
+
+# --- 3. introspection on the system bus ----------------------------------------------------------
+check "busctl introspect (root) shows SetThrust" \
+  bash -c 'busctl introspect --xml-interface "$1" "$2" | grep -q "<method name=\"SetThrust\">"' _ $V $VP
+tree=$(busctl tree --list $V 2>&1)
+check "busctl tree shows thruster/0..7, teensy and bus" \
+  bash -c 'for p in thruster/0 thruster/7 teensy bus; do grep -qx "$1/$p" <<<"$2" || exit 1; done' _ $VP "$tree"
+
+# --- 4. a SetThrust from root reaches the simulated thrusters -------------------------------------
+mt=$(prop $V $VP/thruster/0 org.caracara.Vehicle1.Thruster Address)
+variant=$(prop $V $VP/thruster/0 org.caracara.Vehicle1.Thruster Variant)
+steps=$(((1000 * 102 * 2 + 8850) / (2 * 8850)))   # round(1000 * 102 / 8850)
+spd=$((0x80 + steps))
+csum=$(((mt + spd + 100) & 0xFF))
+info "thruster 0: MT=$mt ($variant); motor value 1000 -> SPEED $spd, order [$spd 100 $csum] at 7-bit address $((mt >> 1))"
+busctl call $S $SP $S ClearWireLog
+if busctl call $V $VP $V SetThrust ai 8 1000 0 0 0 0 0 0 0; then
+  pass "root: busctl call SetThrust 1000 0 0 0 0 0 0 0 accepted"
+else
+  fail "root: busctl call SetThrust"
+fi
+wire=$(busctl call $S $SP $S GetWireLog t 0 2>&1)
+# Entries print as: index time transaction "bus" addr read [n data...] [n miso...] "result"
+check "the simulated I2C wire carried the order [$spd 100 $csum] to thruster 0" \
+  grep -qE "\"[^\"]*\" $((mt >> 1)) false 3 $spd 100 $csum " <<<"$wire"
+check "busctl left the bus: the daemon brought the thrusters back to zero" wait_until 3 all_zero
+hold 1000
+check "root: caracaractl thrust holds thruster 0 at SPEED $spd in the simulator" wait_until 5 speed_is 0 $spd
+info "simulated SPEED bytes: $(speeds)"
+
+# --- 5. kill -9: systemd restarts the daemon, which zeroes the thrusters before it is ready ------
+pid=$(unit caracarad MainPID)
+nr=$(unit caracarad NRestarts)
+z0=$(prop $S "$SP/thruster/0" $ST ZeroOrders)
+t=$(now_ms)
+kill -KILL "$pid"
+stop_ctl   # the commanding client dies too, without a word: only the restart can zero
+restarted() { local p; p=$(unit caracarad MainPID); [ "$p" != 0 ] && [ "$p" != "$pid" ] && active caracarad; }
+if wait_until 15 restarted; then
+  pass "kill -9: systemd restarted caracarad in $(($(now_ms) - t)) ms (pid $pid -> $(unit caracarad MainPID))"
+else
+  fail "kill -9: caracarad was not restarted (state $(systemctl is-active caracarad))"
+fi
+speeds_now=$(speeds)
+check "the restarted daemon is ready with every thruster at zero ($speeds_now)" all_zero
+check "the zero came from the new daemon (thruster 0 got new zero orders)" \
+  [ "$(prop $S "$SP/thruster/0" $ST ZeroOrders)" -gt "${z0:-0}" ]
+check "NRestarts counts the restart" [ "$(unit caracarad NRestarts)" -gt "$nr" ]
+wait_until 10 state_is ready
+
+# --- 6. an unprivileged user reads, and is refused every command by the policy ---------------------
+useradd --no-create-home --shell /usr/sbin/nologin tester
+useradd --no-create-home --shell /usr/sbin/nologin --groups caracara pilot
+check "tester: reads State" bash -c '[ -n "$(runuser -u tester -- busctl get-property "$@")" ]' _ $V $VP $V State
+check "tester: GetManagedObjects" allowed tester $V $VP org.freedesktop.DBus.ObjectManager GetManagedObjects
+check "tester: introspects" bash -c 'runuser -u tester -- busctl introspect "$1" "$2" >/dev/null' _ $V $VP
+check "tester: caracaractl status exits 0" as tester caracaractl status
+check "tester: reads the simulator's wire log" allowed tester $S $SP $S GetWireLog t 0
+for call in "SetThrust ai 8 1000 0 0 0 0 0 0 0" "SetMotion dddddd 0.1 0 0 0 0 0" \
+            "ApplyPacket ai 13 0 0 0 0 0 0 0 0 0 0 0 0 0" "Kill" "ClearKill" "PowerOff s power-off" \
+            "SetLeds yyy 1 2 3"; do
+  # shellcheck disable=SC2086
+  check "tester: $V.${call%% *} refused by the policy" denied tester $V $VP $V $call
+done
+for call in "SetSpeed ii 10 10" "Turn d 0.1" "TurnTo d 0.1" "Stop y 10" "SetServo yy 0 90" "GetDistance y 0"; do
+  # shellcheck disable=SC2086
+  check "tester: $VT.${call%% *} refused by the policy" denied tester $V $VP/teensy $VT $call
+done
+check "tester: Simulator1.SetKillSwitch refused by the policy" denied tester $S $SP $S SetKillSwitch b true
+ctl_rc=0
+as tester caracaractl kill >/dev/null 2>&1 || ctl_rc=$?
+check "tester: caracaractl kill exits 4 (permission denied)" [ "$ctl_rc" = 4 ]
+check "after all that the vehicle is still ready (not killed, not powered off)" state_is ready
+
+# --- 7. a member of the caracara group commands ---------------------------------------------------
+check "pilot (group caracara): SetLeds 10 20 30 accepted" allowed pilot $V $VP $V SetLeds yyy 10 20 30
+leds_are() { [ "$(prop $S $SP/teensy $STE Leds)" = "10 20 30" ]; }
+check "the simulated Teensy shows the LEDs 10 20 30" wait_until 3 leds_are
+check "pilot: GetDistance 0 answered" allowed pilot $V $VP/teensy $VT GetDistance y 0
+check "pilot: SetThrust accepted" allowed pilot $V $VP $V SetThrust ai 8 500 0 0 0 0 0 0 0
+check "pilot: Simulator1.ClearWireLog accepted (the simulator's policy)" allowed pilot $S $SP $S ClearWireLog
+
+# --- 8. the watchdog is fed ---------------------------------------------------------------------------
+check "WatchdogSec=5s is in force" [ "$(unit caracarad WatchdogUSec)" = 5s ]
+w1=$(unit caracarad WatchdogTimestampMonotonic)
+fed() { [ "$(unit caracarad WatchdogTimestampMonotonic)" != "$w1" ]; }
+check "the daemon feeds the watchdog (WATCHDOG=1 seen within 4 s)" wait_until 4 fed
+
+# --- 9. the status follows the state: Kill as root, then ClearKill ------------------------------------
+c1=$(cursor)
+check "root: Kill" busctl call $V $VP $V Kill
+stext=$(unit caracarad StatusText)
+info "after Kill: State=$(state) StatusText=$stext"
+status_says_killed() { unit caracarad StatusText | grep -qi killed; }
+check "the status line says killed" wait_until 2 status_says_killed
+check "root: ClearKill" busctl call $V $VP $V ClearKill
+check "ready again after the arming delay" wait_until 10 state_is ready
+
+# --- 10. systemctl stop leaves the thrusters at zero ----------------------------------------------------
+hold 1000
+check "before stop: thruster 0 held at SPEED $spd" wait_until 5 speed_is 0 $spd
+t=$(now_ms)
+systemctl stop caracarad
+info "systemctl stop took $(($(now_ms) - t)) ms"
+speeds_now=$(speeds)
+check "systemctl stop: every thruster at zero when stop returns ($speeds_now)" all_zero
+stop_ctl
+check "systemctl stop: a clean exit (inactive, status 0)" \
+  bash -c '[ "$(systemctl is-active caracarad)" = inactive ] && [ "$(systemctl show -p ExecMainStatus --value caracarad)" = 0 ]'
+check "the journal says why, at priority notice: zeroing on SIGTERM" journal_grep "$c1" 5 "thrusters to zero"
+
+# --- 11. a configuration error fails the start, with the reason in the journal -------------------------
+cp "$CONF" /root/caracarad.toml.good
+sed -i 's/^loop_rate_hz = .*/loop_rate_hz = 5000/' "$CONF"
+grep -q '^loop_rate_hz = 5000$' "$CONF" || info "could not break $CONF"
+systemctl reset-failed caracarad 2>/dev/null
+nr=$(unit caracarad NRestarts)
+c2=$(cursor)
+if timeout 60 systemctl start caracarad 2>/dev/null; then
+  fail "a bad loop_rate_hz: systemctl start fails"
+else
+  pass "a bad loop_rate_hz: systemctl start fails"
+fi
+failed() { [ "$(unit caracarad ActiveState)" = failed ]; }
+check "the unit ends failed" wait_until 20 failed
+check "the journal names the key at priority err" wait_until 5 journal_grep "$c2" 3 "control.loop_rate_hz"
+journalctl -u caracarad --after-cursor="$c2" -p err -o short-monotonic --no-pager | head -n 4 | sed 's/^/  | /'
+info "ExecMainStatus=$(unit caracarad ExecMainStatus) NRestarts=$(unit caracarad NRestarts) Result=$(unit caracarad Result)"
+check "a configuration error is not retried (exit status 78, RestartPreventExitStatus)" \
+  bash -c '[ "$(systemctl show -p ExecMainStatus --value caracarad)" = 78 ] && [ "$(systemctl show -p NRestarts --value caracarad)" = "$1" ]' _ "$nr"
+cp /root/caracarad.toml.good "$CONF"
+systemctl reset-failed caracarad
+check "with the configuration fixed it starts again" timeout 60 systemctl start caracarad
+check "and is ready" wait_until 10 state_is ready
+
+# --- 12. exposure -----------------------------------------------------------------------------------------
+for u in caracarad caracara-sim; do
+  sec=$(systemd-analyze security --no-pager "$u.service" 2>&1)
+  echo "$sec" | grep -E '^✗' | sed "s/^/  $u: /"
+  overall=$(echo "$sec" | sed -n 's/.*Overall exposure level for .*: \([0-9.]*\) .*/\1/p')
+  echo "EXPOSURE: $u.service ${overall:-?} ($(echo "$sec" | tail -n 1 | sed 's/.*: [0-9.]* //'))"
+  check "systemd-analyze security $u.service: exposure ${overall:-?} <= 2.0" \
+    awk -v x="${overall:-99}" 'BEGIN { exit !(x <= 2.0) }'
+done
+
+# --- done -------------------------------------------------------------------------------------------------
+systemctl stop caracarad caracara-sim
+journalctl -b --no-pager -o short-monotonic -u caracarad -u caracara-sim -u dbus -u caracara-systest \
+  >"$out/journal.txt" 2>&1
+echo "== $(grep -c '^PASS' "$out/results.txt") passed, $(grep -c '^FAIL' "$out/results.txt") failed"
+touch "$out/done"

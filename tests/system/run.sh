@@ -1,0 +1,233 @@
+#!/usr/bin/env bash
+# The system test: caracarad under a real systemd, on a real system bus, with the installed
+# unit files, bus policy and configuration, in a Debian 12 container.
+#
+#   tests/system/run.sh BUILD_DIR
+#
+# 1. Builds a minimal Debian 12 root with debootstrap, once: the result is cached as a
+#    tarball under /var/cache/caracara-systest/ (CARACARA_SYSTEST_CACHE), keyed by the
+#    package list, so later runs unpack it in seconds.
+# 2. Unpacks it into a temporary directory under /var/tmp, installs the build into it with
+#    `cmake --install BUILD_DIR --prefix /usr` (DESTDIR), adds the checks (check.sh, run
+#    at boot by a test-only unit) and boots it with systemd-nspawn.
+# 3. check.sh does everything inside the container (systemctl, busctl, caracaractl as root,
+#    as a user in the caracara group and as an unprivileged user), writes PASS/FAIL lines
+#    to a bind-mounted directory, then powers the container off.
+# 4. The host prints the results and exits non-zero on any failure, a missing result or a
+#    timeout. The container, its processes and the temporary root are always removed.
+#
+# Needs root, debootstrap and systemd-container (installed with apt-get when missing). The
+# Debian mirror is the one this machine's apt uses (CARACARA_SYSTEST_MIRROR overrides it).
+# Exit status 77 (skipped) when not run as root.
+set -euo pipefail
+
+here=$(cd "$(dirname "$0")" && pwd)
+build=${1:?usage: run.sh BUILD_DIR}
+build=$(cd "$build" && pwd)
+suite=bookworm
+arch=$(dpkg --print-architecture)
+cache_dir=${CARACARA_SYSTEST_CACHE:-/var/cache/caracara-systest}
+timeout_s=${CARACARA_SYSTEST_TIMEOUT:-420}
+# What the container needs besides debootstrap's minbase: an init, the system bus, and the
+# shared libraries of caracarad, caracara-sim and caracaractl.
+packages=(systemd systemd-sysv dbus libsystemd0 libgpiod2 libtomlplusplus3)
+# Bump when the way the cached root is made changes.
+recipe=1
+
+say() { echo "system-test: $*"; }
+die() { echo "system-test: FAIL: $*" >&2; exit 1; }
+
+if [ "$(id -u)" -ne 0 ]; then
+  say "SKIP: needs root (debootstrap, systemd-nspawn)"
+  exit 77
+fi
+for bin in caracarad caracara-sim caracaractl; do
+  case $bin in caracarad) p=daemon/$bin ;; caracara-sim) p=sim/$bin ;; *) p=tools/$bin ;; esac
+  [ -x "$build/$p" ] || die "$build/$p is not built"
+done
+
+# --- host tools ----------------------------------------------------------------------------
+need=()
+command -v debootstrap >/dev/null || need+=(debootstrap)
+command -v systemd-nspawn >/dev/null || need+=(systemd-container)
+if ((${#need[@]})); then
+  say "installing ${need[*]}"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
+fi
+
+# --- the Debian mirror this machine's apt uses ------------------------------------------------
+# deb822 files first (Debian 12's default), then one-line sources. Only a "deb" source of the
+# suite itself counts (not -updates, -security, or another distribution).
+find_mirror() {
+  if [ -n "${CARACARA_SYSTEST_MIRROR:-}" ]; then
+    echo "$CARACARA_SYSTEST_MIRROR"
+    return
+  fi
+  local f uri
+  for f in /etc/apt/sources.list.d/*.sources; do
+    [ -f "$f" ] || continue
+    uri=$(awk -v suite="$suite" '
+      BEGIN { RS = ""; FS = "\n" }
+      {
+        types = ""; uris = ""; suites = ""; enabled = "yes"
+        for (i = 1; i <= NF; i++) {
+          line = $i
+          if (line ~ /^[ \t]*#/) continue
+          split(line, kv, ":")
+          key = tolower(kv[1]); val = substr(line, length(kv[1]) + 2)
+          gsub(/^[ \t]+|[ \t]+$/, "", val)
+          if (key == "types") types = val
+          else if (key == "uris") uris = val
+          else if (key == "suites") suites = val
+          else if (key == "enabled") enabled = tolower(val)
+        }
+        if (enabled == "no") next
+        if ((" " types " ") !~ / deb /) next
+        if ((" " suites " ") !~ (" " suite " ")) next
+        split(uris, u, /[ \t]+/)
+        print u[1]; exit
+      }' "$f")
+    if [[ $uri =~ ^(https?|file):// ]]; then echo "$uri"; return; fi
+  done
+  for f in /etc/apt/sources.list /etc/apt/sources.list.d/*.list; do
+    [ -f "$f" ] || continue
+    uri=$(awk -v suite="$suite" '
+      $1 == "deb" {
+        i = 2
+        if ($i ~ /^\[/) { while ($i !~ /\]$/ && i < NF) i++; i++ }
+        if ($(i + 1) == suite) { print $i; exit }
+      }' "$f")
+    if [[ $uri =~ ^(https?|file):// ]]; then echo "$uri"; return; fi
+  done
+  return 1
+}
+
+# --- the cached Debian 12 root ------------------------------------------------------------------
+key=$(printf '%s\n' "$suite" "$arch" minbase "$recipe" "${packages[@]}" | sha256sum | cut -c1-16)
+cache=$cache_dir/$suite-$arch-$key.tar
+t0=$(date +%s)
+if [ ! -f "$cache" ]; then
+  mirror=$(find_mirror) || die "no Debian $suite mirror in this machine's apt sources (set CARACARA_SYSTEST_MIRROR)"
+  say "building the $suite root with debootstrap from $mirror (cached in $cache)"
+  mkdir -p "$cache_dir"
+  boot=$(mktemp -d "$cache_dir/debootstrap.XXXXXX")
+  # Remove a half-made root on any exit from here on; the cache file appears only when complete.
+  trap 'rm -rf --one-file-system "$boot"' EXIT
+  if ! debootstrap --variant=minbase --components=main --include="$(IFS=,; echo "${packages[*]}")" \
+      "$suite" "$boot/root" "$mirror" >"$boot/debootstrap.log" 2>&1; then
+    tail -n 30 "$boot/debootstrap.log" >&2
+    die "debootstrap failed"
+  fi
+  chroot "$boot/root" apt-get clean
+  rm -rf "$boot/root/var/lib/apt/lists/"* "$boot/root/var/log/"*.log "$boot/root/var/cache/debconf/"*-old
+  tar -C "$boot/root" --numeric-owner -cpf "$boot/root.tar" .
+  mv "$boot/root.tar" "$cache"
+  rm -rf --one-file-system "$boot"
+  # Roots made for another package list are of no more use.
+  find "$cache_dir" -maxdepth 1 -name "$suite-$arch-*.tar" ! -path "$cache" -delete
+  trap - EXIT
+  say "root built in $(($(date +%s) - t0)) s"
+fi
+
+# --- this run's root --------------------------------------------------------------------------
+# A run killed before its cleanup (SIGKILL from a test timeout) leaves its root behind: remove
+# those whose run and container are both gone. Each root records their pids.
+for stale in /var/tmp/caracara-systest.*; do
+  [ -d "$stale" ] || continue
+  if [ ! -f "$stale/run.pid" ] && [ -z "$(find "$stale" -maxdepth 0 -mmin +10)" ]; then
+    continue  # just made by a run that has not written its pid yet
+  fi
+  live=0
+  for f in "$stale"/*.pid; do
+    [ -f "$f" ] && kill -0 "$(cat "$f")" 2>/dev/null && live=1
+  done
+  if [ "$live" -eq 0 ]; then
+    say "removing $stale, left by an earlier run"
+    rm -rf --one-file-system "$stale"
+  fi
+done
+work=$(mktemp -d /var/tmp/caracara-systest.XXXXXX)
+echo $$ >"$work/run.pid"
+machine=caracara-systest-$$
+nspawn_pid=
+cleanup() {
+  local rc=$?
+  if [ -n "$nspawn_pid" ] && kill -0 "$nspawn_pid" 2>/dev/null; then
+    say "stopping the container"
+    kill -TERM "$nspawn_pid" 2>/dev/null || true
+    for _ in $(seq 50); do kill -0 "$nspawn_pid" 2>/dev/null || break; sleep 0.2; done
+    kill -KILL "$nspawn_pid" 2>/dev/null || true
+    wait "$nspawn_pid" 2>/dev/null || true
+  fi
+  # systemd-nspawn mounts in its own namespace; unmount anything that leaked into ours anyway.
+  local m
+  for m in $(awk -v w="$work" 'index($2, w) == 1 { print $2 }' /proc/self/mounts | sort -r); do
+    umount -l "$m" 2>/dev/null || true
+  done
+  rm -rf --one-file-system "$work"
+  exit "$rc"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+root=$work/root
+out=$work/out
+mkdir -p "$root" "$out"
+chmod 0777 "$out"
+tar -C "$root" --numeric-owner -xpf "$cache"
+
+say "installing $build into the root (cmake --install --prefix /usr)"
+DESTDIR=$root cmake --install "$build" --prefix /usr >"$work/install.log" 2>&1 \
+  || { cat "$work/install.log" >&2; die "cmake --install failed"; }
+
+# The checks: a test-only unit that runs check.sh once the system is up, then powers off.
+install -D -m 0755 "$here/check.sh" "$root/usr/local/libexec/caracara-systest/check.sh"
+install -D -m 0644 "$here/caracara-systest.service" "$root/etc/systemd/system/caracara-systest.service"
+mkdir -p "$root/etc/systemd/system/multi-user.target.wants"
+ln -sf ../caracara-systest.service "$root/etc/systemd/system/multi-user.target.wants/caracara-systest.service"
+# Nothing reads the console: no getty on it.
+ln -sf /dev/null "$root/etc/systemd/system/console-getty.service"
+echo caracara-systest >"$root/etc/hostname"
+
+say "booting the container (systemd-nspawn --boot; at most ${timeout_s} s)"
+t1=$(date +%s)
+timeout --signal=TERM --kill-after=20 "$timeout_s" \
+  systemd-nspawn --quiet --boot --keep-unit --register=no --machine="$machine" \
+    --directory="$root" --private-network --link-journal=no --resolv-conf=off \
+    --console=read-only --bind="$out:/systest-out" \
+    >"$work/console.log" 2>&1 &
+nspawn_pid=$!
+echo "$nspawn_pid" >"$work/nspawn.pid"
+set +e
+wait "$nspawn_pid"
+nspawn_rc=$?
+set -e
+nspawn_pid=
+say "container ran $(($(date +%s) - t1)) s (systemd-nspawn exit status $nspawn_rc)"
+
+[ -f "$out/check.log" ] && cat "$out/check.log"
+failed=0
+if [ "$nspawn_rc" -eq 124 ] || [ "$nspawn_rc" -eq 137 ]; then
+  say "FAIL: the container did not finish within ${timeout_s} s"
+  failed=1
+fi
+if [ ! -f "$out/done" ]; then
+  say "FAIL: check.sh did not finish"
+  failed=1
+fi
+npass=$(grep -c '^PASS: ' "$out/results.txt" 2>/dev/null || true)
+nfail=$(grep -c '^FAIL: ' "$out/results.txt" 2>/dev/null || true)
+[ "${nfail:-0}" -eq 0 ] || failed=1
+[ "${npass:-0}" -gt 0 ] || failed=1
+if [ "$failed" -ne 0 ]; then
+  echo "---- container console (last 80 lines) ----"
+  tail -n 80 "$work/console.log" || true
+  if [ -f "$out/journal.txt" ]; then
+    echo "---- journal of caracarad, caracara-sim, dbus (last 150 lines) ----"
+    tail -n 150 "$out/journal.txt"
+  fi
+  grep '^FAIL: ' "$out/results.txt" 2>/dev/null || true
+fi
+say "${npass:-0} passed, ${nfail:-0} failed ($(($(date +%s) - t0)) s in all)"
+exit "$failed"
