@@ -11,8 +11,11 @@ echo "built in $build"
 dir=$(mktemp -d /tmp/caracara-demo.XXXXXX)
 pids=()
 cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
+  # The daemon first (it zeroes the thrusters on its way out), then the vehicle, then the bus.
+  for ((i = ${#pids[@]} - 1; i >= 0; i--)); do
+    kill "${pids[i]}" 2>/dev/null || true
+    wait "${pids[i]}" 2>/dev/null || true
+  done
   rm -rf "$dir"
 }
 trap cleanup EXIT
