@@ -130,7 +130,8 @@ std::string Controller::start() {
     if (config_.control.loop_rate_hz > 0) {
         uint64_t now_us = 0;
         sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
-        r = sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 0, on_tick, this);
+        // Accuracy 1 us: 0 would mean sd-event's default of 250 ms and a 4 Hz "50 Hz" loop.
+        r = sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 1, on_tick, this);
         if (r < 0)
             return "sd_event_add_time: " + errno_name(-r);
         tick_source_.reset(s);
@@ -314,7 +315,7 @@ void Controller::schedule_recovery(uint64_t delay_ns) {
     const uint64_t at_us = (now() + delay_ns) / 1000;
     if (!recovery_timer_) {
         sd_event_source* s = nullptr;
-        if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, at_us, 0, on_recovery_timer, this) < 0) {
+        if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, at_us, 1, on_recovery_timer, this) < 0) {
             log_error("cannot schedule the bus recovery");
             return;
         }
@@ -375,20 +376,31 @@ void Controller::recovery_wait_node() {
 }
 
 void Controller::recovery_finish() {
-    recovering_ = false;
     recovery_phase_ = RecoveryPhase::Idle;
+    // The current orders go out at once, a pending kill first: zeros while the vehicle may not
+    // drive. Still flagged as recovering, so these transfers decide the outcome below instead
+    // of starting a new recovery.
+    if (safety_.may_drive())
+        for (size_t i = 0; i < thrusters_.size(); ++i)
+            send_order(i);
+    else
+        zero_now();
+    bool answered = false;
+    for (const auto& t : thrusters_)
+        answered = answered || t->online();
+    if (!answered) {
+        // The lines were cleared and the node is back, but nothing gets through: not recovered.
+        i2c_.close();
+        recovery_failed("no thruster answers after the bus clear");
+        return;
+    }
+    recovering_ = false;
     consecutive_bus_errors_ = 0;
     consecutive_failures_ = 0;
     const bool was_lost = bus_tm_.state == "lost";
     bus_tm_.state = "ok";
     ++bus_tm_.recoveries;
     bus_tm_.last_pulses = last_pulses_;
-    // The current orders go out at once, a pending kill first: zeros while the vehicle may not drive.
-    if (safety_.may_drive())
-        for (size_t i = 0; i < thrusters_.size(); ++i)
-            send_order(i);
-    else
-        zero_now();
     bus_tm_.last_recovery_ms = static_cast<double>(now() - recovery_started_ns_) / 1e6;
     log_notice("I2C bus recovered after %u pulse(s), %.1f ms, attempt %u; orders re-sent", last_pulses_,
                bus_tm_.last_recovery_ms, attempt_);
@@ -471,6 +483,8 @@ void Controller::poll_kill_switch() {
         log_warning("KILLED by the kill switch");
     else if (!set)
         log_notice("kill switch released; ClearKill re-arms the vehicle");
+    if (set && !was_killed)
+        stop_teensy_motion();
     if (set && turn_done_)
         finish_turn({Status::Killed, "the kill switch was set during the turn"});
 }
@@ -619,9 +633,18 @@ Result Controller::kill(KillSource source, std::string_view reason) {
     if (!was_killed && safety_.state() == SafetyState::Killed)
         log_warning("KILLED by %s%s%s", std::string(kill_source_name()).c_str(), reason.empty() ? "" : ": ",
                     std::string(reason).c_str());
+    stop_teensy_motion();
     if (turn_done_)
         finish_turn({Status::Killed, "the vehicle was killed during the turn"});
     return {};
+}
+
+void Controller::stop_teensy_motion() {
+    // Kill stops every motor, the Teensy's drive too: Stop halts the wheels and ends a turn.
+    if (!spi_.is_open())
+        return;
+    if (auto e = teensy_link_.stop(0); e != teensy::TeensyError::None)
+        log_error("Teensy Stop on kill failed: %s", std::string(teensy::teensy_error_name(e)).c_str());
 }
 
 Result Controller::clear_kill() {
@@ -650,6 +673,7 @@ Result Controller::power_off(std::string_view confirmation) {
     if (power_off_out_)
         power_off_out_->set(1);
     log_warning("POWER-OFF confirmed: thrusters zeroed%s", power_off_out_ ? ", power-off line asserted" : "");
+    stop_teensy_motion();
     if (turn_done_)
         finish_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
@@ -740,8 +764,9 @@ void Controller::poll_teensy() {
 }
 
 Result Controller::teensy_set_speed(int left, int right) {
-    if (safety_.state() == SafetyState::PoweredOff)
-        return state_error();
+    // Drive motors are motors: only a ready vehicle moves them (stopping is always allowed).
+    if (Result r = state_error(); !r.ok() && (left != 0 || right != 0))
+        return r;
     return teensy_result(teensy_link_.set_speed(left, right), "Set Speed");
 }
 
@@ -767,7 +792,7 @@ Result Controller::teensy_distance(int sensor, uint16_t& mm) {
 }
 
 Result Controller::teensy_turn(double radians, bool absolute, std::function<void(const Result&)> done) {
-    if (Result r = state_error(); !r.ok() && safety_.state() != SafetyState::Arming)
+    if (Result r = state_error(); !r.ok())
         return r;
     if (turn_done_)
         return {Status::Busy, "a turn is already running"};
@@ -783,7 +808,7 @@ Result Controller::teensy_turn(double radians, bool absolute, std::function<void
     sd_event_source* s = nullptr;
     uint64_t now_us = 0;
     sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
-    if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 0, on_turn_step, this) < 0) {
+    if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 1, on_turn_step, this) < 0) {
         finish_turn({Status::Hardware, "cannot schedule the confirmation handshake"});
         return {};
     }

@@ -185,6 +185,7 @@ private:
     Result state_error() const;
     void note_bus_result(IoError e);
     void poll_teensy();
+    void stop_teensy_motion();
     void turn_step();
     void finish_turn(const Result& r);
     void publish_telemetry_if_due();

@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
         uint64_t now_us = 0;
         sd_event_now(event.get(), CLOCK_MONOTONIC, &now_us);
         sd_event_source* s = nullptr;
-        sd_event_add_time(event.get(), &s, CLOCK_MONOTONIC, now_us + wd.interval_us, 0, on_watchdog, &wd);
+        sd_event_add_time(event.get(), &s, CLOCK_MONOTONIC, now_us + wd.interval_us, 1000, on_watchdog, &wd);
         sd_event_source_set_enabled(s, SD_EVENT_ON);
         wd_source.reset(s);
     }

@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
     uint64_t now_us = 0;
     sd_event_now(event.get(), CLOCK_MONOTONIC, &now_us);
     sd_event_source* phys = nullptr;
-    sd_event_add_time(event.get(), &phys, CLOCK_MONOTONIC, now_us, 0, on_physics, &physics);
+    sd_event_add_time(event.get(), &phys, CLOCK_MONOTONIC, now_us, 1, on_physics, &physics); // 0 = 250 ms slack
     sd_event_source_set_enabled(phys, SD_EVENT_ON);
     dbus::SourcePtr phys_guard(phys);
 

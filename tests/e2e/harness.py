@@ -7,9 +7,10 @@ nothing of what the daemon claims.
     rig = Rig(control={"arming_delay_ms": 300})
     rig.start()                      # dbus-daemon, caracara-sim, caracarad; waits for the name
     rig.wait_state("ready")
-    rig.vcall("SetThrust", [...], signature="ai")
-    rig.poll(lambda: rig.sim_speeds() == [...])
-    rig.stop()                       # SIGTERM, wait, SIGKILL fallback, directory removed
+    rig.thrust([1000, 0, 0, 0, 0, 0, 0, 0])
+    poll(lambda: rig.sim_speeds()[0] == speed_byte(1000))
+    rig.stop_checked()               # SIGTERM, wait, SIGKILL fallback, directory removed;
+                                     # fails if a process did not exit cleanly
 
 VehicleTestCase starts one rig per test class (configured by class attributes) and tears it
 down even when setUpClass fails. Binaries come from $CARACARA_BUILD_DIR (default
@@ -20,11 +21,11 @@ Needs Debian's /usr/bin/python3 with python3-dbus and python3-gi.
 
 import atexit
 import ctypes
+import math
 import os
 import shutil
 import signal
 import subprocess
-import sys
 import tempfile
 import time
 import unittest
@@ -125,7 +126,6 @@ def order_bytes(mt, value, info=INFO):
 
 def angle_diff(a, b):
     """a - b wrapped into [-pi, pi]."""
-    import math
     d = (a - b) % (2 * math.pi)
     return d - 2 * math.pi if d > math.pi else d
 
@@ -309,6 +309,7 @@ BUS_CONF = """<!DOCTYPE busconfig PUBLIC "-//freedesktop//DTD D-Bus Bus Configur
     <allow send_destination="*" eavesdrop="true"/>
     <allow eavesdrop="true"/>
     <allow own="*"/>
+{extra}
   </policy>
 </busconfig>
 """
@@ -319,11 +320,12 @@ class Rig:
 
     START_TIMEOUT = 30.0  # generous: sanitizer builds on slow machines start slowly
 
-    def __init__(self, control=None, gpio=True, extra_config=None, raw_config=None):
+    def __init__(self, control=None, gpio=True, extra_config=None, extra_toml="", bus_policy_extra=""):
         self.control = dict(control or {})
         self.gpio = gpio
         self.extra_config = dict(extra_config or {})
-        self.raw_config = raw_config
+        self.extra_toml = extra_toml  # appended verbatim (e.g. [[thruster]] sections)
+        self.bus_policy_extra = bus_policy_extra  # more <allow>/<deny> rules for the bus policy
         self.dir = None
         self.procs = {}
         self.logs = {}
@@ -345,13 +347,11 @@ class Rig:
         return os.path.join(self.dir, "caracarad.toml")
 
     def config_text(self):
-        if self.raw_config is not None:
-            return self.raw_config
         sections = {"control": self.control}
         if self.gpio:
             sections["gpio"] = SIM_GPIO
         sections.update(self.extra_config)
-        return toml_dumps(sections)
+        return toml_dumps(sections) + "\n" + self.extra_toml
 
     def _spawn(self, name, argv):
         log_path = os.path.join(self.dir, name + ".log")
@@ -370,7 +370,7 @@ class Rig:
             if not os.access(binary(name), os.X_OK):
                 raise RuntimeError("%s is not built (CARACARA_BUILD_DIR=%s)" % (binary(name), BUILD_DIR))
         with open(os.path.join(self.dir, "bus.conf"), "w") as f:
-            f.write(BUS_CONF.format(dir=self.dir))
+            f.write(BUS_CONF.format(dir=self.dir, extra=self.bus_policy_extra))
         self._spawn("dbus-daemon", ["/usr/bin/dbus-daemon", "--nofork",
                                     "--config-file=" + os.path.join(self.dir, "bus.conf")])
         poll(lambda: os.path.exists(os.path.join(self.dir, "bus")) or self._died("dbus-daemon"),
@@ -388,11 +388,10 @@ class Rig:
             self.start_daemon()
         return self
 
-    def start_daemon(self, extra_args=()):
+    def start_daemon(self):
         self.daemon_exit = None
         self._spawn("caracarad", [binary("caracarad"), "--hardware=sim:" + self.sim_socket,
-                                  "--bus-address", self.address, "--config", self.config_path]
-                    + list(extra_args))
+                                  "--bus-address", self.address, "--config", self.config_path])
         poll(lambda: self.conn.name_has_owner(VEHICLE) or self._died("caracarad"), self.START_TIMEOUT,
              message="caracarad did not take its name")
         self._check_alive("caracarad")
@@ -423,7 +422,7 @@ class Rig:
         self.daemon_exit = self.terminate("caracarad", timeout)
         return self.daemon_exit
 
-    def stop(self):
+    def stop(self, remove_dir=True):
         """Tears everything down; safe to call more than once and after a failed start."""
         _live_rigs.discard(self)
         for name in ("caracarad", "caracara-sim"):
@@ -444,8 +443,33 @@ class Rig:
         except Exception:
             pass
         self.procs.clear()
+        if remove_dir:
+            self.remove_dir()
+
+    def remove_dir(self):
         if self.dir and not os.environ.get("CARACARA_KEEP_TEST_DIR"):
             shutil.rmtree(self.dir, ignore_errors=True)
+
+    SANITIZER_MARKS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:")
+
+    def stop_checked(self):
+        """stop(), then fails if caracarad or caracara-sim did not exit with 0 on SIGTERM or
+        a sanitizer reported a problem (the CI runs these tests under ASan/UBSan)."""
+        procs = {name: self.procs.get(name) for name in ("caracarad", "caracara-sim")}
+        self.stop(remove_dir=False)
+        problems, logs = [], {}
+        for name, p in procs.items():
+            if p is None:
+                continue
+            logs[name] = self.log(name)
+            if p.returncode != 0:
+                problems.append("%s exited with %s" % (name, p.returncode))
+            if any(mark in logs[name] for mark in self.SANITIZER_MARKS):
+                problems.append("%s: sanitizer report" % name)
+        self.remove_dir()
+        if problems:
+            raise AssertionError("; ".join(problems) + "".join(
+                "\n--- %s log (end) ---\n%s" % (n, logs[n][-4000:]) for n in logs))
 
     def log(self, name="caracarad"):
         try:
@@ -625,12 +649,16 @@ class VehicleTestCase(unittest.TestCase):
     CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 60000}
     GPIO = True
     EXTRA_CONFIG = {}
+    EXTRA_TOML = ""
+    BUS_POLICY_EXTRA = ""
     WAIT_READY = True
 
     @classmethod
     def setUpClass(cls):
-        cls.rig = Rig(control=cls.CONTROL, gpio=cls.GPIO, extra_config=cls.EXTRA_CONFIG)
-        cls.addClassCleanup(cls.rig.stop)
+        cls.rig = Rig(control=cls.CONTROL, gpio=cls.GPIO, extra_config=cls.EXTRA_CONFIG,
+                      extra_toml=cls.EXTRA_TOML,
+                      bus_policy_extra=cls.BUS_POLICY_EXTRA)
+        cls.addClassCleanup(cls.rig.stop_checked)
         cls.rig.start()
         if cls.WAIT_READY:
             cls.rig.wait_state("ready")

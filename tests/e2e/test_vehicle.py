@@ -6,9 +6,7 @@ harness.budget_limit, harness.SEED_AXIS_MOTORS), never read back from the daemon
 """
 
 import math
-import os
 import signal
-import subprocess
 import time
 import unittest
 
@@ -23,6 +21,20 @@ from harness import (BUS_IFACE, BUS_PATH, DEFAULT_MT, ERR, INVALID_ARGS, MOTORS,
 
 def hexes(bs):
     return [hex(b) for b in bs]
+
+
+def assert_zeroed_before_reply(test, rig, wire_from, replied_ns):
+    """Every thruster got a zero order before the daemon's reply arrived: at once, not at a
+    later tick. The wire log and time.monotonic_ns() share CLOCK_MONOTONIC; the log stamps
+    the end of the modelled transfer, so its wire time is taken off."""
+    bit_ns = 1e9 / int(rig.sim_get("ClockHz"))
+    _, log = rig.wire_log(wire_from)
+    for i, mt in enumerate(DEFAULT_MT):
+        zero = [e for e in log if e.bus == "i2c" and not e.read and e.addr == mt >> 1
+                and list(e.data) == harness.order_bytes(mt, 0)]
+        test.assertTrue(zero, "no zero order to thruster %d in the wire log" % i)
+        started = zero[0].time_ns - (10 + 9 * len(zero[0].data)) * bit_ns
+        test.assertLessEqual(started, replied_ns, "thruster %d zeroed only after the reply" % i)
 
 
 class PropertyWatcher:
@@ -96,6 +108,20 @@ class PropertiesTest(VehicleTestCase):
         # Controller is our unique name once we command.
         self.assertEqual(self.rig.vget("Controller"), self.rig.conn.get_unique_name())
 
+    def test_loop_rate_is_honoured(self):
+        # LoopRateHz is 50: the thrusters' orders are refreshed about that often, also when
+        # no client is calling the daemon (nothing else wakes its event loop).
+        rate = float(self.rig.vget("LoopRateHz"))
+        c0 = int(self.rig.vget("Cycles"))
+        o0 = self.rig.sim_counters("OrdersReceived")
+        t0 = time.monotonic()
+        time.sleep(2.0)
+        dt = time.monotonic() - t0
+        cycles = (int(self.rig.vget("Cycles")) - c0) / dt
+        orders = min(b - a for a, b in zip(o0, self.rig.sim_counters("OrdersReceived"))) / dt
+        self.assertGreaterEqual(cycles, 0.5 * rate, "control loop ran at %.1f Hz, configured %g Hz" % (cycles, rate))
+        self.assertGreaterEqual(orders, 0.5 * rate, "orders refreshed at %.1f Hz, configured %g Hz" % (orders, rate))
+
     def test_requested_and_motor_values(self):
         # 1 motor over the 1-2 motor limit: requested keeps the demand, MotorValues the budgeted one.
         self.rig.thrust([0, 0, 0, 8000, 0, 0, 0, 0])
@@ -157,37 +183,6 @@ class PropertiesTest(VehicleTestCase):
         fw = self.rig.vget("FirmwareRevision", thruster_path(0), THRUSTER_IFACE)
         self.assertEqual(dbus_signature(fw), "y")
 
-    def test_thruster_faults_nacks_and_bad_replies(self):
-        # A fault the simulated controller raises shows up in Faults.
-        self.rig.sim_thruster_call(2, "SetFault", "overtemp", True, signature="sb")
-        try:
-            poll(lambda: "overtemp" in list(self.rig.vget("Faults", thruster_path(2), THRUSTER_IFACE)), 15,
-                 message="the overtemp fault never reached Faults")
-        finally:
-            self.rig.sim_thruster_call(2, "SetFault", "overtemp", False, signature="sb")
-        poll(lambda: list(self.rig.vget("Faults", thruster_path(2), THRUSTER_IFACE)) == [], 15)
-
-        # A NACKing controller: counted, LastError "nack", Online false; back when it answers.
-        self.rig.sim_thruster_call(5, "SetNack", True, signature="b")
-        try:
-            poll(lambda: int(self.rig.vget("Nacks", thruster_path(5), THRUSTER_IFACE)) > 0, 10)
-            self.assertEqual(self.rig.vget("LastError", thruster_path(5), THRUSTER_IFACE), "nack")
-            self.assertFalse(self.rig.vget("Online", thruster_path(5), THRUSTER_IFACE))
-            self.assertGreater(int(self.rig.vget("OrderFailures", thruster_path(5), THRUSTER_IFACE)), 0)
-        finally:
-            self.rig.sim_thruster_call(5, "SetNack", False, signature="b")
-        poll(lambda: bool(self.rig.vget("Online", thruster_path(5), THRUSTER_IFACE)), 10,
-             message="thruster 5 did not come back online")
-        # One thruster NACKing is not a bus failure.
-        self.assertEqual(self.rig.vget("State", BUS_PATH, BUS_IFACE), "ok")
-        self.assertEqual(self.rig.state(), "ready")
-
-        # Corrupted status replies are counted and never believed.
-        self.rig.sim_thruster_call(6, "CorruptReplies", dbus.UInt32(2), "checksum", signature="us")
-        poll(lambda: int(self.rig.vget("BadReplies", thruster_path(6), THRUSTER_IFACE)) >= 2, 15,
-             message="corrupted replies not counted")
-        self.assertEqual(self.rig.vget("LastError", thruster_path(6), THRUSTER_IFACE), "bad-checksum")
-
     def test_bus_properties(self):
         p = self.check_interface_props(BUS_PATH, BUS_IFACE)
         self.assertEqual(p["Device"], "/dev/i2c-1")
@@ -223,6 +218,183 @@ class PropertiesTest(VehicleTestCase):
         poll(lambda: int(self.rig.vget("LinkErrors", TEENSY_PATH, TEENSY_IFACE)) >= e0 + 1, 10,
              message="a garbled acknowledgement was not counted")
         poll(lambda: bool(self.rig.vget("Online", TEENSY_PATH, TEENSY_IFACE)), 10)
+
+
+class ThrusterFaultTest(VehicleTestCase):
+    """Faults injected into the simulated controllers (a rig of its own: LastError and the
+    error counters stay as evidence)."""
+
+    def setUp(self):
+        self.rig.reset()
+
+    def test_thruster_faults_nacks_and_bad_replies(self):
+        # A fault the simulated controller raises shows up in Faults.
+        self.rig.sim_thruster_call(2, "SetFault", "overtemp", True, signature="sb")
+        try:
+            poll(lambda: "overtemp" in list(self.rig.vget("Faults", thruster_path(2), THRUSTER_IFACE)), 15,
+                 message="the overtemp fault never reached Faults")
+        finally:
+            self.rig.sim_thruster_call(2, "SetFault", "overtemp", False, signature="sb")
+        poll(lambda: list(self.rig.vget("Faults", thruster_path(2), THRUSTER_IFACE)) == [], 15)
+
+        # A NACKing controller: counted, LastError "nack", Online false; back when it answers.
+        self.rig.sim_thruster_call(5, "SetNack", True, signature="b")
+        try:
+            poll(lambda: int(self.rig.vget("Nacks", thruster_path(5), THRUSTER_IFACE)) > 0, 10)
+            self.assertEqual(self.rig.vget("LastError", thruster_path(5), THRUSTER_IFACE), "nack")
+            self.assertFalse(self.rig.vget("Online", thruster_path(5), THRUSTER_IFACE))
+            self.assertGreater(int(self.rig.vget("OrderFailures", thruster_path(5), THRUSTER_IFACE)), 0)
+        finally:
+            self.rig.sim_thruster_call(5, "SetNack", False, signature="b")
+        poll(lambda: bool(self.rig.vget("Online", thruster_path(5), THRUSTER_IFACE)), 10,
+             message="thruster 5 did not come back online")
+        # One thruster NACKing is not a bus failure.
+        self.assertEqual(self.rig.vget("State", BUS_PATH, BUS_IFACE), "ok")
+        self.assertEqual(self.rig.state(), "ready")
+
+        # Corrupted status replies are counted and never believed.
+        self.rig.sim_thruster_call(6, "CorruptReplies", dbus.UInt32(2), "checksum", signature="us")
+        poll(lambda: int(self.rig.vget("BadReplies", thruster_path(6), THRUSTER_IFACE)) >= 2, 15,
+             message="corrupted replies not counted")
+        self.assertEqual(self.rig.vget("LastError", thruster_path(6), THRUSTER_IFACE), "bad-checksum")
+
+REVERSED_THRUSTERS = "".join(
+    "[[thruster]]\naddress = 0x%02X\n%s\n" % (mt, "reversed = true\n" if i == 2 else "")
+    for i, mt in enumerate(DEFAULT_MT))
+
+
+class ReversedThrusterTest(VehicleTestCase):
+    """Thruster 2 mounted backwards: the motor value keeps its meaning, the wire is reversed."""
+    EXTRA_TOML = REVERSED_THRUSTERS
+
+    def test_reversal_applies_on_the_wire_only(self):
+        self.assertTrue(self.rig.vget("Reversed", thruster_path(2), THRUSTER_IFACE))
+        self.assertFalse(self.rig.vget("Reversed", thruster_path(0), THRUSTER_IFACE))
+        values = [1000, 0, 1000, 0, 0, 0, 0, 0]
+        self.rig.thrust(values)
+        self.rig.wait_sim_speeds([speed_byte(1000), ZERO, speed_byte(-1000), ZERO, ZERO, ZERO, ZERO, ZERO])
+        self.assertEqual(self.rig.motor_values(), values)
+        self.assertEqual(self.rig.vget("OrderedValue", thruster_path(2), THRUSTER_IFACE), 1000)
+        self.assertEqual(self.rig.vget("OrderedSpeed", thruster_path(2), THRUSTER_IFACE), speed_byte(-1000))
+        # Motion: forward drives motor 2 forward, i.e. reversed on its wire.
+        self.rig.motion(y=0.5)
+        self.rig.wait_sim_speeds([speed_byte(4425), ZERO, speed_byte(-4425), ZERO, speed_byte(4425), ZERO,
+                                  speed_byte(4425), ZERO])
+
+
+# --------------------------------------------------------------------------------------------
+# The I2C bus: lockup, bus clear, the BusLost/BusRestored signals
+# --------------------------------------------------------------------------------------------
+
+RECOVERY_GPIO = dict(harness.SIM_GPIO, scl={"chip": "gpiochip0", "line": "GPIO3"},
+                     sda={"chip": "gpiochip0", "line": "GPIO2"})
+# The simulator plays a Raspberry Pi 4: taking the pins as GPIO steals them from the I2C
+# controller until its driver is rebound (its default driver id is fe804000.i2c).
+RECOVERY = {"enabled": True, "attempts": 3, "backoff_ms": 50, "driver_id": "fe804000.i2c"}
+
+
+class BusSignals:
+    def __init__(self, rig):
+        self.events = []
+        self.match = rig.conn.add_signal_receiver(
+            lambda *args, **kw: self.events.append((kw["member"],) + tuple(args)),
+            dbus_interface=BUS_IFACE, path=BUS_PATH, member_keyword="member")
+
+    def wait(self, member, timeout=20.0):
+        return poll(lambda: [e for e in self.events if e[0] == member], timeout, pump=pump_main_loop,
+                    message="no %s signal" % member)
+
+    def remove(self):
+        self.match.remove()
+
+
+class BusRecoveryTest(VehicleTestCase):
+    GPIO = False
+    EXTRA_CONFIG = {"gpio": RECOVERY_GPIO, "recovery": RECOVERY}
+
+    def setUp(self):
+        self.rig.reset()
+
+    def bus(self, name):
+        return self.rig.vget(name, BUS_PATH, BUS_IFACE)
+
+    def test_sda_stuck_low_is_cleared_and_orders_resume(self):
+        rig = self.rig
+        values = [0, 1700, 0, 0, 0, 0, -1700, 0]
+        rig.thrust(values)
+        rig.wait_sim_speeds([speed_byte(v) for v in values])
+        recoveries = int(self.bus("Recoveries"))
+        signals = BusSignals(rig)
+        try:
+            rig.sim_call("HangBus", dbus.UInt32(5), signature="u")  # a slave holds SDA for 5 clocks
+            lost = signals.wait("BusLost")
+            restored = signals.wait("BusRestored")
+        finally:
+            signals.remove()
+        self.assertTrue(str(lost[0][1]))
+        self.assertEqual(int(restored[0][1]), 5, "pulses the bus clear needed")
+        self.assertGreater(float(restored[0][2]), 0.0)
+        self.assertEqual(rig.sim_get("BusHang"), "none")
+        self.assertGreaterEqual(int(rig.sim_get("SclPulses")), 5)
+        self.assertTrue(rig.sim_get("I2cFunction"), "the pins were not given back to the I2C controller")
+        poll(lambda: self.bus("State") == "ok", 10)
+        self.assertEqual(int(self.bus("Recoveries")), recoveries + 1)
+        self.assertEqual(int(self.bus("LastPulses")), 5)
+        self.assertGreater(float(self.bus("LastRecoveryMs")), 0.0)
+        # The orders were re-sent, and the vehicle never stopped being ready.
+        rig.wait_orders_refreshed()
+        self.assertEqual(rig.sim_speeds(), [speed_byte(v) for v in values])
+        self.assertEqual(rig.state(), "ready")
+        time.sleep(1.0)
+        self.assertEqual(int(self.bus("Recoveries")), recoveries + 1, "recovering again after a good recovery")
+
+    def test_scl_held_low_kills_with_source_bus(self):
+        rig = self.rig
+        rig.thrust([1200] + [0] * 7)
+        rig.wait_sim_speeds([speed_byte(1200)] + [ZERO] * 7)
+        failures = int(self.bus("RecoveryFailures"))
+        rig.sim_call("HoldScl")  # clocking cannot clear this
+        try:
+            rig.wait_state("killed", 30)
+            self.assertEqual(rig.vget("KillSource"), "bus")
+            self.assertEqual(self.bus("State"), "lost")
+            self.assertGreaterEqual(int(self.bus("RecoveryFailures")), failures + RECOVERY["attempts"])
+            self.assertTrue(self.bus("LastRecoveryError"))
+            self.assertTrue(rig.sim_get("KillOutput"), "the kill output de-energizes what the bus cannot reach")
+        finally:
+            rig.sim_call("ReleaseBus")
+        # The background retries bring the bus back; the pending kill's zero orders go out first.
+        poll(lambda: self.bus("State") == "ok", 30, interval=0.1, message="the bus never came back")
+        rig.wait_sim_zero(10)
+        self.assertEqual(rig.state(), "killed", "a bus kill must be cleared explicitly")
+
+
+class BusRecoveryWithoutRebindTest(VehicleTestCase):
+    """A bus clear that does not give the bus back (here: no driver_id, so the pins stay GPIO,
+    as on a Raspberry Pi configured without it) is a failed recovery: the vehicle must end up
+    killed with source "bus", not loop through "successful" recoveries while it reaches no
+    thruster."""
+    GPIO = False
+    EXTRA_CONFIG = {"gpio": RECOVERY_GPIO, "recovery": dict(RECOVERY, driver_id="")}
+
+    def test_ineffective_recovery_escalates_to_a_kill(self):
+        rig = self.rig
+        rig.thrust([1200] + [0] * 7)
+        rig.wait_sim_speeds([speed_byte(1200)] + [ZERO] * 7)
+        rig.sim_call("HangBus", dbus.UInt32(3), signature="u")
+        poll(lambda: int(rig.vget("RecoveryFailures", BUS_PATH, BUS_IFACE)) >= 1, 20)
+        self.assertFalse(rig.sim_get("I2cFunction"))  # the simulated pins stay GPIO
+        self.assertIn("no thruster answers", rig.vget("LastRecoveryError", BUS_PATH, BUS_IFACE))
+        try:
+            rig.wait_state("killed", 10)  # 3 attempts 50 ms apart: well under a second
+        except harness.Timeout:
+            self.fail("not killed while no transaction reaches the thrusters: State %s, bus %s, %d recoveries, "
+                      "thruster 0 still at %s" % (rig.state(), rig.vget("State", BUS_PATH, BUS_IFACE),
+                                                  int(rig.vget("Recoveries", BUS_PATH, BUS_IFACE)),
+                                                  hex(rig.sim_speeds()[0])))
+        self.assertEqual(rig.vget("KillSource"), "bus")
+        self.assertTrue(rig.sim_get("KillOutput"))
+        self.assertEqual(int(rig.vget("Recoveries", BUS_PATH, BUS_IFACE)), 0, "nothing was recovered")
 
 
 # --------------------------------------------------------------------------------------------
@@ -424,9 +596,12 @@ class PacketTest(VehicleTestCase):
         self.rig.packet(packet(motors))
         self.rig.wait_sim_speeds([speed_byte(v) for v in motors])
         zeros_before = self.rig.sim_counters("ZeroOrders")
+        wire_from = self.rig.wire_next()
         # Any non-zero killState kills (the seed's "non-zero: motors de-energized").
         self.rig.packet(packet(motors, kill=-5, rgb=(255, 0, 0)))
+        replied_ns = time.monotonic_ns()
         self.assertEqual(self.rig.sim_speeds(), [ZERO] * MOTORS)
+        assert_zeroed_before_reply(self, self.rig, wire_from, replied_ns)
         self.assertTrue(all(a > b for a, b in zip(self.rig.sim_counters("ZeroOrders"), zeros_before)))
         self.assertEqual(self.rig.state(), "killed")
         self.assertEqual(self.rig.vget("KillSource"), "packet")
@@ -484,13 +659,7 @@ class KillTest(VehicleTestCase):
         zeros_after = self.rig.sim_counters("ZeroOrders")
         for i in range(MOTORS):
             self.assertGreater(zeros_after[i], zeros_before[i], "thruster %d got no zero order" % i)
-        # The zero orders were on the wire before the daemon replied (same monotonic clock).
-        _, log = self.rig.wire_log(wire_from)
-        for i, mt in enumerate(DEFAULT_MT):
-            zero = [e for e in log if e.bus == "i2c" and not e.read and e.addr == mt >> 1
-                    and list(e.data) == harness.order_bytes(mt, 0)]
-            self.assertTrue(zero, "no zero order to thruster %d in the wire log" % i)
-            self.assertLessEqual(zero[0].time_ns, replied_ns, "thruster %d zeroed after the Kill reply" % i)
+        assert_zeroed_before_reply(self, self.rig, wire_from, replied_ns)
         self.assertEqual(self.rig.state(), "killed")
         self.assertEqual(self.rig.vget("KillSource"), "dbus")
         self.assertTrue(self.rig.sim_get("KillOutput"))
@@ -585,6 +754,28 @@ class KillTest(VehicleTestCase):
             watcher.remove()
 
 
+class KillSwitchAtStartTest(unittest.TestCase):
+
+    def test_start_with_the_switch_set_is_killed(self):
+        rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
+        self.addCleanup(rig.stop_checked)
+        rig.start(daemon=False)
+        rig.sim_call("SetKillSwitch", True, signature="b")
+        rig.start_daemon()
+        self.assertEqual(rig.state(), "killed")
+        self.assertEqual(rig.vget("KillSource"), "switch")
+        self.assertTrue(rig.sim_get("KillOutput"))
+        self.assertEqual(error_name(rig.thrust, [100] * MOTORS), ERR + "Killed")
+        self.assertEqual(error_name(rig.vcall, "ClearKill"), ERR + "KillSwitchSet")
+        time.sleep(0.5)
+        self.assertEqual(rig.state(), "killed", "the kill switch kill ended by itself")
+        rig.sim_call("SetKillSwitch", False, signature="b")
+        rig.vcall("ClearKill")
+        rig.wait_state("ready")
+        rig.thrust([100] * MOTORS)
+        rig.wait_sim_speeds([speed_byte(100)] * MOTORS)
+
+
 class DefaultArmingTest(VehicleTestCase):
     """The default 3 s arming delay (the board firmware's), at start and after ClearKill."""
     CONTROL = {"command_timeout_ms": 60000}
@@ -592,6 +783,9 @@ class DefaultArmingTest(VehicleTestCase):
 
     def test_default_arming_delay(self):
         rig = self.rig
+        # Nobody has commanded this fresh daemon yet.
+        self.assertEqual(rig.vget("CommandAgeMs"), -1)
+        self.assertEqual(rig.vget("Controller"), "")
         self.assertEqual(rig.vget("ArmingDelayMs"), 3000)
         # At start: arming, zero output, commands refused.
         if rig.state() == "arming":
@@ -618,7 +812,7 @@ class PowerOffTest(unittest.TestCase):
 
     def setUp(self):
         self.rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
-        self.addCleanup(self.rig.stop)
+        self.addCleanup(self.rig.stop_checked)
         self.rig.start()
         self.rig.wait_state("ready")
         self.values = [1500, -1500, 0, 0, 3000, 0, 0, 0]
@@ -658,7 +852,9 @@ class PowerOffTest(unittest.TestCase):
                 self.assertFalse(rig.sim_get("PowerOffOutput"))
                 rig.wait_orders_refreshed()
                 self.assertEqual(rig.sim_snapshot(), before)
+        wire_from = rig.wire_next()
         rig.vcall("PowerOff", "power-off", signature="s")
+        assert_zeroed_before_reply(self, rig, wire_from, time.monotonic_ns())
         self.check_powered_off()
 
     def test_packet_power_off(self):
@@ -753,7 +949,7 @@ class ClientLossTest(VehicleTestCase):
     def test_busctl_one_shot(self):
         rig = self.rig
         wire_from = rig.wire_next()
-        r = rig.busctl("call", VEHICLE, ROOT, VEHICLE, "SetThrust", "ai", 8, 3000, 0, 0, 0, 0, 0, 0, -3000)
+        r = rig.busctl("call", "--", VEHICLE, ROOT, VEHICLE, "SetThrust", "ai", 8, 3000, 0, 0, 0, 0, 0, 0, -3000)
         self.assertEqual(r.returncode, 0, r.stderr)
         # busctl left the bus right after the reply: the thrusters end at zero...
         rig.wait_sim_zero(10)
@@ -773,9 +969,32 @@ class ClientLossTest(VehicleTestCase):
 
 class SigtermTest(unittest.TestCase):
 
+    def test_start_zeroes_orders_a_crashed_daemon_left(self):
+        rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
+        self.addCleanup(rig.stop_checked)
+        rig.start()
+        rig.wait_state("ready")
+        values = [0, 3500, 0, 3500, 0, -3500, 0, -3500]
+        rig.thrust(values)
+        rig.wait_sim_speeds([speed_byte(v) for v in values])
+        # A daemon that dies without zeroing: the thrusters keep their last order (the IDS
+        # has no thruster-side timeout).
+        proc = rig.procs["caracarad"]
+        proc.kill()
+        proc.wait(30)
+        poll(lambda: not rig.conn.name_has_owner(VEHICLE), 10)
+        time.sleep(0.2)
+        self.assertEqual(rig.sim_speeds(), [speed_byte(v) for v in values])
+        # The next daemon zeroes them before it takes its name.
+        rig.start_daemon()
+        self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS, "orders standing when the service appeared")
+        self.assertEqual(rig.state(), "arming")
+        rig.wait_state("ready")
+        self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+
     def test_sigterm_zeroes_and_exits_0(self):
         rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
-        self.addCleanup(rig.stop)
+        self.addCleanup(rig.stop_checked)
         rig.start()
         rig.wait_state("ready")
         values = [4000, -4000, 4000, -4000, 0, 0, 0, 0]
@@ -804,12 +1023,12 @@ INF = float("inf")
 
 class InvalidInputTest(VehicleTestCase):
 
-    @classmethod
-    def setUpClass(cls):
-        super().setUpClass()
-        cls.values = [1000, -2000, 3000, 0, 0, 0, 0, -500]
-        cls.rig.thrust(cls.values)
-        cls.rig.wait_sim_speeds([speed_byte(v) for v in cls.values])
+    values = [1000, -2000, 3000, 0, 0, 0, 0, -500]
+
+    def setUp(self):
+        # A known, non-zero output that every refused call must leave alone.
+        self.rig.thrust(self.values)
+        self.rig.wait_sim_speeds([speed_byte(v) for v in self.values])
 
     def check_refused(self, expected_error, fn, *args, **kwargs):
         rig = self.rig
@@ -920,6 +1139,8 @@ class TeensyTest(VehicleTestCase):
 
     def setUp(self):
         self.rig.reset()
+        # No turn left running on the simulated Teensy by an earlier test.
+        poll(lambda: str(self.rig.sim_teensy("Task")) != "running", 15)
 
     def tcall(self, method, *args, signature=None, **kw):
         return self.rig.vcall(method, *args, signature=signature, path=TEENSY_PATH, iface=TEENSY_IFACE, **kw)
@@ -961,7 +1182,7 @@ class TeensyTest(VehicleTestCase):
     def test_turn_replies_when_the_teensy_acknowledged(self):
         rig = self.rig
         acks = int(rig.sim_teensy("Acknowledgements"))
-        yaw0 = float(self.tget("Orientation")[0])
+        offset0 = float(rig.sim_teensy("HeadingOffset"))
         result = {}
 
         def done(*_):
@@ -1000,9 +1221,33 @@ class TeensyTest(VehicleTestCase):
         self.assertEqual(result["sim_task"], "idle")
         self.assertAlmostEqual(float(rig.sim_teensy("LastTurn")), 0.6, places=5)
         self.assertGreaterEqual(result["t"] - start, 0.3, "0.6 rad at the simulated 1 rad/s took no time")
+        self.assertAlmostEqual(angle_diff(float(rig.sim_teensy("HeadingOffset")), offset0), 0.6, places=4)
         poll(lambda: str(self.tget("Task")) == "idle", 5)
-        poll(lambda: abs(angle_diff(float(self.tget("Orientation")[0]), yaw0) - 0.6) < 0.05, 10,
-             message="the daemon's heading did not move by the turn")
+        # The daemon's heading follows the simulated Teensy's (body yaw + the turn).
+        poll(lambda: abs(angle_diff(float(self.tget("Orientation")[0]), rig.sim_yaw())) < 0.02, 10,
+             message="the daemon's heading does not follow the turn")
+
+    def test_kill_ends_a_running_turn(self):
+        rig = self.rig
+        result = {}
+        rig.obj(VEHICLE, TEENSY_PATH).get_dbus_method("Turn", TEENSY_IFACE)(
+            3.0, signature="d", reply_handler=lambda *a: result.setdefault("ok", True),
+            error_handler=lambda e: result.setdefault("error", e.get_dbus_name()), timeout=60)
+        poll(lambda: str(self.tget("Task")) == "turning", 10, pump=pump_main_loop)
+        rig.vcall("Kill")
+        poll(lambda: result, 10, pump=pump_main_loop, message="Turn never replied after the kill")
+        self.assertEqual(result, {"error": ERR + "Killed"})
+        self.assertEqual(str(self.tget("Task")), "idle")
+        # The vehicle itself stops turning: the Teensy's turn task is ended, not left to run
+        # its remaining ~3 rad after the kill.
+        try:
+            poll(lambda: str(rig.sim_teensy("Task")) != "running", 1.5)  # the whole turn takes 3 s
+        except harness.Timeout:
+            self.fail("the simulated Teensy is still turning after Kill (heading offset %.2f rad and rising)"
+                      % float(rig.sim_teensy("HeadingOffset")))
+        offset = float(rig.sim_teensy("HeadingOffset"))
+        time.sleep(0.3)
+        self.assertAlmostEqual(float(rig.sim_teensy("HeadingOffset")), offset, places=6)
 
     def test_turn_while_turning_is_busy(self):
         rig = self.rig
@@ -1039,9 +1284,9 @@ class TeensyTest(VehicleTestCase):
         prev = [rig.sim_yaw()]
 
         def settled():
-            time.sleep(0.1)
+            time.sleep(0.5)
             now = rig.sim_yaw()
-            still = abs(angle_diff(now, prev[0])) < 0.002
+            still = abs(angle_diff(now, prev[0])) < 0.003
             prev[0] = now
             return still
         poll(settled, 20, interval=0.0)
