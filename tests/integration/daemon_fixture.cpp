@@ -72,6 +72,19 @@ uint32_t DaemonFixture::bus_u32(const char* prop) {
     return v;
 }
 
+namespace {
+// Sends a prepared call and returns "" or the D-Bus error name.
+std::string send_call(sd_bus* bus, sd_bus_message* m) {
+    sd_bus_error e = SD_BUS_ERROR_NULL;
+    sd_bus_message* reply = nullptr;
+    int r = sd_bus_call(bus, m, 10'000'000, &e, &reply);
+    sd_bus_message_unref(reply);
+    std::string name = r < 0 ? (e.name ? e.name : "error") : "";
+    sd_bus_error_free(&e);
+    return name;
+}
+} // namespace
+
 std::string DaemonFixture::call(const char* method, const char* sig, ...) {
     sd_bus_message* m = nullptr;
     sd_bus_message_new_method_call(bus_.get(), &m, "org.caracara.Vehicle1", "/org/caracara/Vehicle1",
@@ -81,13 +94,7 @@ std::string DaemonFixture::call(const char* method, const char* sig, ...) {
     va_start(ap, sig);
     sd_bus_message_appendv(m, sig, ap);
     va_end(ap);
-    sd_bus_error e = SD_BUS_ERROR_NULL;
-    sd_bus_message* reply = nullptr;
-    int r = sd_bus_call(bus_.get(), m, 10'000'000, &e, &reply);
-    sd_bus_message_unref(reply);
-    std::string name = r < 0 ? (e.name ? e.name : "error") : "";
-    sd_bus_error_free(&e);
-    return name;
+    return send_call(bus_.get(), m);
 }
 
 std::string DaemonFixture::set_thrust(const std::vector<int32_t>& v) {
@@ -96,13 +103,7 @@ std::string DaemonFixture::set_thrust(const std::vector<int32_t>& v) {
                                    "org.caracara.Vehicle1", "SetThrust");
     dbus::MessagePtr guard(m);
     sd_bus_message_append_array(m, 'i', v.data(), v.size() * sizeof(int32_t));
-    sd_bus_error e = SD_BUS_ERROR_NULL;
-    sd_bus_message* reply = nullptr;
-    int r = sd_bus_call(bus_.get(), m, 10'000'000, &e, &reply);
-    sd_bus_message_unref(reply);
-    std::string name = r < 0 ? (e.name ? e.name : "error") : "";
-    sd_bus_error_free(&e);
-    return name;
+    return send_call(bus_.get(), m);
 }
 
 } // namespace caracara::test

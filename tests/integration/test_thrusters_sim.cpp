@@ -40,6 +40,22 @@ struct Bench {
     }
 };
 
+// Two thrusters at MT 0x52 behind PCA9544A muxes: (mux, channel) each.
+std::string two_muxed(uint16_t mux_a, uint8_t ch_a, uint16_t mux_b, uint8_t ch_b) {
+    auto one = [](uint16_t mux, uint8_t ch) {
+        return "[[thruster]]\naddress = 0x52\nmux_address = " + std::to_string(mux) + "\nmux_channel = " +
+               std::to_string(ch) + "\n";
+    };
+    return one(mux_a, ch_a) + one(mux_b, ch_b);
+}
+
+ThrusterConfig muxed(uint16_t mux, uint8_t ch) {
+    ThrusterConfig c;
+    c.mt = 0x52;
+    c.mux = MuxRoute{mux, ch};
+    return c;
+}
+
 std::vector<ThrusterConfig> default_configs() {
     std::vector<ThrusterConfig> v;
     for (uint8_t mt : kDefaultMt) {
@@ -165,24 +181,9 @@ TEST_CASE("corrupted replies are discarded and counted, a NACKing thruster goes 
 }
 
 TEST_CASE("same-address thrusters behind a PCA9544A get their channel selected first") {
-    const std::string cfg = R"(
-[[thruster]]
-address = 0x52
-mux_address = 0x70
-mux_channel = 0
-[[thruster]]
-address = 0x52
-mux_address = 0x70
-mux_channel = 1
-)";
     SimFixture probe;
-    SimFixture f({"--config", probe.write_file("vehicle.toml", cfg)});
-    ThrusterConfig c0;
-    c0.mt = 0x52;
-    c0.mux = MuxRoute{0x70, 0};
-    ThrusterConfig c1 = c0;
-    c1.mux = MuxRoute{0x70, 1};
-    Bench b(f, {c0, c1});
+    SimFixture f({"--config", probe.write_file("vehicle.toml", two_muxed(0x70, 0, 0x70, 1))});
+    Bench b(f, {muxed(0x70, 0), muxed(0x70, 1)});
     REQUIRE(b.thrusters[0]->send_order(2000) == IoError::None);
     REQUIRE(b.thrusters[1]->send_order(-2000) == IoError::None);
     REQUIRE(b.thrusters[0]->send_order(2000) == IoError::None);
@@ -210,24 +211,9 @@ TEST_CASE("reversed thrusters get the opposite direction on the wire") {
 }
 
 TEST_CASE("same-address thrusters behind two muxes: only one mux channel is ever enabled") {
-    const std::string cfg = R"(
-[[thruster]]
-address = 0x52
-mux_address = 0x70
-mux_channel = 0
-[[thruster]]
-address = 0x52
-mux_address = 0x71
-mux_channel = 0
-)";
     SimFixture probe;
-    SimFixture f({"--config", probe.write_file("vehicle.toml", cfg)});
-    ThrusterConfig a;
-    a.mt = 0x52;
-    a.mux = MuxRoute{0x70, 0};
-    ThrusterConfig c = a;
-    c.mux = MuxRoute{0x71, 0};
-    Bench b(f, {a, c});
+    SimFixture f({"--config", probe.write_file("vehicle.toml", two_muxed(0x70, 0, 0x71, 0))});
+    Bench b(f, {muxed(0x70, 0), muxed(0x71, 0)});
     REQUIRE(b.thrusters[0]->send_order(1500) == IoError::None);
     REQUIRE(b.thrusters[1]->send_order(-1500) == IoError::None);
     // Had both muxes been left on, both thrusters would have taken the second order.
@@ -238,24 +224,9 @@ mux_channel = 0
 }
 
 TEST_CASE("a NACK on one thruster does not disturb the mux state of the others") {
-    const std::string cfg = R"(
-[[thruster]]
-address = 0x52
-mux_address = 0x70
-mux_channel = 0
-[[thruster]]
-address = 0x52
-mux_address = 0x70
-mux_channel = 1
-)";
     SimFixture probe;
-    SimFixture f({"--config", probe.write_file("vehicle.toml", cfg)});
-    ThrusterConfig a;
-    a.mt = 0x52;
-    a.mux = MuxRoute{0x70, 0};
-    ThrusterConfig c = a;
-    c.mux = MuxRoute{0x70, 1};
-    Bench b(f, {a, c});
+    SimFixture f({"--config", probe.write_file("vehicle.toml", two_muxed(0x70, 0, 0x70, 1))});
+    Bench b(f, {muxed(0x70, 0), muxed(0x70, 1)});
     REQUIRE(f.call(f.thruster_path(0), "org.caracara.Simulator1.Thruster", "SetNack", "b", 1) == "");
     CHECK(b.thrusters[0]->send_order(1000) == IoError::Nack);
     CHECK(b.thrusters[0]->counters().nacks == 1);
