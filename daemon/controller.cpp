@@ -5,6 +5,7 @@
 #include "packet.hpp"
 
 #include <cmath>
+#include <poll.h>
 #include <systemd/sd-daemon.h>
 #include <ctime>
 
@@ -173,14 +174,35 @@ int Controller::on_tick(sd_event_source* s, uint64_t usec, void* userdata) {
     return 0;
 }
 
+bool Controller::input_pending() const {
+    // Something for a higher-priority source: a D-Bus message (read already, or on the
+    // socket) or a kill switch edge. One poll() instead of a full event-loop iteration.
+    if (!bus_)
+        return true;
+    uint64_t queued = 0;
+    if (sd_bus_get_n_queued_read(bus_, &queued) >= 0 && queued > 0)
+        return true;
+    pollfd fds[2]{{sd_bus_get_fd(bus_), POLLIN, 0}, {-1, POLLIN, 0}};
+    if (kill_switch_)
+        fds[1].fd = kill_switch_->event_fd();
+    return ::poll(fds, 2, 0) != 0;
+}
+
 int Controller::on_work(sd_event_source*, void* userdata) {
     auto* self = static_cast<Controller*>(userdata);
-    if (!self->work_one()) {
-        sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
-        self->in_cycle_ = false;
-        self->last_cycle_ns_ = self->now();
-        if (self->config_.control.loop_rate_hz == 0)
-            self->cycle(); // as fast as the bus allows
+    // Transactions back to back while nothing else waits; the check between them keeps a
+    // Kill or a command at most one transaction away, as before.
+    for (int n = 0; n < 32; ++n) {
+        if (!self->work_one()) {
+            sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
+            self->in_cycle_ = false;
+            self->last_cycle_ns_ = self->now();
+            if (self->config_.control.loop_rate_hz == 0)
+                self->cycle(); // as fast as the bus allows
+            return 0;
+        }
+        if (self->input_pending())
+            return 0;
     }
     return 0;
 }
@@ -192,20 +214,26 @@ void Controller::cycle() {
     if (in_cycle_) {
         // The bus did not finish the last cycle in one period: refresh what is left rather
         // than piling work up. Orders stay due; status reads are not stacked.
-        mark_orders_due();
+        refresh_orders();
         publish_telemetry_if_due();
         return;
     }
     ++cycles_;
     in_cycle_ = true;
-    mark_orders_due();
+    refresh_orders();
     status_due_ = config_.control.status_reads_per_tick;
     teensy_due_ = spi_.is_open();
     publish_telemetry_if_due();
 }
 
-void Controller::mark_orders_due() {
-    order_due_.fill(true);
+void Controller::refresh_orders() {
+    // A burst still going out (a new command's orders) already refreshes every thruster:
+    // those sent are fresh, the rest are due. Restarting it would only delay the last ones.
+    bool any = false;
+    for (bool d : order_due_)
+        any = any || d;
+    if (!any)
+        order_due_.fill(true);
     if (work_source_)
         sd_event_source_set_enabled(work_source_.get(), SD_EVENT_ON);
 }
@@ -553,12 +581,20 @@ Result Controller::accept_motors(const MotorValues& wanted, bool mix_saturated, 
     const bool saturated = b.saturated || mix_saturated;
     // A stream re-sending the same command changes nothing worth announcing.
     const bool changed = requested_ != wanted || applied_ != b.motors || limit_ != limit || saturated_ != saturated;
+    // The changed orders go out now, one transaction per loop iteration, not at the next tick;
+    // an unchanged one is already on the wire and refreshed by the tick.
+    bool any_due = false;
+    for (size_t i = 0; i < kMotorCount; ++i)
+        if (applied_[i] != b.motors[i] || ordered_[i] != b.motors[i]) {
+            order_due_[i] = true;
+            any_due = true;
+        }
     requested_ = wanted;
     applied_ = b.motors;
     limit_ = limit;
     saturated_ = saturated;
-    // The new orders go out now, one transaction per loop iteration, not at the next tick.
-    mark_orders_due();
+    if (any_due && work_source_)
+        sd_event_source_set_enabled(work_source_.get(), SD_EVENT_ON);
     notify((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
     return {};
 }

@@ -115,6 +115,7 @@ public:
     // Orders zero to every thruster (SIGTERM, fatal errors). Safe to call more than once.
     void shutdown();
     void set_observer(ControllerObserver* o) { observer_ = o; }
+    void set_bus(sd_bus* bus) { bus_ = bus; }
 
     Result set_thrust(std::span<const int32_t> values, std::string_view client);
     Result set_motion(const AxisDemand& demand, std::string_view client);
@@ -158,6 +159,7 @@ public:
 private:
     static int on_tick(sd_event_source*, uint64_t usec, void* userdata);
     static int on_work(sd_event_source*, void* userdata);
+    bool input_pending() const;
     static int on_turn_step(sd_event_source*, uint64_t usec, void* userdata);
     static int on_kill_switch(sd_event_source*, int fd, uint32_t revents, void* userdata);
     static int on_recovery_timer(sd_event_source*, uint64_t usec, void* userdata);
@@ -177,7 +179,7 @@ private:
     uint64_t now() const;
     void cycle();
     bool work_one();
-    void mark_orders_due();
+    void refresh_orders();
     void send_order(size_t i);
     void zero_now();
     void handle(const SafetyAction& a);
@@ -202,6 +204,7 @@ private:
     TeensyLink teensy_link_;
     SafetyMachine safety_;
     ControllerObserver* observer_ = nullptr;
+    sd_bus* bus_ = nullptr;
 
     MotorValues requested_{};
     MotorValues applied_{};

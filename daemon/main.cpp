@@ -169,6 +169,7 @@ int main(int argc, char** argv) {
     // Losing the bus ends the loop; the thrusters are zeroed on the way out and systemd restarts us.
     sd_bus_set_exit_on_disconnect(bus.get(), 1);
     sd_bus_attach_event(bus.get(), event.get(), SD_EVENT_PRIORITY_NORMAL);
+    controller.set_bus(bus.get());
 
     uint64_t wd_usec = 0;
     Watchdog wd{&controller, 0};

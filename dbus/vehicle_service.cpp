@@ -431,6 +431,35 @@ int VehicleService::on_name_owner_changed(sd_bus_message* m, void* userdata, sd_
 }
 
 void VehicleService::vehicle_changed(uint32_t changes) {
+    // Announce after the reply that caused the change has gone out, coalesced.
+    sd_event* ev = sd_bus_get_event(bus_);
+    if (!ev) {
+        emit_vehicle_changes(changes);
+        return;
+    }
+    pending_ |= changes;
+    if (!flush_) {
+        sd_event_source* s = nullptr;
+        if (sd_event_add_defer(ev, &s, on_flush, this) < 0) {
+            emit_vehicle_changes(pending_);
+            pending_ = 0;
+            return;
+        }
+        flush_.reset(s);
+        sd_event_source_set_priority(s, SD_EVENT_PRIORITY_NORMAL + 1);
+    }
+    sd_event_source_set_enabled(flush_.get(), SD_EVENT_ONESHOT);
+}
+
+int VehicleService::on_flush(sd_event_source*, void* userdata) {
+    auto* self = static_cast<VehicleService*>(userdata);
+    const uint32_t c = self->pending_;
+    self->pending_ = 0;
+    self->emit_vehicle_changes(c);
+    return 0;
+}
+
+void VehicleService::emit_vehicle_changes(uint32_t changes) {
     std::vector<const char*> names;
     if (changes & kChangeState) {
         names.push_back("State");
@@ -479,11 +508,17 @@ VehicleService::ThrusterSnapshot VehicleService::snapshot(size_t i) const {
 }
 
 void VehicleService::telemetry() {
+    counters_due_ = (++publications_ % 5) == 0;
     const char* vehicle_names[] = {"CommandAgeMs", "Cycles", nullptr};
     sd_bus_emit_properties_changed_strv(bus_, kRootPath, kVehicleIface, const_cast<char**>(vehicle_names));
 
     for (size_t i = 0; i < thruster_objects_.size(); ++i) {
         ThrusterSnapshot now = snapshot(i);
+        if (!counters_due_) {
+            // Steady counters (one more order every tick) are announced at 1 Hz, not 5 Hz.
+            now.orders = published_[i].orders;
+            now.reads = published_[i].reads;
+        }
         const ThrusterSnapshot& was = published_[i];
         if (now == was)
             continue;
@@ -517,7 +552,7 @@ void VehicleService::telemetry() {
     if (te.servos != published_teensy_.servos) tn.push_back("Servos");
     if (te.turning != published_teensy_.turning) tn.push_back("Task");
     if (te.online != published_teensy_.online) tn.push_back("Online");
-    if (tc.frames != published_teensy_frames_) tn.push_back("Frames");
+    if (counters_due_ && tc.frames != published_teensy_frames_) tn.push_back("Frames");
     if (tc.busy_retries != published_teensy_busy_) tn.push_back("BusyRetries");
     if (tc.link_errors != published_teensy_errors_) tn.push_back("LinkErrors");
     if (!tn.empty()) {
@@ -525,7 +560,8 @@ void VehicleService::telemetry() {
         sd_bus_emit_properties_changed_strv(bus_, (std::string(kRootPath) + "/teensy").c_str(), kTeensyIface,
                                             const_cast<char**>(tn.data()));
         published_teensy_ = te;
-        published_teensy_frames_ = tc.frames;
+        if (counters_due_)
+            published_teensy_frames_ = tc.frames;
         published_teensy_busy_ = tc.busy_retries;
         published_teensy_errors_ = tc.link_errors;
     }
@@ -537,7 +573,7 @@ void VehicleService::emit_bus_changes() {
     const BusTelemetry& b = controller_.bus();
     std::vector<const char*> bn;
     if (b.state != published_bus_.state) bn.push_back("State");
-    if (b.transactions != published_bus_.transactions) bn.push_back("Transactions");
+    if (counters_due_ && b.transactions != published_bus_.transactions) bn.push_back("Transactions");
     if (b.errors != published_bus_.errors) bn.push_back("Errors");
     if (b.last_error != published_bus_.last_error) bn.push_back("LastError");
     if (b.recoveries != published_bus_.recoveries) bn.push_back("Recoveries");

@@ -54,6 +54,12 @@ private:
     };
     ThrusterSnapshot snapshot(size_t i) const;
     void emit_bus_changes();
+    void emit_vehicle_changes(uint32_t changes);
+    static int on_flush(sd_event_source*, void* userdata);
+    uint32_t pending_ = 0;
+    uint64_t publications_ = 0;
+    bool counters_due_ = true;
+    SourcePtr flush_;
     static int on_name_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*);
 
     sd_bus* bus_;

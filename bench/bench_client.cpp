@@ -1,0 +1,664 @@
+// caracara-bench: the D-Bus side of the benchmarks (bench/run.py drives it). One sd-bus
+// connection, synchronous calls, CLOCK_MONOTONIC around them; the simulator's wire log
+// (stamped with the same clock at the end of each message) tells when the wire saw what.
+//
+//   caracara-bench rtt        --bus ADDR [--calls N] [--warmup N]
+//   caracara-bench cmd2wire   --bus ADDR [--samples N] [--phase-ms MS] [--seed S]
+//   caracara-bench kill2wire  --bus ADDR [--samples N] [--source dbus|switch] [--phase-ms MS]
+//   caracara-bench cycles     --bus ADDR --seconds S
+//   caracara-bench stream     --bus ADDR --hz H --seconds S
+//   caracara-bench wait-ready --bus ADDR [--timeout-ms MS]
+//
+// Every measuring command prints one JSON object on stdout.
+#include "bench_common.hpp"
+#include "sdbus.hpp"
+#include "seabotix.hpp"
+
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+using namespace caracara;
+using namespace caracara::bench;
+
+namespace {
+
+constexpr const char* kVehicle = "org.caracara.Vehicle1";
+constexpr const char* kVehiclePath = "/org/caracara/Vehicle1";
+constexpr const char* kSim = "org.caracara.Simulator1";
+constexpr const char* kSimPath = "/org/caracara/Simulator1";
+constexpr uint64_t kCallTimeoutUs = 10'000'000;
+
+using Values = std::array<int32_t, 8>;
+// Two command sets that differ in every motor and stay inside the 8-motor budget (4200),
+// so the daemon sends them unscaled and every thruster's SPEED byte changes between them.
+constexpr Values kSetA{3000, 3000, 3000, 3000, 3000, 3000, 3000, 3000};
+constexpr Values kSetB{-2000, -2000, -2000, -2000, -2000, -2000, -2000, -2000};
+
+[[noreturn]] void die(const char* what, int r) {
+    std::fprintf(stderr, "caracara-bench: %s: %s\n", what, std::strerror(r < 0 ? -r : r));
+    std::exit(1);
+}
+
+struct Entry {
+    uint64_t index = 0;
+    uint64_t time_ns = 0;
+    uint64_t txn = 0;
+    std::string bus;
+    uint16_t addr = 0;
+    bool read = false;
+    std::vector<uint8_t> data;
+    std::string result;
+};
+
+class Client {
+public:
+    explicit Client(const std::string& address) {
+        dbus::BusChoice c{dbus::BusChoice::Kind::Address, address};
+        if (int r = dbus::open_bus(c, "caracara-bench", bus_); r < 0)
+            die("cannot connect to the bus", r);
+    }
+    sd_bus* bus() { return bus_.get(); }
+
+    // Builds a SetThrust call (not timed), so the timed part is the call alone.
+    dbus::MessagePtr set_thrust_msg(const Values& v) {
+        sd_bus_message* m = nullptr;
+        int r = sd_bus_message_new_method_call(bus(), &m, kVehicle, kVehiclePath, kVehicle, "SetThrust");
+        if (r >= 0)
+            r = sd_bus_message_append_array(m, 'i', v.data(), v.size() * sizeof(int32_t));
+        if (r < 0)
+            die("building SetThrust", r);
+        return dbus::MessagePtr(m);
+    }
+    dbus::MessagePtr method_msg(const char* dest, const char* path, const char* iface, const char* member) {
+        sd_bus_message* m = nullptr;
+        if (int r = sd_bus_message_new_method_call(bus(), &m, dest, path, iface, member); r < 0)
+            die("building a call", r);
+        return dbus::MessagePtr(m);
+    }
+    // Sends and waits; returns 0 or the negative errno, with the D-Bus error name in `error`.
+    int call(dbus::MessagePtr& m, std::string* error = nullptr, dbus::MessagePtr* reply_out = nullptr) {
+        sd_bus_error err = SD_BUS_ERROR_NULL;
+        sd_bus_message* reply = nullptr;
+        int r = sd_bus_call(bus(), m.get(), kCallTimeoutUs, &err, &reply);
+        if (r < 0 && error)
+            *error = err.name ? err.name : std::strerror(-r);
+        sd_bus_error_free(&err);
+        if (reply_out)
+            reply_out->reset(reply);
+        else
+            sd_bus_message_unref(reply);
+        return r < 0 ? r : 0;
+    }
+    int set_thrust(const Values& v, std::string* error = nullptr) {
+        auto m = set_thrust_msg(v);
+        return call(m, error);
+    }
+    int vehicle_call(const char* member, std::string* error = nullptr) {
+        auto m = method_msg(kVehicle, kVehiclePath, kVehicle, member);
+        return call(m, error);
+    }
+    int set_kill_switch(bool on) {
+        auto m = method_msg(kSim, kSimPath, kSim, "SetKillSwitch");
+        if (int r = sd_bus_message_append(m.get(), "b", static_cast<int>(on)); r < 0)
+            die("SetKillSwitch", r);
+        std::string e;
+        int r = call(m, &e);
+        if (r < 0)
+            std::fprintf(stderr, "caracara-bench: SetKillSwitch: %s\n", e.c_str());
+        return r;
+    }
+    std::string get_string(const char* dest, const char* path, const char* iface, const char* member) {
+        sd_bus_error err = SD_BUS_ERROR_NULL;
+        char* s = nullptr;
+        int r = sd_bus_get_property_string(bus(), dest, path, iface, member, &err, &s);
+        sd_bus_error_free(&err);
+        if (r < 0)
+            return {};
+        std::string out = s;
+        std::free(s);
+        return out;
+    }
+    template <typename T>
+    T get_trivial(const char* dest, const char* path, const char* iface, const char* member, char type) {
+        sd_bus_error err = SD_BUS_ERROR_NULL;
+        T v{};
+        int r = sd_bus_get_property_trivial(bus(), dest, path, iface, member, &err, type, &v);
+        sd_bus_error_free(&err);
+        if (r < 0)
+            die(member, r);
+        return v;
+    }
+    std::string state() { return get_string(kVehicle, kVehiclePath, kVehicle, "State"); }
+    uint64_t cycles() { return get_trivial<uint64_t>(kVehicle, kVehiclePath, kVehicle, "Cycles", 't'); }
+
+    // GetWireLog(since): appends the entries to `out`, returns the next index.
+    uint64_t wire_log(uint64_t since, std::vector<Entry>* out) {
+        auto m = method_msg(kSim, kSimPath, kSim, "GetWireLog");
+        if (int r = sd_bus_message_append(m.get(), "t", since); r < 0)
+            die("GetWireLog", r);
+        dbus::MessagePtr reply;
+        std::string e;
+        if (int r = call(m, &e, &reply); r < 0) {
+            std::fprintf(stderr, "caracara-bench: GetWireLog: %s\n", e.c_str());
+            std::exit(1);
+        }
+        sd_bus_message* rp = reply.get();
+        uint64_t next = 0;
+        int r = sd_bus_message_read(rp, "t", &next);
+        if (r >= 0)
+            r = sd_bus_message_enter_container(rp, 'a', "(tttsqbayays)");
+        while (r >= 0) {
+            r = sd_bus_message_enter_container(rp, 'r', "tttsqbayays");
+            if (r <= 0)
+                break;
+            Entry en;
+            const char* busname = nullptr;
+            int rd = 0;
+            r = sd_bus_message_read(rp, "tttsqb", &en.index, &en.time_ns, &en.txn, &busname, &en.addr, &rd);
+            const void* p = nullptr;
+            size_t n = 0;
+            if (r >= 0)
+                r = sd_bus_message_read_array(rp, 'y', &p, &n);
+            if (r >= 0 && n)
+                en.data.assign(static_cast<const uint8_t*>(p), static_cast<const uint8_t*>(p) + n);
+            if (r >= 0)
+                r = sd_bus_message_read_array(rp, 'y', &p, &n); // miso: not needed
+            const char* res = nullptr;
+            if (r >= 0)
+                r = sd_bus_message_read(rp, "s", &res);
+            if (r >= 0)
+                r = sd_bus_message_exit_container(rp);
+            if (r < 0)
+                break;
+            en.bus = busname ? busname : "";
+            en.read = rd != 0;
+            en.result = res ? res : "";
+            if (out)
+                out->push_back(std::move(en));
+        }
+        if (r < 0)
+            die("parsing the wire log", r);
+        return next;
+    }
+    uint64_t wire_next() { return wire_log(UINT64_MAX, nullptr); }
+
+    bool wait_ready(uint64_t timeout_ns) {
+        const uint64_t end = mono_ns() + timeout_ns;
+        while (mono_ns() < end) {
+            if (state() == "ready")
+                return true;
+            sleep_ns(1'000'000);
+        }
+        return false;
+    }
+
+private:
+    dbus::BusPtr bus_;
+};
+
+struct Args {
+    std::string command;
+    std::string bus;
+    long calls = 10000;
+    long warmup = 500;
+    long samples = 500;
+    double phase_ms = 20;
+    double seconds = 5;
+    double hz = 20;
+    double timeout_ms = 10000;
+    uint64_t seed = 1;
+    std::string source = "dbus";
+};
+
+Args parse(int argc, char** argv) {
+    Args a;
+    if (argc < 2) {
+        std::fprintf(stderr, "usage: caracara-bench rtt|cmd2wire|kill2wire|cycles|stream|wait-ready --bus ADDR ...\n");
+        std::exit(2);
+    }
+    a.command = argv[1];
+    for (int i = 2; i < argc; ++i) {
+        std::string k = argv[i];
+        if (i + 1 >= argc) {
+            std::fprintf(stderr, "caracara-bench: %s needs a value\n", k.c_str());
+            std::exit(2);
+        }
+        const char* v = argv[++i];
+        if (k == "--bus") a.bus = v;
+        else if (k == "--calls") a.calls = std::strtol(v, nullptr, 10);
+        else if (k == "--warmup") a.warmup = std::strtol(v, nullptr, 10);
+        else if (k == "--samples") a.samples = std::strtol(v, nullptr, 10);
+        else if (k == "--phase-ms") a.phase_ms = std::strtod(v, nullptr);
+        else if (k == "--seconds") a.seconds = std::strtod(v, nullptr);
+        else if (k == "--hz") a.hz = std::strtod(v, nullptr);
+        else if (k == "--timeout-ms") a.timeout_ms = std::strtod(v, nullptr);
+        else if (k == "--seed") a.seed = std::strtoull(v, nullptr, 10);
+        else if (k == "--source") a.source = v;
+        else {
+            std::fprintf(stderr, "caracara-bench: unknown option %s\n", k.c_str());
+            std::exit(2);
+        }
+    }
+    if (a.bus.empty()) {
+        std::fprintf(stderr, "caracara-bench: --bus ADDR is required\n");
+        std::exit(2);
+    }
+    return a;
+}
+
+// --- 1. SetThrust round trip against Peer.Ping ---------------------------------------------
+
+int cmd_rtt(const Args& a) {
+    Client c(a.bus);
+    if (!c.wait_ready(10'000'000'000ull)) {
+        std::fprintf(stderr, "caracara-bench: the vehicle is not ready\n");
+        return 1;
+    }
+    std::vector<double> st, ping;
+    st.reserve(static_cast<size_t>(a.calls));
+    ping.reserve(static_cast<size_t>(a.calls));
+    long errors = 0;
+    std::string last_error;
+    // Interleaved one by one: each SetThrust follows a Ping and each Ping follows a SetThrust,
+    // so both meet the daemon in the same state (the orders of the previous command going out).
+    for (long i = 0; i < a.warmup + a.calls; ++i) {
+        auto m1 = c.set_thrust_msg(i % 2 ? kSetA : kSetB);
+        auto m2 = c.method_msg(kVehicle, kVehiclePath, "org.freedesktop.DBus.Peer", "Ping");
+        uint64_t t0 = mono_ns();
+        int r = c.call(m1, &last_error);
+        uint64_t t1 = mono_ns();
+        if (r < 0)
+            ++errors;
+        uint64_t t2 = mono_ns();
+        c.call(m2);
+        uint64_t t3 = mono_ns();
+        if (i >= a.warmup) {
+            st.push_back(static_cast<double>(t1 - t0) / 1000.0);
+            ping.push_back(static_cast<double>(t3 - t2) / 1000.0);
+        }
+    }
+    // Diagnostic: the same pair while the vehicle is killed. SetThrust is then refused
+    // (Killed) after the same parsing and validation, with no orders and no PropertiesChanged,
+    // so the difference to the accepted call is what acceptance costs (orders, signal).
+    std::vector<double> refused, ping_killed;
+    if (c.vehicle_call("Kill") == 0) {
+        const long n = std::max(1L, a.calls / 4);
+        for (long i = 0; i < a.warmup + n; ++i) {
+            auto m1 = c.set_thrust_msg(i % 2 ? kSetA : kSetB);
+            auto m2 = c.method_msg(kVehicle, kVehiclePath, "org.freedesktop.DBus.Peer", "Ping");
+            uint64_t t0 = mono_ns();
+            c.call(m1);
+            uint64_t t1 = mono_ns();
+            c.call(m2);
+            uint64_t t2 = mono_ns();
+            if (i >= a.warmup) {
+                refused.push_back(static_cast<double>(t1 - t0) / 1000.0);
+                ping_killed.push_back(static_cast<double>(t2 - t1) / 1000.0);
+            }
+        }
+        c.vehicle_call("ClearKill");
+    }
+    std::printf("{\"calls\": %ld, \"errors\": %ld, \"last_error\": \"%s\", \"setthrust_us\": %s, \"ping_us\": %s, "
+                "\"refused_setthrust_us\": %s, \"ping_while_killed_us\": %s}\n",
+                a.calls, errors, errors ? last_error.c_str() : "", stats_json(st).c_str(), stats_json(ping).c_str(),
+                stats_json(refused).c_str(), stats_json(ping_killed).c_str());
+    return 0;
+}
+
+// --- wire-log helpers ----------------------------------------------------------------------
+
+struct Vehicle {
+    uint32_t clock_hz = 100000;
+    std::array<uint16_t, 8> addr7{};
+    std::array<bool, 8> reversed{};
+    uint8_t speed(size_t i, int32_t v) const { return motor_to_speed(reversed[i] ? -v : v).value_or(0x80); }
+};
+
+Vehicle describe(Client& c) {
+    Vehicle v;
+    v.clock_hz = c.get_trivial<uint32_t>(kSim, kSimPath, kSim, "ClockHz", 'u');
+    for (size_t i = 0; i < 8; ++i) {
+        const std::string p = std::string(kVehiclePath) + "/thruster/" + std::to_string(i);
+        const uint8_t mt = c.get_trivial<uint8_t>(kVehicle, p.c_str(), "org.caracara.Vehicle1.Thruster", "Address", 'y');
+        v.addr7[i] = static_cast<uint16_t>(mt >> 1);
+        v.reversed[i] = c.get_trivial<int>(kVehicle, p.c_str(), "org.caracara.Vehicle1.Thruster", "Reversed", 'b') != 0;
+    }
+    return v;
+}
+
+bool is_order(const Entry& e) { return e.bus == "i2c" && !e.read && e.data.size() == 3 && e.result == "ack"; }
+bool is_zero_speed(uint8_t s) { return s == 0x80 || s == 0x7F; }
+
+const char* kind_of(const Entry& e) {
+    if (e.bus == "spi")
+        return "spi";
+    if (e.bus == "i2c")
+        return e.read ? "status-read" : (e.data.size() == 3 ? "order" : "i2c-other");
+    return "other";
+}
+
+// Polls the wire log from `since` into `log` until `done(log)` or the deadline.
+template <typename Done>
+bool poll_log(Client& c, uint64_t since, std::vector<Entry>& log, uint64_t deadline, Done done) {
+    uint64_t next = since;
+    for (;;) {
+        next = c.wire_log(next, &log);
+        if (done(log))
+            return true;
+        if (mono_ns() > deadline)
+            return false;
+        sleep_ns(1'000'000);
+    }
+}
+
+struct Tally {
+    std::map<std::string, long> inflight_kind; // what ended on the wire after t0, before the first new order
+    std::map<std::string, long> preceding;     // how many such transactions: "0", "1", "2+"
+    void add(const std::vector<Entry>& log, size_t first_new, uint64_t t0) {
+        long n = 0;
+        const Entry* first = nullptr;
+        for (size_t k = 0; k < first_new; ++k)
+            if (log[k].time_ns > t0 && log[k].bus != "i2c-lines") {
+                ++n;
+                if (!first)
+                    first = &log[k];
+            }
+        preceding[n == 0 ? "0" : n == 1 ? "1" : "2+"]++;
+        inflight_kind[first ? kind_of(*first) : "idle"]++;
+    }
+    std::string json() const {
+        std::string s = "{\"preceding\": {";
+        bool comma = false;
+        for (auto& [k, v] : preceding) {
+            s += (comma ? ", \"" : "\"") + k + "\": " + std::to_string(v);
+            comma = true;
+        }
+        s += "}, \"inflight_kind\": {";
+        comma = false;
+        for (auto& [k, v] : inflight_kind) {
+            s += (comma ? ", \"" : "\"") + k + "\": " + std::to_string(v);
+            comma = true;
+        }
+        return s + "}}";
+    }
+};
+
+// --- 2. command to wire --------------------------------------------------------------------
+
+int cmd_cmd2wire(const Args& a) {
+    Client c(a.bus);
+    if (!c.wait_ready(10'000'000'000ull)) {
+        std::fprintf(stderr, "caracara-bench: the vehicle is not ready\n");
+        return 1;
+    }
+    const Vehicle veh = describe(c);
+    const double bit_us = 1e6 / veh.clock_hz;
+    Rng rng(a.seed);
+    std::vector<double> last_us, first_us, reply_us, spacing_us, busy_last, idle_last, residual_us, burst_txns;
+    Tally tally;
+    long missing = 0;
+    // Start from a known command.
+    c.set_thrust(kSetB);
+    sleep_ns(50'000'000);
+    for (long s = 0; s < a.samples; ++s) {
+        const Values& v = (s % 2 == 0) ? kSetA : kSetB;
+        sleep_ns(static_cast<uint64_t>(rng.below(static_cast<uint64_t>(a.phase_ms * 1e6))));
+        const uint64_t since = c.wire_next();
+        const uint64_t t0 = mono_ns();
+        std::string err;
+        if (c.set_thrust(v, &err) < 0) {
+            std::fprintf(stderr, "caracara-bench: SetThrust: %s\n", err.c_str());
+            if (!c.wait_ready(5'000'000'000ull))
+                return 1;
+            continue;
+        }
+        const uint64_t t1 = mono_ns();
+        sleep_ns(6'000'000); // let the burst go out before we ask the simulator anything
+        std::vector<Entry> log;
+        const uint8_t want_last = veh.speed(7, v[7]);
+        auto found_last = [&](const std::vector<Entry>& l) {
+            for (const Entry& e : l)
+                if (is_order(e) && e.addr == veh.addr7[7] && e.data[0] == want_last && e.time_ns > t0)
+                    return true;
+            return false;
+        };
+        if (!poll_log(c, since, log, mono_ns() + 500'000'000ull, found_last)) {
+            ++missing;
+            continue;
+        }
+        size_t first_new = log.size(), last_new = log.size();
+        for (size_t k = 0; k < log.size(); ++k) {
+            const Entry& e = log[k];
+            if (!is_order(e) || e.time_ns <= t0)
+                continue;
+            for (size_t i = 0; i < 8; ++i)
+                if (e.addr == veh.addr7[i] && e.data[0] == veh.speed(i, v[i])) {
+                    if (first_new == log.size())
+                        first_new = k;
+                    if (i == 7 && last_new == log.size())
+                        last_new = k;
+                }
+        }
+        const double lat = static_cast<double>(log[last_new].time_ns - t0) / 1000.0;
+        last_us.push_back(lat);
+        first_us.push_back(static_cast<double>(log[first_new].time_ns - t0) / 1000.0);
+        reply_us.push_back(static_cast<double>(t1 - t0) / 1000.0);
+        // Spacing between consecutive orders of the burst: wire time plus per-transaction overhead.
+        if (last_new > first_new)
+            spacing_us.push_back(static_cast<double>(log[last_new].time_ns - log[first_new].time_ns) / 1000.0 /
+                                 static_cast<double>(last_new - first_new));
+        tally.add(log, first_new, t0);
+        // Transactions from the first new order to the last one: 8 when the burst went out
+        // undisturbed; more when something (a tick, a status read) came in between.
+        long between = 0;
+        for (size_t k = first_new; k <= last_new; ++k)
+            if (log[k].bus != "i2c-lines")
+                ++between;
+        burst_txns.push_back(static_cast<double>(between));
+        if (std::getenv("CARACARA_BENCH_DEBUG") && lat > 5000) {
+            std::fprintf(stderr, "sample %ld: %.0f us, t0=%llu\n", s, lat, static_cast<unsigned long long>(t0));
+            for (const Entry& e : log)
+                std::fprintf(stderr, "  %+9.1f us %-5s addr 0x%02x %s %s\n",
+                             (static_cast<double>(e.time_ns) - static_cast<double>(t0)) / 1000.0, e.bus.c_str(), e.addr,
+                             kind_of(e), e.data.empty() ? "" : std::to_string(e.data[0]).c_str());
+        }
+        bool busy = false;
+        for (size_t k = 0; k < first_new; ++k)
+            if (log[k].time_ns > t0 && log[k].bus != "i2c-lines") {
+                busy = true;
+                residual_us.push_back(static_cast<double>(log[k].time_ns - t0) / 1000.0);
+                break;
+            }
+        (busy ? busy_last : idle_last).push_back(lat);
+    }
+    const double order_bits = 38; // START + 3 x 9-bit bytes + address byte + STOP
+    std::printf("{\"samples\": %ld, \"missing\": %ld, \"clock_hz\": %u, \"order_wire_us\": %.3f, \"floor_us\": %.3f, "
+                "\"last_us\": %s, \"first_us\": %s, \"reply_us\": %s, \"spacing_us\": %s, \"last_us_bus_idle\": %s, "
+                "\"last_us_bus_busy\": %s, \"inflight_residual_us\": %s, \"burst_transactions\": %s, \"tally\": %s, "
+                "\"raw\": {\"last_us\": %s, \"first_us\": %s, \"burst_transactions\": %s, \"busy_last_us\": %s, "
+                "\"idle_last_us\": %s, \"inflight_residual_us\": %s, \"spacing_us\": %s}}\n",
+                a.samples, missing, veh.clock_hz, order_bits * bit_us, 8 * order_bits * bit_us,
+                stats_json(last_us).c_str(), stats_json(first_us).c_str(), stats_json(reply_us).c_str(),
+                stats_json(spacing_us).c_str(), stats_json(idle_last).c_str(), stats_json(busy_last).c_str(),
+                stats_json(residual_us).c_str(), stats_json(burst_txns).c_str(), tally.json().c_str(),
+                array_json(last_us).c_str(), array_json(first_us).c_str(), array_json(burst_txns).c_str(),
+                array_json(busy_last).c_str(), array_json(idle_last).c_str(), array_json(residual_us).c_str(),
+                array_json(spacing_us).c_str());
+    return 0;
+}
+
+// --- 3. kill to wire -----------------------------------------------------------------------
+
+int cmd_kill2wire(const Args& a) {
+    const bool by_switch = a.source == "switch";
+    Client c(a.bus);
+    const Vehicle veh = describe(c);
+    const double bit_us = 1e6 / veh.clock_hz;
+    Rng rng(a.seed + 7);
+    std::vector<double> all_us, first_us, call_us;
+    Tally tally;
+    long missing = 0, not_holding = 0, not_ready = 0;
+    auto rearm = [&]() {
+        if (by_switch)
+            c.set_kill_switch(false);
+        if (c.state() == "killed") {
+            std::string e;
+            if (c.vehicle_call("ClearKill", &e) < 0)
+                std::fprintf(stderr, "caracara-bench: ClearKill: %s\n", e.c_str());
+        }
+        return c.wait_ready(5'000'000'000ull);
+    };
+    for (long s = 0; s < a.samples; ++s) {
+        if (!rearm()) {
+            ++not_ready;
+            if (not_ready > 5) {
+                std::fprintf(stderr, "caracara-bench: the vehicle does not become ready again\n");
+                return 1;
+            }
+            continue;
+        }
+        // Drive all eight, and wait until the last one runs the new order.
+        const Values& v = (s % 2 == 0) ? kSetA : kSetB;
+        uint64_t since = c.wire_next();
+        const uint64_t tc = mono_ns();
+        if (c.set_thrust(v) < 0)
+            continue;
+        std::vector<Entry> pre;
+        const uint8_t want_last = veh.speed(7, v[7]);
+        poll_log(c, since, pre, mono_ns() + 500'000'000ull, [&](const std::vector<Entry>& l) {
+            for (const Entry& e : l)
+                if (is_order(e) && e.addr == veh.addr7[7] && e.data[0] == want_last && e.time_ns > tc)
+                    return true;
+            return false;
+        });
+        sleep_ns(static_cast<uint64_t>(rng.below(static_cast<uint64_t>(a.phase_ms * 1e6))));
+        since = c.wire_next();
+        const uint64_t t0 = mono_ns();
+        if (by_switch) {
+            if (c.set_kill_switch(true) < 0)
+                return 1;
+        } else {
+            std::string e;
+            if (c.vehicle_call("Kill", &e) < 0) {
+                std::fprintf(stderr, "caracara-bench: Kill: %s\n", e.c_str());
+                return 1;
+            }
+        }
+        const uint64_t t1 = mono_ns();
+        call_us.push_back(static_cast<double>(t1 - t0) / 1000.0);
+        sleep_ns(8'000'000);
+        std::vector<Entry> log;
+        auto all_zero = [&](const std::vector<Entry>& l) {
+            size_t seen = 0;
+            for (size_t i = 0; i < 8; ++i)
+                for (const Entry& e : l)
+                    if (is_order(e) && e.addr == veh.addr7[i] && is_zero_speed(e.data[0]) && e.time_ns > t0) {
+                        ++seen;
+                        break;
+                    }
+            return seen == 8;
+        };
+        if (!poll_log(c, since, log, mono_ns() + 500'000'000ull, all_zero)) {
+            ++missing;
+            continue;
+        }
+        uint64_t worst = 0, first = UINT64_MAX;
+        size_t first_zero = log.size();
+        for (size_t i = 0; i < 8; ++i) {
+            bool zeroed = false;
+            for (size_t k = 0; k < log.size(); ++k) {
+                const Entry& e = log[k];
+                if (!is_order(e) || e.addr != veh.addr7[i] || e.time_ns <= t0)
+                    continue;
+                if (!zeroed && is_zero_speed(e.data[0])) {
+                    zeroed = true;
+                    worst = std::max(worst, e.time_ns);
+                    first = std::min(first, e.time_ns);
+                    first_zero = std::min(first_zero, k);
+                } else if (zeroed && !is_zero_speed(e.data[0])) {
+                    ++not_holding; // a non-zero order after the zero one: the kill did not hold
+                }
+            }
+        }
+        all_us.push_back(static_cast<double>(worst - t0) / 1000.0);
+        first_us.push_back(static_cast<double>(first - t0) / 1000.0);
+        tally.add(log, first_zero, t0);
+    }
+    rearm();
+    c.set_thrust({0, 0, 0, 0, 0, 0, 0, 0});
+    const double order_bits = 38;
+    std::printf("{\"source\": \"%s\", \"samples\": %ld, \"missing\": %ld, \"not_holding\": %ld, \"clock_hz\": %u, "
+                "\"floor_us\": %.3f, \"all_zero_us\": %s, \"first_zero_us\": %s, \"call_us\": %s, \"tally\": %s, "
+                "\"raw\": {\"all_zero_us\": %s, \"first_zero_us\": %s, \"call_us\": %s}}\n",
+                a.source.c_str(), a.samples, missing, not_holding, veh.clock_hz, 8 * order_bits * bit_us,
+                stats_json(all_us).c_str(), stats_json(first_us).c_str(), stats_json(call_us).c_str(),
+                tally.json().c_str(), array_json(all_us).c_str(), array_json(first_us).c_str(),
+                array_json(call_us).c_str());
+    return 0;
+}
+
+// --- 4. loop rate, and a command stream for the cost figures ---------------------------------
+
+int cmd_cycles(const Args& a) {
+    Client c(a.bus);
+    const uint64_t c0 = c.cycles();
+    const uint64_t t0 = mono_ns();
+    sleep_ns(static_cast<uint64_t>(a.seconds * 1e9));
+    const uint64_t c1 = c.cycles();
+    const uint64_t t1 = mono_ns();
+    const double secs = static_cast<double>(t1 - t0) / 1e9;
+    std::printf("{\"cycles\": %llu, \"seconds\": %.6f, \"rate_hz\": %.3f, \"start\": %llu}\n",
+                static_cast<unsigned long long>(c1 - c0), secs, static_cast<double>(c1 - c0) / secs,
+                static_cast<unsigned long long>(c0));
+    return 0;
+}
+
+int cmd_stream(const Args& a) {
+    Client c(a.bus);
+    const uint64_t period = static_cast<uint64_t>(1e9 / a.hz);
+    const uint64_t start = mono_ns();
+    const uint64_t end = start + static_cast<uint64_t>(a.seconds * 1e9);
+    uint64_t next = start;
+    long calls = 0, errors = 0;
+    std::string last_error;
+    while (mono_ns() < end) {
+        if (c.set_thrust(calls % 2 ? kSetA : kSetB, &last_error) < 0)
+            ++errors;
+        ++calls;
+        next += period;
+        sleep_until_ns(next);
+    }
+    std::printf("{\"calls\": %ld, \"errors\": %ld, \"last_error\": \"%s\"}\n", calls, errors,
+                errors ? last_error.c_str() : "");
+    return 0;
+}
+
+int cmd_wait_ready(const Args& a) {
+    Client c(a.bus);
+    if (!c.wait_ready(static_cast<uint64_t>(a.timeout_ms * 1e6))) {
+        std::fprintf(stderr, "caracara-bench: not ready after %.0f ms (state '%s')\n", a.timeout_ms, c.state().c_str());
+        return 1;
+    }
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    const Args a = parse(argc, argv);
+    if (a.command == "rtt") return cmd_rtt(a);
+    if (a.command == "cmd2wire") return cmd_cmd2wire(a);
+    if (a.command == "kill2wire") return cmd_kill2wire(a);
+    if (a.command == "cycles") return cmd_cycles(a);
+    if (a.command == "stream") return cmd_stream(a);
+    if (a.command == "wait-ready") return cmd_wait_ready(a);
+    std::fprintf(stderr, "caracara-bench: unknown command %s\n", a.command.c_str());
+    return 2;
+}

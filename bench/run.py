@@ -1,0 +1,689 @@
+#!/usr/bin/python3
+"""Caracara benchmarks: latency to the wire, kill latency, loop rate, CPU and memory.
+
+Benchmarks print figures; they never fail on time. Every figure is measured next to its
+floor in the same run. See bench/README.md for what each figure and floor is.
+
+    bench/run.py --build DIR [--quick] [--out FILE] [--rss-seconds S]
+
+bench/run.sh builds the programs and calls this with the right interpreter (/usr/bin/python3).
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def log(msg):
+    print(f"[bench {time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
+
+
+class Bench:
+    def __init__(self, build, quick, keep):
+        self.build = build
+        self.quick = quick
+        self.keep = keep
+        self.dir = tempfile.mkdtemp(prefix="caracara-bench.")
+        self.procs = []
+        self.rt = False
+        self.rt_active = True
+        self.bus = None
+        self.sock = os.path.join(self.dir, "sim.sock")
+        self.daemon = None
+        self.sim = None
+        self.dbusd = None
+        self.exe = {
+            "daemon": os.path.join(build, "daemon", "caracarad"),
+            "sim": os.path.join(build, "sim", "caracara-sim"),
+            "client": os.path.join(build, "bench", "caracara-bench"),
+            "floor": os.path.join(build, "bench", "caracara-bench-floor"),
+        }
+        for name, path in self.exe.items():
+            if not os.access(path, os.X_OK):
+                sys.exit(f"bench: {path} is missing; build first (bench/run.sh does)")
+
+    # --- processes --------------------------------------------------------------------
+
+    def prefix(self):
+        return ["chrt", "-f", "10"] if self.rt and self.rt_active else []
+
+    def spawn(self, argv, name, **kw):
+        argv = [*self.prefix(), *argv]
+        out = open(os.path.join(self.dir, f"{name}.log"), "ab")
+        p = subprocess.Popen(argv, stdout=kw.pop("stdout", out), stderr=out, **kw)
+        self.procs.append(p)
+        return p
+
+    def stop(self, p, sig=signal.SIGTERM, timeout=20):
+        if p is None or p.poll() is not None:
+            return
+        try:
+            p.send_signal(signal.SIGCONT)
+            p.send_signal(sig)
+            p.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+
+    def cleanup(self):
+        for p in reversed(self.procs):
+            self.stop(p, timeout=5)
+        self.procs = []
+        if not self.keep:
+            shutil.rmtree(self.dir, ignore_errors=True)
+
+    def start_bus(self):
+        conf = os.path.join(self.dir, "bus.conf")
+        path = os.path.join(self.dir, "bus")
+        with open(conf, "w") as f:
+            f.write(f"""<!DOCTYPE busconfig PUBLIC "-//freedesktop//DTD D-Bus Bus Configuration 1.0//EN"
+ "http://www.freedesktop.org/standards/dbus/1.0/busconfig.dtd">
+<busconfig><type>session</type><listen>unix:path={path}</listen><auth>EXTERNAL</auth>
+<policy context="default"><allow send_destination="*" eavesdrop="true"/><allow eavesdrop="true"/><allow own="*"/></policy>
+</busconfig>
+""")
+        self.dbusd = self.spawn(["dbus-daemon", "--nofork", f"--config-file={conf}"], "dbus-daemon")
+        self.bus = f"unix:path={path}"
+        self.wait_for(lambda: os.path.exists(path), 10, "the private dbus-daemon")
+
+    def wait_for(self, pred, timeout, what):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if pred():
+                return
+            time.sleep(0.02)
+        raise RuntimeError(f"timed out waiting for {what}")
+
+    def busctl(self, *args, check=True):
+        r = subprocess.run(["busctl", f"--address={self.bus}", *args], capture_output=True, text=True)
+        if check and r.returncode != 0:
+            raise RuntimeError(f"busctl {' '.join(args)}: {r.stderr.strip()}")
+        return r
+
+    def sim_call(self, method, sig="", *args):
+        return self.busctl("call", "org.caracara.Simulator1", "/org/caracara/Simulator1", "org.caracara.Simulator1",
+                           method, *([sig, *map(str, args)] if sig else []))
+
+    def start_sim(self, realistic):
+        self.stop_sim()
+        if os.path.exists(self.sock):
+            os.unlink(self.sock)
+        argv = [self.exe["sim"], "--socket", self.sock, "--bus-address", self.bus]
+        if realistic:
+            argv.append("--realistic-timing")
+        self.sim = self.spawn(argv, "sim")
+
+        def up():
+            return os.path.exists(self.sock) and self.busctl(
+                "get-property", "org.caracara.Simulator1", "/org/caracara/Simulator1", "org.caracara.Simulator1",
+                "ClockHz", check=False).returncode == 0
+        self.wait_for(up, 10, "caracara-sim")
+
+    def stop_sim(self):
+        self.stop(self.sim)
+        self.sim = None
+
+    def sim_has_kill_switch(self):
+        r = self.busctl("introspect", "--xml-interface", "org.caracara.Simulator1", "/org/caracara/Simulator1",
+                        check=False)
+        return r.returncode == 0 and re.search(r'<method name="SetKillSwitch"', r.stdout) is not None
+
+    def daemon_config(self, rate, reads=1, kill_switch=False):
+        path = os.path.join(self.dir, f"caracarad-{rate}-{int(kill_switch)}.toml")
+        with open(path, "w") as f:
+            f.write(f"""# generated by bench/run.py
+[control]
+loop_rate_hz = {rate}
+status_reads_per_tick = {reads}
+command_timeout_ms = 500
+arming_delay_ms = 0
+""")
+            if kill_switch:
+                f.write('[gpio]\nkill_switch = { chip = "gpiochip0", line = "KILL_SWITCH" }\n')
+        return path
+
+    def start_daemon(self, config, wrapper=(), ready_timeout=20):
+        self.stop_daemon()
+        argv = [*wrapper, self.exe["daemon"], f"--hardware=sim:{self.sock}", "--bus-address", self.bus,
+                "--config", config]
+        self.daemon = self.spawn(argv, "caracarad")
+        r = subprocess.run([self.exe["client"], "wait-ready", "--bus", self.bus,
+                            "--timeout-ms", str(ready_timeout * 1000)], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"caracarad did not become ready: {r.stderr.strip()}")
+        return self.daemon
+
+    def stop_daemon(self):
+        self.stop(self.daemon, timeout=60)
+        self.daemon = None
+
+    def client(self, *args, timeout=None):
+        r = subprocess.run([*self.prefix(), self.exe["client"], *map(str, args), "--bus", self.bus],
+                           capture_output=True, text=True,
+                           timeout=timeout)
+        if r.returncode != 0:
+            raise RuntimeError(f"caracara-bench {' '.join(map(str, args))}: {r.stderr.strip()}")
+        if r.stderr.strip():
+            log(r.stderr.strip())
+        return json.loads(r.stdout)
+
+    def floor(self, *args, config=None, wrapper=()):
+        argv = [*self.prefix(), *wrapper, self.exe["floor"], "--socket", self.sock, *map(str, args)]
+        if config:
+            argv += ["--config", config]
+        r = subprocess.run(argv, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"caracara-bench-floor {' '.join(map(str, args))}: {r.stderr.strip()}")
+        return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+# --- /proc helpers --------------------------------------------------------------------------
+
+def cpu_ns(pid):
+    with open(f"/proc/{pid}/schedstat") as f:
+        return int(f.read().split()[0])
+
+
+def status_kib(pid, key):
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith(key + ":"):
+                return int(line.split()[1])
+    return 0
+
+
+def callgrind_total(path):
+    """Total Ir of a callgrind output file (its 'totals:' or 'summary:' line)."""
+    total = None
+    with open(path) as f:
+        for line in f:
+            if line.startswith("totals:") or line.startswith("summary:"):
+                total = int(line.split()[1])
+    if total is None:
+        raise RuntimeError(f"no totals in {path}")
+    return total
+
+
+def callgrind_inclusive(path, patterns):
+    """Inclusive Ir of the functions whose names match `patterns` (callgrind_annotate)."""
+    r = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100", path], capture_output=True,
+                       text=True)
+    out = {}
+    for line in r.stdout.splitlines():
+        m = re.match(r"\s*([\d,]+)\s+(?:\([^)]*\)\s+)?(\S.*)$", line)
+        if not m:
+            continue
+        ir = int(m.group(1).replace(",", ""))
+        name = m.group(2)
+        for key, pat in patterns.items():
+            if key not in out and re.search(pat, name):
+                out[key] = ir
+    return out
+
+
+# --- the figures ------------------------------------------------------------------------------
+
+def phase_dbus(b, p, res):
+    log("1. SetThrust round trip vs Peer.Ping (simulator answers at once, loop at 50 Hz)")
+    b.start_sim(realistic=False)
+    b.start_daemon(b.daemon_config(50))
+    res["rtt"] = b.client("rtt", "--calls", p["rtt_calls"], "--warmup", p["rtt_warmup"])
+    b.stop_daemon()
+    b.stop_sim()
+
+
+def pstats(v):
+    """The same nearest-rank statistics as bench_common.hpp's stats_json."""
+    if not v:
+        return {"n": 0, "min": 0, "p50": 0, "p90": 0, "p99": 0, "max": 0, "mean": 0}
+    s = sorted(v)
+
+    def pct(q):
+        rank = -(-q * len(s) // 100)  # ceil
+        return s[min(max(int(rank), 1), len(s)) - 1]
+    return {"n": len(s), "min": s[0], "p50": pct(50), "p90": pct(90), "p99": pct(99), "max": s[-1],
+            "mean": sum(s) / len(s)}
+
+
+def merge(parts):
+    """Merges the JSON of several runs of one measurement: raw samples, tallies, counts."""
+    out = dict(parts[0])
+    raw = {k: [x for q in parts for x in q["raw"][k]] for k in parts[0]["raw"]}
+    for k, v in raw.items():
+        out[k] = pstats(v)
+    out["raw"] = raw
+    for k in ("samples", "missing", "not_holding"):
+        if k in out:
+            out[k] = sum(q[k] for q in parts)
+    if "tally" in out:
+        t = {}
+        for q in parts:
+            for group, counts in q["tally"].items():
+                for name, n in counts.items():
+                    t.setdefault(group, {}).setdefault(name, 0)
+                    t[group][name] += n
+        out["tally"] = t
+    out["blocks"] = len(parts)
+    return out
+
+
+def phase_wire(b, p, res):
+    log("2./3. command and kill to the wire (realistic timing at 100 kHz)")
+    b.start_sim(realistic=True)
+    ks = b.sim_has_kill_switch()
+    res["kill_switch_available"] = ks
+    if not ks:
+        log("kill switch edge: not available in this build")
+    res["wire"] = {}
+    nb = p["wire_blocks"]
+    for rate in (50, 0):
+        cfg = b.daemon_config(rate, kill_switch=ks)
+        try:
+            d = b.start_daemon(cfg)
+        except RuntimeError as e:
+            if not ks:
+                raise
+            # A simulator with a kill switch but a daemon that cannot use one (gpio.kill_switch).
+            log(f"caracarad refused gpio.kill_switch ({e}); kill switch edge: not available in this build")
+            ks = res["kill_switch_available"] = False
+            cfg = b.daemon_config(rate)
+            d = b.start_daemon(cfg)
+        parts = {"seam": [], "cmd": [], "kill_dbus": [], "kill_switch": []}
+        log(f"   loop_rate_hz={rate}: {nb} blocks of seam floor / command / Kill(){' / kill switch' if ks else ''}")
+        # Blocks interleave the measurements so that they share the machine's drift. The seam
+        # floor (a program sending eight orders back to back through the same seam to the same
+        # simulator) runs while the daemon is stopped.
+        for blk in range(nb):
+            d.send_signal(signal.SIGSTOP)
+            try:
+                parts["seam"].append(b.floor("--burst", max(1, p["burst_samples"] // nb)))
+            finally:
+                d.send_signal(signal.SIGCONT)
+            parts["cmd"].append(b.client("cmd2wire", "--samples", max(1, p["cmd_samples"] // nb),
+                                         "--seed", 1000 * rate + blk + 11))
+            parts["kill_dbus"].append(b.client("kill2wire", "--samples", max(1, p["kill_samples"] // nb),
+                                               "--source", "dbus", "--seed", 1000 * rate + blk + 5))
+            if ks:
+                parts["kill_switch"].append(b.client("kill2wire", "--samples", max(1, p["kill_samples"] // nb),
+                                                     "--source", "switch", "--seed", 1000 * rate + blk + 9))
+        res["wire"][str(rate)] = {k: merge(v) for k, v in parts.items() if v}
+        b.stop_daemon()
+    b.stop_sim()
+
+
+def phase_loop(b, p, res):
+    log("4. loop rate at loop_rate_hz=0 against the floor program (alternating windows)")
+    b.start_sim(realistic=False)
+    cfg = b.daemon_config(0)
+    d = b.start_daemon(cfg)
+    res["loop"] = {}
+    for realistic in (True, False):
+        b.sim_call("SetRealisticTiming", "b", "true" if realistic else "false")
+        rows = {"daemon": [], "floor": []}
+        ratios = []
+        # Adjacent windows, daemon then floor (the daemon stopped meanwhile), several rounds:
+        # the machine's speed drifts, so each round's ratio compares like with like.
+        for _ in range(p["loop_rounds"]):
+            dw = b.client("cycles", "--seconds", p["loop_window"])
+            d.send_signal(signal.SIGSTOP)
+            try:
+                fw = b.floor("--seconds", p["loop_window"], config=cfg)
+            finally:
+                d.send_signal(signal.SIGCONT)
+            rows["daemon"].append(dw)
+            rows["floor"].append(fw)
+            ratios.append(dw["rate_hz"] / fw["rate_hz"])
+            time.sleep(0.2)
+        key = "realistic" if realistic else "immediate"
+        dc = sum(r["cycles"] for r in rows["daemon"]) / sum(r["seconds"] for r in rows["daemon"])
+        fc = sum(r["cycles"] for r in rows["floor"]) / sum(r["seconds"] for r in rows["floor"])
+        ratios.sort()
+        res["loop"][key] = {"daemon_hz": dc, "floor_hz": fc, "median_round_ratio": ratios[len(ratios) // 2],
+                            "round_ratios": ratios, "windows": rows}
+    b.stop_daemon()
+    b.stop_sim()
+
+
+def callgrind_window(b, pid, seconds, name):
+    """Zeroes callgrind's counters, counts Cycles over `seconds`, dumps; returns (dump path, window)."""
+    before = set(f for f in os.listdir(b.dir) if f.startswith("cg-daemon.out."))
+    subprocess.run(["callgrind_control", "--zero", str(pid)], capture_output=True, check=True)
+    win = b.client("cycles", "--seconds", seconds)
+    r = subprocess.run(["callgrind_control", f"--dump={name}", str(pid)], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"callgrind_control --dump: {r.stderr}")
+    for _ in range(100):
+        new = set(f for f in os.listdir(b.dir) if f.startswith("cg-daemon.out.")) - before
+        if new:
+            return os.path.join(b.dir, sorted(new)[0]), win
+        time.sleep(0.1)
+    raise RuntimeError("callgrind wrote no dump")
+
+
+CG_FUNCTIONS = {
+    "on_tick": r"Controller::on_tick\(",
+    "on_work (bus transactions)": r"Controller::on_work\(",
+    "telemetry": r"VehicleService::telemetry\(",
+    "vehicle_changed": r"VehicleService::vehicle_changed\(",
+    "SetThrust handler": r"m_set_thrust\(",
+    "sd_bus_emit_properties_changed_strv": r"sd_bus_emit_properties_changed_strv",
+    "sd_event_prepare": r"\bsd_event_prepare\b",
+    "sd_event_wait": r"\bsd_event_wait\b",
+    "malloc": r":malloc \[",
+    "free": r":free \[",
+}
+
+
+def phase_cost(b, p, res):
+    log("5. cost: instructions per tick (callgrind), CPU at 50 Hz, RSS")
+    b.rt_active = False  # cost is counted, not timed: normal scheduling like a default unit
+    b.start_sim(realistic=False)
+    cfg50 = b.daemon_config(50)
+    cost = res["cost"] = {}
+
+    # Floor instructions per cycle: two runs of different lengths, the difference divided by
+    # the difference in cycles (start-up cancels out).
+    totals = []
+    for n in p["cg_floor_cycles"]:
+        out = os.path.join(b.dir, f"cg-floor-{n}.out")
+        b.floor("--cycles", n, config=cfg50,
+                wrapper=("valgrind", "--tool=callgrind", f"--callgrind-out-file={out}"))
+        totals.append(callgrind_total(out))
+    n0, n1 = p["cg_floor_cycles"]
+    cost["floor_ir_per_cycle"] = (totals[1] - totals[0]) / (n1 - n0)
+
+    # The daemon under callgrind at 50 Hz: zero the counters after start-up, count the Cycles
+    # property over a window, dump: Ir(window) / cycles. Once without commands, once with a
+    # steady SetThrust stream.
+    out = os.path.join(b.dir, "cg-daemon.out")
+    log("   callgrind: caracarad at 50 Hz")
+    d = b.start_daemon(cfg50, wrapper=("valgrind", "--tool=callgrind", f"--callgrind-out-file={out}"),
+                       ready_timeout=120)
+    time.sleep(p["cg_warm"])
+    cg = cost["callgrind"] = {"stream_hz": p["stream_hz"]}
+    dump, win = callgrind_window(b, d.pid, p["cg_window"], "idle")
+    ir = callgrind_total(dump)
+    cg["idle"] = {"window_cycles": win["cycles"], "window_seconds": win["seconds"], "ir": ir,
+                  "ir_per_tick": ir / max(1, win["cycles"]),
+                  "inclusive_per_tick": {k: v / max(1, win["cycles"])
+                                         for k, v in callgrind_inclusive(dump, CG_FUNCTIONS).items()}}
+    stream = b.spawn([b.exe["client"], "stream", "--bus", b.bus, "--hz", str(p["stream_hz"]),
+                      "--seconds", str(p["cg_window"] + 60)], "stream-cg", stdout=subprocess.PIPE)
+    time.sleep(2)
+    dump, win = callgrind_window(b, d.pid, p["cg_window"], "stream")
+    ir = callgrind_total(dump)
+    cg["stream"] = {"window_cycles": win["cycles"], "window_seconds": win["seconds"], "ir": ir,
+                    "ir_per_tick": ir / max(1, win["cycles"]),
+                    "inclusive_per_tick": {k: v / max(1, win["cycles"])
+                                           for k, v in callgrind_inclusive(dump, CG_FUNCTIONS).items()}}
+    b.stop(stream)
+    b.stop_daemon()
+
+    # Native run at 50 Hz: CPU over a window without commands and over one with the stream;
+    # the floor program over the same windows (its own CPU clock); RSS sampled every second
+    # for the whole run.
+    log(f"   CPU and RSS: caracarad at 50 Hz for {p['rss_seconds']:.0f} s")
+    d = b.start_daemon(cfg50)
+    pid = d.pid
+    total = p["rss_seconds"]
+    W = p["cpu_window"]
+    t_start = time.monotonic()
+    samples = []
+    state = {"stream": None}
+
+    def sample():
+        samples.append((time.monotonic() - t_start, status_kib(pid, "VmRSS")))
+
+    def daemon_cpu_window():
+        c0, t0 = cpu_ns(pid), time.monotonic()
+        cyc = subprocess.Popen([b.exe["client"], "cycles", "--bus", b.bus, "--seconds", str(W)],
+                               stdout=subprocess.PIPE, text=True)
+        while cyc.poll() is None:
+            sample()
+            time.sleep(1.0)
+        c1, t1 = cpu_ns(pid), time.monotonic()
+        w = json.loads(cyc.communicate()[0])
+        return {"percent": 100.0 * (c1 - c0) / ((t1 - t0) * 1e9), "seconds": t1 - t0,
+                "tick_rate_hz": w["rate_hz"], "ticks": w["cycles"]}
+
+    def floor_cpu_window(*extra):
+        fp = subprocess.Popen([b.exe["floor"], "--socket", b.sock, "--config", cfg50, "--seconds", str(W),
+                               "--rate", "50", *extra], stdout=subprocess.PIPE, text=True)
+        b.procs.append(fp)
+        while fp.poll() is None:
+            sample()
+            time.sleep(1.0)
+        fo = json.loads(fp.communicate()[0].strip().splitlines()[-1])
+        return {"percent": 100.0 * fo["cpu_s"] / fo["seconds"], "rate_hz": fo["rate_hz"],
+                "vmhwm_kib": fo.get("vmhwm_kib")}
+
+    while time.monotonic() - t_start < p["cpu_warm"]:
+        sample()
+        time.sleep(1.0)
+    cost["cpu_idle"] = daemon_cpu_window()
+    state["stream"] = b.spawn([b.exe["client"], "stream", "--bus", b.bus, "--hz", str(p["stream_hz"]),
+                               "--seconds", str(total + 60)], "stream", stdout=subprocess.PIPE)
+    time.sleep(1.0)
+    cost["cpu_stream"] = daemon_cpu_window()
+    cost["floor_cpu_idle"] = floor_cpu_window()
+    cost["floor_cpu_stream"] = floor_cpu_window("--burst-hz", str(p["stream_hz"]))
+    while time.monotonic() - t_start < total:
+        sample()
+        time.sleep(1.0)
+    sample()
+    hwm = status_kib(pid, "VmHWM")
+    b.stop(state["stream"])
+    b.stop_daemon()
+    b.stop_sim()
+    warm_from = max(p["cpu_warm"], 0.1 * total)
+    warm = [s for s in samples if s[0] >= warm_from] or samples
+    tail = sorted(s[1] for s in samples if s[0] >= 0.9 * total) or [samples[-1][1]]
+    cost["rss"] = {"peak_kib": hwm, "steady_kib": tail[len(tail) // 2], "after_warmup_kib": warm[0][1],
+                   "end_kib": samples[-1][1], "seconds": samples[-1][0], "warmup_seconds": warm_from,
+                   "growth_kib": samples[-1][1] - warm[0][1], "max_sampled_kib": max(s[1] for s in samples),
+                   "samples": [[round(t, 1), v] for t, v in samples[::max(1, len(samples) // 120)]]}
+
+
+# --- the table ----------------------------------------------------------------------------------
+
+def rows_from(res, p):
+    rows = []
+
+    def row(fig, value, floor, ratio, target, met, unit=""):
+        rows.append({"figure": fig, "value": value, "floor": floor, "ratio": ratio, "target": target, "met": met,
+                     "unit": unit})
+
+    if "rtt" in res:
+        st, pg = res["rtt"]["setthrust_us"], res["rtt"]["ping_us"]
+        r50, r99 = st["p50"] / pg["p50"], st["p99"] / pg["p99"]
+        row("1. SetThrust round trip p50 (vs Peer.Ping)", st["p50"], pg["p50"], r50, "<= 1.3x", r50 <= 1.3, "us")
+        row("1. SetThrust round trip p99 (vs Peer.Ping)", st["p99"], pg["p99"], r99, "<= 2x", r99 <= 2.0, "us")
+        rf, pk = res["rtt"].get("refused_setthrust_us"), res["rtt"].get("ping_while_killed_us")
+        if rf and rf["n"]:
+            row("   diagnostic: SetThrust refused while killed, p50", rf["p50"], pk["p50"], rf["p50"] / pk["p50"],
+                "info", None, "us")
+    if "wire" in res:
+        for rate in ("50", "0"):
+            w = res["wire"].get(rate)
+            if not w:
+                continue
+            label = "50 Hz" if rate == "50" else "rate 0"
+            c = w["cmd"]
+            fl = c["floor_us"]
+            row(f"2. command to wire p50, {label}", c["last_us"]["p50"], fl, c["last_us"]["p50"] / fl,
+                "info", None, "us")
+            row(f"2. command to wire p99, {label}", c["last_us"]["p99"], fl, c["last_us"]["p99"] / fl,
+                "<= floor + 1 ms", c["last_us"]["p99"] <= fl + 1000, "us")
+            if "seam" in w:
+                sb = w["seam"]["burst_us"]
+                row(f"   seam floor p50 (floor program, 8 orders), {label}", sb["p50"], fl, sb["p50"] / fl,
+                    "info", None, "us")
+                row(f"   seam floor p99 (floor program, 8 orders), {label}", sb["p99"], fl, sb["p99"] / fl,
+                    "info", None, "us")
+            k = w["kill_dbus"]
+            row(f"3. Kill() to wire p99, {label}", k["all_zero_us"]["p99"], k["floor_us"],
+                k["all_zero_us"]["p99"] / k["floor_us"], "<= 1.5x", k["all_zero_us"]["p99"] <= 1.5 * k["floor_us"],
+                "us")
+            if "kill_switch" in w:
+                k = w["kill_switch"]
+                row(f"3. kill switch edge to wire p99, {label}", k["all_zero_us"]["p99"], k["floor_us"],
+                    k["all_zero_us"]["p99"] / k["floor_us"], "<= 1.5x",
+                    k["all_zero_us"]["p99"] <= 1.5 * k["floor_us"], "us")
+        if not res.get("kill_switch_available"):
+            rows.append({"figure": "3. kill switch edge: not available in this build", "value": None, "floor": None,
+                         "ratio": None, "target": "", "met": None, "unit": ""})
+    if "loop" in res:
+        for key, label in (("realistic", "realistic 100 kHz"), ("immediate", "sim answers at once")):
+            l = res["loop"].get(key)
+            if l:
+                r = l["median_round_ratio"]
+                row(f"4. loop rate, rate 0, {label}", l["daemon_hz"], l["floor_hz"], r, ">= 0.95x", r >= 0.95, "Hz")
+    if "cost" in res:
+        c = res["cost"]
+        cg = c.get("callgrind", {})
+        for key, label in (("idle", "no commands"), ("stream", f"{cg.get('stream_hz', 20)} Hz SetThrust stream")):
+            if key in cg:
+                v = cg[key]["ir_per_tick"]
+                row(f"5. instructions per tick, 50 Hz, {label}", v, c["floor_ir_per_cycle"],
+                    v / c["floor_ir_per_cycle"], "<= 100000", v <= 100000, "Ir")
+        for key, fkey, label in (("cpu_idle", "floor_cpu_idle", "no commands"),
+                                 ("cpu_stream", "floor_cpu_stream", f"{cg.get('stream_hz', 20)} Hz stream")):
+            if c.get(key):
+                fl = (c.get(fkey) or {}).get("percent")
+                v = c[key]["percent"]
+                row(f"5. CPU at 50 Hz, {label} (% of a core)", v, fl, v / fl if fl else None, "< 1%", v < 1.0, "%")
+        if c.get("cpu_idle"):
+            v = c["cpu_idle"]["tick_rate_hz"]
+            row("   achieved tick rate at loop_rate_hz=50", v, 50.0, v / 50.0, ">= 0.99x", v >= 49.5, "Hz")
+        if c.get("rss"):
+            fl = (c.get("floor_cpu_idle") or {}).get("vmhwm_kib")
+            rs = c["rss"]
+            row(f"5. RSS peak over {rs['seconds']:.0f} s", rs["peak_kib"], fl, rs["peak_kib"] / fl if fl else None,
+                "< 8 MiB", rs["peak_kib"] < 8192, "KiB")
+            row("5. RSS steady (median of the last 10%)", rs["steady_kib"], fl, None, "< 8 MiB",
+                rs["steady_kib"] < 8192, "KiB")
+            row(f"5. RSS growth from {rs['warmup_seconds']:.0f} s to the end", rs["growth_kib"], 0, None,
+                "flat (<= 64 KiB)", rs["growth_kib"] <= 64, "KiB")
+    return rows
+
+
+def strip_raw(obj):
+    """Drops the per-sample arrays (kept with --raw)."""
+    if isinstance(obj, dict):
+        obj.pop("raw", None)
+        for v in obj.values():
+            strip_raw(v)
+    elif isinstance(obj, list):
+        for v in obj:
+            strip_raw(v)
+
+
+def fmt(v, unit=""):
+    if v is None:
+        return "-"
+    if isinstance(v, bool):
+        return "yes" if v else "NO"
+    if unit == "%":
+        return f"{v:.3f}"
+    if abs(v) >= 1000:
+        return f"{v:,.0f}"
+    return f"{v:.1f}" if abs(v) >= 10 else f"{v:.3f}"
+
+
+def print_table(rows, out=sys.stdout):
+    hdr = ("figure", "value", "floor", "ratio", "target", "met?")
+    lines = []
+    for r in rows:
+        if r["value"] is None:
+            lines.append((r["figure"], "", "", "", "", ""))
+            continue
+        ratio = "-" if r["ratio"] is None else f"{r['ratio']:.2f}x"
+        met = "-" if r["met"] is None else ("yes" if r["met"] else "NO")
+        lines.append((r["figure"], f"{fmt(r['value'], r['unit'])} {r['unit']}", f"{fmt(r['floor'], r['unit'])}",
+                      ratio, r["target"], met))
+    widths = [max(len(hdr[i]), *(len(l[i]) for l in lines)) for i in range(6)]
+    print("  ".join(h.ljust(widths[i]) for i, h in enumerate(hdr)), file=out)
+    print("  ".join("-" * w for w in widths), file=out)
+    for l in lines:
+        print("  ".join((l[i].ljust(widths[i]) if i in (0, 4) else l[i].rjust(widths[i])) for i in range(6)),
+              file=out)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", required=True, help="build tree with caracarad, caracara-sim and bench/")
+    ap.add_argument("--out", default=os.path.join(HERE, "results.json"), help="JSON results (default bench/results.json)")
+    ap.add_argument("--quick", action="store_true", help="shorten every phase (smoke run)")
+    ap.add_argument("--rss-seconds", type=float, default=None, help="length of the RSS run (default 600, quick 20)")
+    ap.add_argument("--only", default="dbus,wire,loop,cost", help="comma-separated phases: dbus,wire,loop,cost")
+    ap.add_argument("--keep", action="store_true", help="keep the temporary directory (logs, callgrind files)")
+    ap.add_argument("--raw", action="store_true", help="keep every latency sample in the JSON (large)")
+    ap.add_argument("--rt", action="store_true",
+                    help="run the bus, simulator, daemon, client and floor of the latency and loop-rate phases "
+                         "under SCHED_FIFO (chrt -f 10), shielding them from other load on the machine")
+    a = ap.parse_args()
+
+    if a.quick:
+        p = dict(rtt_calls=2000, rtt_warmup=200, cmd_samples=100, kill_samples=40, burst_samples=40, wire_blocks=2,
+                 loop_rounds=2, loop_window=2, cg_floor_cycles=(50, 250), cg_warm=3, cg_window=4, stream_hz=20,
+                 cpu_warm=3, cpu_window=5, rss_seconds=30)
+    else:
+        p = dict(rtt_calls=10000, rtt_warmup=500, cmd_samples=1000, kill_samples=300, burst_samples=300, wire_blocks=10,
+                 loop_rounds=6, loop_window=5, cg_floor_cycles=(200, 1200), cg_warm=5, cg_window=20, stream_hz=20,
+                 cpu_warm=10, cpu_window=30, rss_seconds=600)
+    if a.rss_seconds is not None:
+        p["rss_seconds"] = a.rss_seconds
+    p["rss_seconds"] = max(p["rss_seconds"], p["cpu_warm"] + p["cpu_window"] * 4 + 10)
+
+    b = Bench(os.path.abspath(a.build), a.quick, a.keep)
+    b.rt = a.rt
+
+    def on_signal(signum, _frame):
+        b.cleanup()
+        sys.exit(128 + signum)
+    signal.signal(signal.SIGTERM, on_signal)
+    signal.signal(signal.SIGINT, on_signal)
+
+    res = {"quick": a.quick, "rt": a.rt, "params": p, "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+           "host": {"nproc": os.cpu_count(), "uname": " ".join(os.uname())}}
+    phases = {"dbus": phase_dbus, "wire": phase_wire, "loop": phase_loop, "cost": phase_cost}
+    try:
+        b.start_bus()
+        for name in a.only.split(","):
+            t0 = time.monotonic()
+            try:
+                phases[name](b, p, res)
+            except Exception as e:  # a broken phase must not hide the others' figures
+                log(f"phase {name} failed: {e}")
+                res.setdefault("errors", {})[name] = str(e)
+                b.stop_daemon()
+                b.stop_sim()
+            res.setdefault("phase_seconds", {})[name] = round(time.monotonic() - t0, 1)
+    finally:
+        if a.keep:
+            log(f"logs kept in {b.dir}")
+        b.cleanup()
+    rows = rows_from(res, p)
+    if not a.raw:
+        strip_raw(res)
+    res["table"] = rows
+    res["finished"] = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+    with open(a.out, "w") as f:
+        json.dump(res, f, indent=1)
+    print()
+    print_table(rows)
+    if res.get("kill_switch_available") is False:
+        print("\nkill switch edge: not available in this build")
+    print(f"\nfigures written to {a.out}")
+
+
+if __name__ == "__main__":
+    main()
