@@ -5,20 +5,13 @@
 
 #include "controller.hpp"
 #include "sdbus.hpp"
+#include "vehicle_names.hpp"
 
 #include <array>
 #include <string>
 #include <vector>
 
 namespace caracara::dbus {
-
-inline constexpr const char* kBusName = "org.caracara.Vehicle1";
-inline constexpr const char* kRootPath = "/org/caracara/Vehicle1";
-inline constexpr const char* kVehicleIface = "org.caracara.Vehicle1";
-inline constexpr const char* kThrusterIface = "org.caracara.Vehicle1.Thruster";
-inline constexpr const char* kTeensyIface = "org.caracara.Vehicle1.Teensy";
-inline constexpr const char* kBusIface = "org.caracara.Vehicle1.Bus";
-inline constexpr const char* kErrorPrefix = "org.caracara.Vehicle1.Error.";
 
 class VehicleService final : public ControllerObserver {
 public:

@@ -7,19 +7,21 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include "vehicle_names.hpp"
+
 #include <string>
 #include <vector>
 
 namespace caracaractl {
 
-inline constexpr const char* kService = "org.caracara.Vehicle1";
-inline constexpr const char* kRootPath = "/org/caracara/Vehicle1";
-inline constexpr const char* kTeensyPath = "/org/caracara/Vehicle1/teensy";
-inline constexpr const char* kBusPath = "/org/caracara/Vehicle1/bus";
-inline constexpr const char* kVehicleIface = "org.caracara.Vehicle1";
-inline constexpr const char* kThrusterIface = "org.caracara.Vehicle1.Thruster";
-inline constexpr const char* kTeensyIface = "org.caracara.Vehicle1.Teensy";
-inline constexpr const char* kBusIface = "org.caracara.Vehicle1.Bus";
+using caracara::dbus::kBusIface;
+using caracara::dbus::kBusPath;
+using caracara::dbus::kRootPath;
+using caracara::dbus::kTeensyIface;
+using caracara::dbus::kTeensyPath;
+using caracara::dbus::kThrusterIface;
+using caracara::dbus::kVehicleIface;
+inline constexpr const char* kService = caracara::dbus::kBusName;
 
 // Exit codes, as documented in --help.
 enum Exit : int {
