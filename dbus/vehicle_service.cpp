@@ -402,10 +402,10 @@ int VehicleService::start() {
         thruster_objects_.push_back(std::move(obj));
     }
     if (r >= 0)
-        r = keep(sd_bus_add_object_vtable(bus_, &slot, (std::string(kRootPath) + "/teensy").c_str(), kTeensyIface,
+        r = keep(sd_bus_add_object_vtable(bus_, &slot, kTeensyPath, kTeensyIface,
                                           kTeensyVtable, this));
     if (r >= 0)
-        r = keep(sd_bus_add_object_vtable(bus_, &slot, (std::string(kRootPath) + "/bus").c_str(), kBusIface,
+        r = keep(sd_bus_add_object_vtable(bus_, &slot, kBusPath, kBusIface,
                                           kBusVtable, this));
     // Track every disconnect from the start, so a controlling client that leaves right after
     // its command cannot slip past an asynchronously installed match.
@@ -557,7 +557,7 @@ void VehicleService::telemetry() {
     if (tc.link_errors != published_teensy_errors_) tn.push_back("LinkErrors");
     if (!tn.empty()) {
         tn.push_back(nullptr);
-        sd_bus_emit_properties_changed_strv(bus_, (std::string(kRootPath) + "/teensy").c_str(), kTeensyIface,
+        sd_bus_emit_properties_changed_strv(bus_, kTeensyPath, kTeensyIface,
                                             const_cast<char**>(tn.data()));
         published_teensy_ = te;
         if (counters_due_)
@@ -584,17 +584,17 @@ void VehicleService::emit_bus_changes() {
     if (bn.empty())
         return;
     bn.push_back(nullptr);
-    sd_bus_emit_properties_changed_strv(bus_, (std::string(kRootPath) + "/bus").c_str(), kBusIface,
+    sd_bus_emit_properties_changed_strv(bus_, kBusPath, kBusIface,
                                         const_cast<char**>(bn.data()));
     published_bus_ = b;
 }
 
 void VehicleService::bus_lost(const std::string& reason) {
-    sd_bus_emit_signal(bus_, (std::string(kRootPath) + "/bus").c_str(), kBusIface, "BusLost", "s", reason.c_str());
+    sd_bus_emit_signal(bus_, kBusPath, kBusIface, "BusLost", "s", reason.c_str());
 }
 
 void VehicleService::bus_restored(uint32_t pulses, double milliseconds) {
-    sd_bus_emit_signal(bus_, (std::string(kRootPath) + "/bus").c_str(), kBusIface, "BusRestored", "ud", pulses,
+    sd_bus_emit_signal(bus_, kBusPath, kBusIface, "BusRestored", "ud", pulses,
                        milliseconds);
 }
 

@@ -17,11 +17,6 @@ namespace caracara::sim {
 using simproto::Op;
 
 namespace {
-uint64_t now_ns() {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
 // What an i2c-dev adapter like i2c-bcm2835 advertises.
 constexpr unsigned long kI2cFuncs = I2C_FUNC_I2C | I2C_FUNC_SMBUS_EMUL;
 constexpr uint64_t kSpinLimitNs = 2'000'000;
@@ -39,7 +34,7 @@ void DeviceServer::push_gpio_event(int line, int value) {
         simproto::Writer w(buf);
         w.header(Op::GpioEvent, 0, true);
         w.i32(value);
-        w.u64(now_ns());
+        w.u64(monotonic_ns());
         ::send(c->fd, buf, w.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
     }
 }
@@ -101,7 +96,7 @@ int DeviceServer::on_accept(sd_event_source*, int fd, uint32_t, void* userdata) 
 void DeviceServer::drop(Client* c) {
     // Like the kernel, a process that goes away releases its GPIO lines.
     for (auto& [h, line] : c->gpio_lines)
-        vehicle_.gpio().release(line, now_ns());
+        vehicle_.gpio().release(line, monotonic_ns());
     ::close(c->fd);
     clients_.erase(c); // destroys the event sources with the client
 }
@@ -125,12 +120,12 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
     // Realistic timing: the reply leaves when the transaction is over on the wire, and the
     // wire is shared, so a transaction waits for the one before it.
     uint64_t& free_at = self->vehicle_.bus_free_at();
-    const uint64_t start = std::max(now_ns(), free_at);
+    const uint64_t start = std::max(monotonic_ns(), free_at);
     free_at = start + wire_ns;
-    if (free_at - now_ns() <= kSpinLimitNs) {
+    if (free_at - monotonic_ns() <= kSpinLimitNs) {
         // A timer wake-up costs tens of microseconds on a busy VM, a good part of a 380 us
         // order: short waits are spun so the simulated wire, not the host, sets the pace.
-        while (now_ns() < free_at) {
+        while (monotonic_ns() < free_at) {
         }
         self->send_reply(*c);
         return 0;
@@ -155,7 +150,7 @@ int DeviceServer::on_reply_due(sd_event_source*, uint64_t, void* userdata) {
 }
 
 void DeviceServer::send_reply(Client& c) {
-    if (::send(c.fd, c.reply.data(), c.reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT) < 0) {
+    if (::send(c.fd, c.reply.data(), c.reply_len, MSG_NOSIGNAL | MSG_DONTWAIT) < 0) {
         // The client went away; its hangup is handled by the io source.
     }
 }
@@ -163,10 +158,9 @@ void DeviceServer::send_reply(Client& c) {
 uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
     simproto::Reader r(req);
     simproto::Header h;
-    c.reply.assign(simproto::kMaxMessage, 0);
     simproto::Writer w(c.reply);
     // Header and result go first, then the payload; the buffer is trimmed to what was written.
-    auto finish = [&](int) { c.reply.resize(w.size()); };
+    auto finish = [&](int) { c.reply_len = w.size(); };
     if (!r.header(h) || (h.op & simproto::kReplyBit)) {
         ++bad_requests_;
         // Not even a header we understand: answer with a bare error so the client is not left hanging.
@@ -193,7 +187,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         r.i32(); // flags: the simulated nodes ignore O_* like a char device mostly does
         if (!r.ok() || !r.at_end())
             return bad(-EBADMSG);
-        auto kind = vehicle_.node_kind(std::string(path), now_ns());
+        auto kind = vehicle_.node_kind(std::string(path), monotonic_ns());
         if (kind == SimVehicle::NodeKind::None)
             return bad(-ENOENT);
         int hnd = c.next_handle++;
@@ -224,7 +218,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
             return bad(-ENOTTY);
         if (n == 0 || n > I2C_RDWR_IOCTL_MAX_MSGS)
             return bad(-EINVAL);
-        if (!vehicle_.i2c_present(now_ns()))
+        if (!vehicle_.i2c_present(monotonic_ns()))
             return bad(-ENODEV); // the adapter was unbound under an open file
         std::vector<I2cMessage> msgs(n);
         for (auto& m : msgs) {
@@ -242,7 +236,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         }
         if (!r.ok() || !r.at_end())
             return bad(-EBADMSG);
-        uint64_t start = now_ns();
+        uint64_t start = monotonic_ns();
         if (vehicle_.realistic_timing())
             start = std::max(start, vehicle_.bus_free_at());
         auto res = vehicle_.i2c().transfer(msgs, start);
@@ -287,7 +281,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         if (!r.ok() || !r.at_end())
             return bad(-EBADMSG);
         SpiPort* port = vehicle_.spi_port(it->second.path);
-        uint64_t start = now_ns();
+        uint64_t start = monotonic_ns();
         if (vehicle_.realistic_timing())
             start = std::max(start, vehicle_.bus_free_at());
         uint64_t wire = 0;
@@ -358,7 +352,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         if (it->second.kind != SimVehicle::NodeKind::Unbind && it->second.kind != SimVehicle::NodeKind::Bind)
             return bad(-EINVAL);
         int res = vehicle_.sysfs_write(it->second.kind,
-                                       {reinterpret_cast<const char*>(data.data()), data.size()}, now_ns());
+                                       {reinterpret_cast<const char*>(data.data()), data.size()}, monotonic_ns());
         begin(res);
         finish(res);
         return 0;
@@ -375,7 +369,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         int line = vehicle_.gpio().find(chip, name, offset);
         if (line < 0)
             return bad(line);
-        int res = vehicle_.gpio().request(line, static_cast<GpioMode>(mode), active_low, initial, now_ns());
+        int res = vehicle_.gpio().request(line, static_cast<GpioMode>(mode), active_low, initial, monotonic_ns());
         if (res < 0)
             return bad(res);
         int hnd = c.next_handle++;
@@ -398,9 +392,9 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         if (op == Op::GpioGet)
             res = vehicle_.gpio().get(it->second);
         else if (op == Op::GpioSet)
-            res = vehicle_.gpio().set(it->second, value, now_ns());
+            res = vehicle_.gpio().set(it->second, value, monotonic_ns());
         else {
-            vehicle_.gpio().release(it->second, now_ns());
+            vehicle_.gpio().release(it->second, monotonic_ns());
             c.gpio_lines.erase(it);
         }
         begin(res);

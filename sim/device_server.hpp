@@ -3,8 +3,10 @@
 #pragma once
 
 #include "sdbus.hpp"
+#include "sim_protocol.hpp"
 #include "vehicle.hpp"
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -35,7 +37,9 @@ private:
         std::map<int, int> gpio_lines; // handle -> line index in the GPIO model
         int watched_line = -1;         // a GpioWatch connection: pushes edges of this line
         int next_handle = 3;
-        std::vector<uint8_t> reply;
+        // One reply buffer per client, reused for every request (the hot path of the seam).
+        std::array<uint8_t, simproto::kMaxMessage> reply{};
+        size_t reply_len = 0;
     };
 
     static int on_accept(sd_event_source*, int fd, uint32_t, void* userdata);

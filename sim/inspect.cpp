@@ -4,7 +4,6 @@
 
 #include <cerrno>
 #include <string>
-#include <ctime>
 
 namespace caracara::sim {
 
@@ -73,18 +72,12 @@ int get_hang(sd_bus*, const char*, const char*, const char*, sd_bus_message* rep
     return -EINVAL;
 }
 
-uint64_t mono_ns() {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
-
 int m_set_kill_switch(sd_bus_message* m, void* userdata, sd_bus_error*) {
     int on = 0;
     int r = sd_bus_message_read(m, "b", &on);
     if (r < 0)
         return r;
-    insp(userdata).vehicle().gpio().set_kill_switch(on, mono_ns());
+    insp(userdata).vehicle().gpio().set_kill_switch(on, monotonic_ns());
     return sd_bus_reply_method_return(m, "");
 }
 

@@ -9,6 +9,9 @@
 
 namespace caracara::sim {
 
+// CLOCK_MONOTONIC in nanoseconds: the clock of the wire log, shared with the daemon's host.
+uint64_t monotonic_ns();
+
 struct WireEntry {
     uint64_t index = 0;        // monotonic, never reused
     uint64_t time_ns = 0;      // CLOCK_MONOTONIC at the end of the message on the wire
