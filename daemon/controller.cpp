@@ -267,6 +267,14 @@ void Controller::send_order(size_t i) {
     note_bus_result(thrusters_[i]->send_order(v));
 }
 
+void Controller::send_due_orders() {
+    for (size_t i = 0; i < thrusters_.size() && !recovering_; ++i)
+        if (order_due_[i]) {
+            order_due_[i] = false;
+            send_order(i);
+        }
+}
+
 void Controller::zero_now() {
     // Back to back, without returning to the event loop: nothing may come between a kill
     // and the zero orders. Failures are counted; the next tick retries.
@@ -734,6 +742,10 @@ void Controller::client_left(std::string_view unique_name) {
     if (unique_name.empty() || unique_name != safety_.commanding_client())
         return;
     log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
+    // A command it had accepted reaches the wire before the zero: a one-shot `busctl call`
+    // moves the thrusters for a moment, the same whether or not its disconnect happens to
+    // arrive before the loop sent the orders.
+    send_due_orders();
     SafetyAction a = safety_.client_left(unique_name, now());
     handle(a); // clear_commands announces Controller with the motors
 }

@@ -181,6 +181,7 @@ private:
     bool work_one();
     void refresh_orders();
     void send_order(size_t i);
+    void send_due_orders(); // now, back to back
     void zero_now();
     void handle(const SafetyAction& a);
     Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);

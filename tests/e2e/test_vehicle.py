@@ -11,6 +11,8 @@ import time
 import unittest
 
 import dbus
+import dbus.bus
+import dbus.lowlevel
 
 import harness
 from harness import (BUS_IFACE, BUS_PATH, DEFAULT_MT, ERR, INVALID_ARGS, MOTORS, MOTOR_MAX, PROPS, ROOT,
@@ -956,15 +958,44 @@ class ClientLossTest(VehicleTestCase):
         poll(lambda: rig.motor_values() == [0] * MOTORS, 10)
         self.assertEqual(rig.vget("Controller"), "")
         self.assertEqual(rig.state(), "ready")
-        # ...and any order the command put on the wire was followed by a zero order.
-        _, log = rig.wire_log(wire_from)
-        for i in (0, 7):
-            mt = DEFAULT_MT[i]
-            orders = [e for e in log if e.bus == "i2c" and not e.read and e.addr == mt >> 1]
-            self.assertTrue(orders)
-            self.assertEqual(orders[-1].data[0], ZERO)
+        # ...and the accepted command reached the wire before the zero order.
+        self.assert_order_then_zero(wire_from, {0: 3000, 7: -3000})
         rig.wait_orders_refreshed()
         self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+
+    def test_client_gone_before_its_reply(self):
+        # The call and the disconnect arrive together, so the daemon learns that the client
+        # left before its loop had a chance to send the orders: they still go out first.
+        rig = self.rig
+        for round_ in range(5):
+            with self.subTest(round=round_):
+                wire_from = rig.wire_next()
+                conn = dbus.bus.BusConnection(rig.address)
+                msg = dbus.lowlevel.MethodCallMessage(VEHICLE, ROOT, VEHICLE, "SetThrust")
+                msg.append(dbus.Array([0, 0, 1500 + round_, 0, 0, 0, 0, 0], signature="i"), signature="ai")
+                conn.send_message(msg)
+                conn.flush()
+                conn.close()
+                self.assert_order_then_zero(wire_from, {2: 1500 + round_})
+                poll(lambda: rig.vget("Controller") == "", 10)
+
+    def assert_order_then_zero(self, wire_from, commanded, timeout=10.0):
+        """Each thruster's commanded order appears on the wire, and its last order is zero."""
+        def orders():
+            _, log = self.rig.wire_log(wire_from)
+            return {i: [e.data[0] for e in log if e.bus == "i2c" and not e.read and e.addr == DEFAULT_MT[i] >> 1]
+                    for i in commanded}
+
+        def done():
+            got = orders()
+            return all(speed_byte(v) in got[i] and got[i][-1] == ZERO for i, v in commanded.items())
+
+        try:
+            poll(done, timeout)
+        except harness.Timeout:
+            got = {i: sorted(set(speeds)) for i, speeds in orders().items()}
+            self.fail(f"commanded {commanded} (SPEED {[speed_byte(v) for v in commanded.values()]}): "
+                      f"the wire carried only SPEED {got}")
 
 
 class SigtermTest(unittest.TestCase):
