@@ -755,6 +755,46 @@ class KillTest(VehicleTestCase):
         finally:
             watcher.remove()
 
+    def test_properties_changed_of_every_object(self):
+        # Every object announces its changes; each announced property is one the contract
+        # declares on that interface with EmitsChangedSignal true, carried with its declared type.
+        contract = harness.load_contract()
+        events = []
+
+        def on_signal(iface, changed, invalidated, path=None):
+            events.append((str(path), str(iface), dict(changed), list(invalidated)))
+
+        match = self.rig.conn.add_signal_receiver(on_signal, signal_name="PropertiesChanged", dbus_interface=PROPS,
+                                                  bus_name=VEHICLE, path_keyword="path")
+        try:
+            values = [0, 0, 0, 1234, 0, 0, 0, 0]
+            self.rig.thrust(values)
+            pump_main_loop(1.5)  # the steady counters are announced once a second
+            self.rig.thrust([0] * MOTORS)
+            pump_main_loop(0.3)
+        finally:
+            match.remove()
+        expected_iface = {ROOT: VEHICLE, TEENSY_PATH: TEENSY_IFACE, BUS_PATH: BUS_IFACE}
+        expected_iface.update({thruster_path(i): THRUSTER_IFACE for i in range(MOTORS)})
+        seen = {}
+        for path, iface, changed, invalidated in events:
+            self.assertEqual(iface, expected_iface.get(path), f"PropertiesChanged from {path}")
+            self.assertEqual(invalidated, [], f"{path}: values are carried, not invalidated")
+            self.assertTrue(changed, f"{path}: an empty PropertiesChanged")
+            declared = contract[iface]["properties"]
+            for name, value in changed.items():
+                self.assertIn(name, declared, f"{path}: {name} is not in the contract of {iface}")
+                self.assertNotIn(declared[name]["annotations"].get(harness.EMITS, "true"), ("false", "const"),
+                                 f"{iface}.{name} announced but declared without change signals")
+                self.assertEqual(dbus_signature(value), declared[name]["type"], f"{iface}.{name}")
+                seen.setdefault(path, {}).setdefault(name, []).append(value)
+        self.assertEqual(seen[thruster_path(3)]["OrderedValue"][0], 1234)
+        self.assertIn(values, [list(v) for v in seen[ROOT]["MotorValues"]])
+        self.assertIn("Cycles", seen[ROOT])
+        self.assertIn("Transactions", seen[BUS_PATH])
+        self.assertIn("Frames", seen[TEENSY_PATH])
+        self.assertEqual(set(seen), set(expected_iface), "every object announced its changes")
+
 
 class KillSwitchAtStartTest(unittest.TestCase):
 
