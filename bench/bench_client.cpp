@@ -1,6 +1,7 @@
 // caracara-bench: the D-Bus side of the benchmarks (bench/run.py drives it). One sd-bus
 // connection, synchronous calls, CLOCK_MONOTONIC around them; the simulator's wire log
-// (stamped with the same clock at the end of each message) tells when the wire saw what.
+// (stamped with the same clock at the end of each message, and at each GPIO line change)
+// tells when the wire saw what.
 //
 //   caracara-bench rtt        --bus ADDR [--calls N] [--warmup N]
 //   caracara-bench cmd2wire   --bus ADDR [--samples N] [--phase-ms MS] [--seed S]
@@ -125,13 +126,18 @@ public:
         std::free(s);
         return out;
     }
+    // A property of a trivial type: 0 or the negative errno.
+    template <typename T>
+    int read_trivial(const char* dest, const char* path, const char* iface, const char* member, char type, T* v) {
+        sd_bus_error err = SD_BUS_ERROR_NULL;
+        int r = sd_bus_get_property_trivial(bus(), dest, path, iface, member, &err, type, v);
+        sd_bus_error_free(&err);
+        return r < 0 ? r : 0;
+    }
     template <typename T>
     T get_trivial(const char* dest, const char* path, const char* iface, const char* member, char type) {
-        sd_bus_error err = SD_BUS_ERROR_NULL;
         T v{};
-        int r = sd_bus_get_property_trivial(bus(), dest, path, iface, member, &err, type, &v);
-        sd_bus_error_free(&err);
-        if (r < 0)
+        if (int r = read_trivial(dest, path, iface, member, type, &v); r < 0)
             die(member, r);
         return v;
     }
@@ -334,6 +340,9 @@ Vehicle describe(Client& c) {
 }
 
 bool is_order(const Entry& e) { return e.bus == "i2c" && !e.read && e.data.size() == 3 && e.result == "ack"; }
+// A bus transaction, as opposed to the log's line events ("i2c-lines" recovery clocking,
+// "gpio" line level changes).
+bool is_transaction(const Entry& e) { return e.bus == "i2c" || e.bus == "spi"; }
 bool is_zero_speed(uint8_t s) { return s == 0x80 || s == 0x7F; }
 
 const char* kind_of(const Entry& e) {
@@ -365,7 +374,7 @@ struct Tally {
         long n = 0;
         const Entry* first = nullptr;
         for (size_t k = 0; k < first_new; ++k)
-            if (log[k].time_ns > t0 && log[k].bus != "i2c-lines") {
+            if (log[k].time_ns > t0 && is_transaction(log[k])) {
                 ++n;
                 if (!first)
                     first = &log[k];
@@ -459,7 +468,7 @@ int cmd_cmd2wire(const Args& a) {
         // undisturbed; more when something (a tick, a status read) came in between.
         long between = 0;
         for (size_t k = first_new; k <= last_new; ++k)
-            if (log[k].bus != "i2c-lines")
+            if (is_transaction(log[k]))
                 ++between;
         burst_txns.push_back(static_cast<double>(between));
         if (std::getenv("CARACARA_BENCH_DEBUG") && lat > 5000) {
@@ -471,7 +480,7 @@ int cmd_cmd2wire(const Args& a) {
         }
         bool busy = false;
         for (size_t k = 0; k < first_new; ++k)
-            if (log[k].time_ns > t0 && log[k].bus != "i2c-lines") {
+            if (log[k].time_ns > t0 && is_transaction(log[k])) {
                 busy = true;
                 residual_us.push_back(static_cast<double>(log[k].time_ns - t0) / 1000.0);
                 break;
@@ -496,15 +505,40 @@ int cmd_cmd2wire(const Args& a) {
 
 // --- 3. kill to wire -----------------------------------------------------------------------
 
+// The kill switch line as the simulator's wire log shows it ("gpio" entries): its offset and
+// its level on the wire when engaged. None when the simulator does not say so (an older build).
+struct SwitchLine {
+    uint16_t offset = 0;
+    uint8_t engaged_level = 1;
+};
+
+std::optional<SwitchLine> switch_line(Client& c) {
+    uint32_t offset = 0;
+    int active_low = 0;
+    if (c.read_trivial(kSim, kSimPath, kSim, "KillSwitchLine", 'u', &offset) < 0 ||
+        c.read_trivial(kSim, kSimPath, kSim, "KillSwitchActiveLow", 'b', &active_low) < 0)
+        return std::nullopt;
+    return SwitchLine{static_cast<uint16_t>(offset), static_cast<uint8_t>(active_low ? 0 : 1)};
+}
+
 int cmd_kill2wire(const Args& a) {
     const bool by_switch = a.source == "switch";
     Client c(a.bus);
     const Vehicle veh = describe(c);
     const double bit_us = 1e6 / veh.clock_hz;
+    // With the switch, a sample starts at the kill switch edge: the simulator's "gpio" wire-log
+    // entry of the switch line taking its engaged level, stamped when the line changed (when the
+    // daemon's edge event can fire). The D-Bus hop of SetKillSwitch to the simulator is not the
+    // daemon's; the figure from the client's clock before the call stays as a diagnostic
+    // (edge_via_dbus_us), and the hop itself is dbus_to_edge_us.
+    const std::optional<SwitchLine> line = by_switch ? switch_line(c) : std::nullopt;
+    if (by_switch && !line)
+        std::fprintf(stderr, "caracara-bench: the simulator does not name its kill switch line (KillSwitchLine): "
+                             "timing from before SetKillSwitch\n");
     Rng rng(a.seed + 7);
-    std::vector<double> all_us, first_us, call_us;
+    std::vector<double> all_us, first_us, call_us, via_dbus_us, hop_us;
     Tally tally;
-    long missing = 0, not_holding = 0, not_ready = 0;
+    long missing = 0, missing_edge = 0, not_holding = 0, not_ready = 0;
     auto rearm = [&]() {
         if (by_switch)
             c.set_kill_switch(false);
@@ -569,13 +603,27 @@ int cmd_kill2wire(const Args& a) {
             ++missing;
             continue;
         }
+        uint64_t start = t0;
+        if (line) {
+            const Entry* edge = nullptr;
+            for (const Entry& e : log)
+                if (e.bus == "gpio" && e.addr == line->offset && e.data.size() == 1 && e.data[0] == line->engaged_level) {
+                    edge = &e;
+                    break;
+                }
+            if (!edge) {
+                ++missing_edge;
+                continue;
+            }
+            start = edge->time_ns;
+        }
         uint64_t worst = 0, first = UINT64_MAX;
         size_t first_zero = log.size();
         for (size_t i = 0; i < 8; ++i) {
             bool zeroed = false;
             for (size_t k = 0; k < log.size(); ++k) {
                 const Entry& e = log[k];
-                if (!is_order(e) || e.addr != veh.addr7[i] || e.time_ns <= t0)
+                if (!is_order(e) || e.addr != veh.addr7[i] || e.time_ns <= start)
                     continue;
                 if (!zeroed && is_zero_speed(e.data[0])) {
                     zeroed = true;
@@ -587,20 +635,31 @@ int cmd_kill2wire(const Args& a) {
                 }
             }
         }
-        all_us.push_back(static_cast<double>(worst - t0) / 1000.0);
-        first_us.push_back(static_cast<double>(first - t0) / 1000.0);
-        tally.add(log, first_zero, t0);
+        all_us.push_back(static_cast<double>(worst - start) / 1000.0);
+        first_us.push_back(static_cast<double>(first - start) / 1000.0);
+        if (line) {
+            via_dbus_us.push_back(static_cast<double>(worst - t0) / 1000.0);
+            hop_us.push_back(static_cast<double>(start - t0) / 1000.0);
+        }
+        tally.add(log, first_zero, start);
     }
     rearm();
     c.set_thrust({0, 0, 0, 0, 0, 0, 0, 0});
     const double order_bits = 38;
-    std::printf("{\"source\": \"%s\", \"samples\": %ld, \"missing\": %ld, \"not_holding\": %ld, \"clock_hz\": %u, "
-                "\"floor_us\": %.3f, \"all_zero_us\": %s, \"first_zero_us\": %s, \"call_us\": %s, \"tally\": %s, "
-                "\"raw\": {\"all_zero_us\": %s, \"first_zero_us\": %s, \"call_us\": %s}}\n",
-                a.source.c_str(), a.samples, missing, not_holding, veh.clock_hz, 8 * order_bits * bit_us,
-                stats_json(all_us).c_str(), stats_json(first_us).c_str(), stats_json(call_us).c_str(),
-                tally.json().c_str(), array_json(all_us).c_str(), array_json(first_us).c_str(),
-                array_json(call_us).c_str());
+    // "start": where the samples start, "edge" (the simulator's kill switch edge) or "call"
+    // (the client's clock before Kill() or SetKillSwitch).
+    std::string edge_stats, edge_raw;
+    if (line) {
+        edge_stats = ", \"edge_via_dbus_us\": " + stats_json(via_dbus_us) + ", \"dbus_to_edge_us\": " + stats_json(hop_us);
+        edge_raw = ", \"edge_via_dbus_us\": " + array_json(via_dbus_us) + ", \"dbus_to_edge_us\": " + array_json(hop_us);
+    }
+    std::printf("{\"source\": \"%s\", \"start\": \"%s\", \"samples\": %ld, \"missing\": %ld, \"missing_edge\": %ld, "
+                "\"not_holding\": %ld, \"clock_hz\": %u, \"floor_us\": %.3f, \"all_zero_us\": %s, \"first_zero_us\": %s, "
+                "\"call_us\": %s%s, \"tally\": %s, \"raw\": {\"all_zero_us\": %s, \"first_zero_us\": %s, \"call_us\": %s%s}}\n",
+                a.source.c_str(), line ? "edge" : "call", a.samples, missing, missing_edge, not_holding, veh.clock_hz,
+                8 * order_bits * bit_us, stats_json(all_us).c_str(), stats_json(first_us).c_str(),
+                stats_json(call_us).c_str(), edge_stats.c_str(), tally.json().c_str(), array_json(all_us).c_str(),
+                array_json(first_us).c_str(), array_json(call_us).c_str(), edge_raw.c_str());
     return 0;
 }
 

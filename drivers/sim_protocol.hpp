@@ -19,7 +19,8 @@
 //            GpioGet     i32 line;   GpioSet  i32 line, u8 value;   GpioRelease i32 line
 //            GpioWatch   str chip, str name, i32 offset (on a connection of its own: from then on the simulator only
 //                                      pushes GpioEvent messages there: header op GpioEvent|reply,
-//                                      seq 0, i32 new logical value, u64 timestamp ns)
+//                                      seq 0, i32 new logical value, u64 CLOCK_MONOTONIC ns of the
+//                                      change, the stamp of the simulator's "gpio" wire-log entry)
 //   reply    header with op | 0x8000 and the request's seq, i32 result, then
 //            I2cRdwr: the bytes of every read message in order; SpiMessage: the rx bytes of every
 //            transfer with has_rx in order; Ioctl: u64 value-out; others: nothing.

@@ -23,10 +23,10 @@ constexpr uint64_t kSpinLimitNs = 2'000'000;
 } // namespace
 
 DeviceServer::DeviceServer(sd_event* event, SimVehicle& vehicle) : event_(event), vehicle_(vehicle) {
-    vehicle_.gpio().on_change = [this](int line, int value) { push_gpio_event(line, value); };
+    vehicle_.gpio().on_change = [this](int line, int value, uint64_t when_ns) { push_gpio_event(line, value, when_ns); };
 }
 
-void DeviceServer::push_gpio_event(int line, int value) {
+void DeviceServer::push_gpio_event(int line, int value, uint64_t when_ns) {
     uint8_t buf[32];
     for (auto& [key, c] : clients_) {
         if (c->watched_line != line)
@@ -34,7 +34,7 @@ void DeviceServer::push_gpio_event(int line, int value) {
         simproto::Writer w(buf);
         w.header(Op::GpioEvent, 0, true);
         w.i32(value);
-        w.u64(monotonic_ns());
+        w.u64(when_ns); // the stamp of the change, as in the wire log
         ::send(c->fd, buf, w.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
     }
 }

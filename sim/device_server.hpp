@@ -49,7 +49,7 @@ private:
     // Builds the reply into c.reply; returns the wire time the request occupied.
     uint64_t handle(Client& c, std::span<const uint8_t> req);
     void send_reply(Client& c);
-    void push_gpio_event(int line, int value);
+    void push_gpio_event(int line, int value, uint64_t when_ns);
 
     sd_event* event_;
     SimVehicle& vehicle_;

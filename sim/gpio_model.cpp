@@ -96,9 +96,12 @@ void GpioModel::update(uint64_t now_ns, const std::vector<bool>& before) {
         if (info_[i].offset == kSda) sda = i;
         if (info_[i].offset == kScl) scl = i;
     }
-    auto line_event = [&](const char* what) {
+    // Line events in the wire log (the kinds are in wire_log.hpp), stamped now.
+    auto line_event = [&](const char* bus, const char* what, uint32_t offset = 0, std::vector<uint8_t> data = {}) {
         WireEntry e;
-        e.bus = "i2c-lines";
+        e.bus = bus;
+        e.addr = static_cast<uint16_t>(offset);
+        e.data = std::move(data);
         e.time_ns = now_ns;
         e.result = what;
         log_.append(std::move(e));
@@ -113,22 +116,28 @@ void GpioModel::update(uint64_t now_ns, const std::vector<bool>& before) {
         }
         last_scl_rise_ns_ = now_ns;
         bus_.on_scl_rising(now_ns);
-        line_event("scl-pulse");
+        line_event("i2c-lines", "scl-pulse");
     }
     auto after = levels();
     // START and STOP are SDA edges while SCL is high (UM10204 3.1.4).
     if (after[scl] && before[scl]) {
         if (!before[sda] && after[sda]) {
             ++stops_;
-            line_event("stop");
+            line_event("i2c-lines", "stop");
         } else if (before[sda] && !after[sda]) {
-            line_event("start");
+            line_event("i2c-lines", "start");
         }
     }
-    if (on_change)
-        for (size_t i = 0; i < info_.size(); ++i)
-            if (before[i] != after[i])
-                on_change(static_cast<int>(i), get(static_cast<int>(i)));
+    // Every other line's level change goes into the wire log (see the header), then to the
+    // edge watchers: the log's stamp is the moment the daemon's edge event can fire.
+    for (size_t i = 0; i < info_.size(); ++i) {
+        if (before[i] == after[i])
+            continue;
+        if (i != sda && i != scl)
+            line_event("gpio", "edge", info_[i].offset, {static_cast<uint8_t>(after[i])});
+        if (on_change)
+            on_change(static_cast<int>(i), get(static_cast<int>(i)), now_ns);
+    }
 }
 
 } // namespace caracara::sim

@@ -1,5 +1,11 @@
 // The simulated vehicle's GPIO chip: the I2C pins as open-drain lines onto the bus model's
 // wired-AND SCL/SDA, the kill switch input, and the kill and power-off outputs.
+//
+// Wire log: every change of the physical level of the kill switch, kill output and power-off
+// lines is an entry {bus "gpio", addr = line offset, data = {new level, 0 or 1, on the wire
+// (before any active-low inversion)}, result "edge"}, stamped with the CLOCK_MONOTONIC time of
+// the change, before edge watchers are told (the same stamp as their GpioEvent). SCL/SDA are
+// logged as I2C line events instead ({bus "i2c-lines", result "scl-pulse", "start", "stop"}).
 #pragma once
 
 #include "i2c_bus_model.hpp"
@@ -40,15 +46,17 @@ public:
     // The simulator's side.
     void set_kill_switch(bool engaged, uint64_t now_ns);
     bool kill_switch_engaged() const { return kill_switch_engaged_; }
+    bool kill_switch_active_low() const { return kill_switch_active_low_; } // engaged = low on the wire
     bool level(uint32_t offset) const; // physical level on the wire
     uint64_t stops() const { return stops_; }
     uint64_t scl_pulses() const { return scl_pulses_; }
     uint64_t min_scl_period_ns() const { return min_scl_period_ns_; }
     const std::vector<GpioLineInfo>& lines() const { return info_; }
 
-    // Called with (line index, its value as get() reports it) on every change of a line's
-    // physical level, requested or not (edge watchers see the kill switch before it is requested).
-    std::function<void(int, int)> on_change;
+    // Called with (line index, its value as get() reports it, the time of the change) on every
+    // change of a line's physical level, requested or not (edge watchers see the kill switch
+    // before it is requested), after the change is in the wire log.
+    std::function<void(int, int, uint64_t)> on_change;
 
 private:
     struct Line {

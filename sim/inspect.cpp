@@ -32,6 +32,7 @@ GETTER(get_bad_requests, "t", static_cast<uint64_t>(insp(userdata).server().bad_
 GETTER(get_clients, "u", static_cast<uint32_t>(insp(userdata).server().clients()))
 
 GETTER(get_kill_switch, "b", static_cast<int>(insp(userdata).vehicle().gpio().kill_switch_engaged()))
+GETTER(get_kill_switch_active_low, "b", static_cast<int>(insp(userdata).vehicle().gpio().kill_switch_active_low()))
 GETTER(get_kill_output, "b", static_cast<int>(insp(userdata).vehicle().gpio().level(GpioModel::kKillOut)))
 GETTER(get_power_off_output, "b", static_cast<int>(insp(userdata).vehicle().gpio().level(GpioModel::kPowerOff)))
 GETTER(get_scl, "b", static_cast<int>(insp(userdata).vehicle().gpio().level(GpioModel::kScl)))
@@ -62,6 +63,10 @@ GETTER(t_reads, "t", static_cast<uint64_t>(thruster(userdata).status_reads()))
 GETTER(t_zero_orders, "t", static_cast<uint64_t>(thruster(userdata).zero_orders()))
 GETTER(t_last_order_time, "t", static_cast<uint64_t>(thruster(userdata).last_order_time_ns()))
 #undef GETTER
+
+int get_kill_switch_line(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void*, sd_bus_error*) {
+    return sd_bus_message_append(reply, "u", static_cast<uint32_t>(GpioModel::kKillSwitch));
+}
 
 int get_hang(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
     switch (insp(userdata).vehicle().i2c().hang()) {
@@ -158,7 +163,11 @@ int m_power_cycle(sd_bus_message* m, void* userdata, sd_bus_error*) {
 }
 
 // GetWireLog(t since) -> (t next, a(tttsqbayays)): index, time_ns, transaction, bus, addr,
-// read, data, miso, result.
+// read, data, miso, result (the kinds of entry are in wire_log.hpp). bus "i2c" and "spi" are
+// transactions; "i2c-lines" are recovery line events; "gpio" is a GPIO line level change:
+// addr = the line offset (KillSwitchLine for the kill switch), data = {new level on the wire},
+// result "edge", time_ns = the moment of the change (for the kill switch, the moment
+// SetKillSwitch changed it, which is when caracarad's edge event can fire).
 int m_wire_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint64_t since = 0;
     int r = sd_bus_message_read(m, "t", &since);
@@ -227,6 +236,8 @@ const sd_bus_vtable kRootVtable[] = {
     SD_BUS_METHOD_WITH_ARGS("SetRealisticTiming", SD_BUS_ARGS("b", enabled), SD_BUS_NO_RESULT, m_set_realistic, kMethod),
     SD_BUS_METHOD_WITH_ARGS("SetClock", SD_BUS_ARGS("u", hz), SD_BUS_NO_RESULT, m_set_clock, kMethod),
     SD_BUS_PROPERTY("KillSwitch", "b", get_kill_switch, 0, 0),
+    SD_BUS_PROPERTY("KillSwitchLine", "u", get_kill_switch_line, 0, SD_BUS_VTABLE_PROPERTY_CONST),
+    SD_BUS_PROPERTY("KillSwitchActiveLow", "b", get_kill_switch_active_low, 0, SD_BUS_VTABLE_PROPERTY_CONST),
     SD_BUS_PROPERTY("KillOutput", "b", get_kill_output, 0, 0),
     SD_BUS_PROPERTY("PowerOffOutput", "b", get_power_off_output, 0, 0),
     SD_BUS_PROPERTY("Scl", "b", get_scl, 0, 0),

@@ -186,6 +186,39 @@ TEST_CASE("the kill switch kills at its edge, not at the next tick, and blocks a
     CHECK(d.vehicle_string("KillSource") == "switch");
     CHECK(f.root_bool("KillOutput"));
 
+    // The simulator's wire log has the edge: bus "gpio", the switch's line offset, its new
+    // level on the wire (active high here), stamped inside the call and before the zero order
+    // of every thruster; the kill output the daemon drives follows it.
+    const uint32_t line = f.root_u32("KillSwitchLine");
+    CHECK_FALSE(f.root_bool("KillSwitchActiveLow"));
+    const auto log = f.wire_log();
+    size_t edge = log.size();
+    for (size_t i = 0; i < log.size() && edge == log.size(); ++i)
+        if (log[i].bus == "gpio" && log[i].addr == line)
+            edge = i;
+    REQUIRE(edge < log.size());
+    CHECK(log[edge].data == std::vector<uint8_t>{1});
+    CHECK(log[edge].result == "edge");
+    CHECK(log[edge].time_ns >= t0);
+    CHECK(log[edge].time_ns <= t1);
+    for (unsigned t = 0; t < 8; ++t) {
+        INFO("thruster " << t);
+        size_t zero = log.size();
+        for (size_t i = 0; i < log.size() && zero == log.size(); ++i)
+            if (log[i].bus == "i2c" && log[i].addr == kMt[t] >> 1 && !log[i].read && log[i].result == "ack" &&
+                log[i].data.size() == 3 && log[i].data[0] == 0x80)
+                zero = i;
+        REQUIRE(zero < log.size());
+        CHECK(zero > edge);
+        CHECK(log[zero].time_ns >= log[edge].time_ns);
+    }
+    constexpr uint16_t kKillOutLine = 27; // KILL_OUT on the simulator's gpiochip0 (sim/gpio_model.hpp)
+    bool kill_out = false;
+    for (size_t i = edge; i < log.size(); ++i)
+        if (log[i].bus == "gpio" && log[i].addr == kKillOutLine && log[i].data == std::vector<uint8_t>{1})
+            kill_out = log[i].time_ns >= log[edge].time_ns;
+    CHECK(kill_out);
+
     CHECK(d.call("ClearKill", "") == "org.caracara.Vehicle1.Error.KillSwitchSet");
     CHECK(d.vehicle_string("State") == "killed");
     CHECK(d.set_thrust(v) == "org.caracara.Vehicle1.Error.Killed");

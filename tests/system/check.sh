@@ -196,11 +196,12 @@ if busctl call $V $VP $V SetThrust ai 8 1000 0 0 0 0 0 0 0; then
 else
   fail "root: busctl call SetThrust"
 fi
-# Entries print as: index time transaction "bus" addr read [n data...] [n miso...] "result"
+# Entries print as: index time transaction "bus" addr read [n data...] [n miso...] "result";
+# only "i2c" entries are messages ("i2c-lines" and "gpio" are line events: addr is no address).
 on_wire() {
   local wire
   wire=$(busctl call $S $SP $S GetWireLog t 0 2>&1)
-  grep -qE "\"[^\"]*\" $((mt >> 1)) false 3 $spd 100 $csum " <<<"$wire"
+  grep -qE "\"i2c\" $((mt >> 1)) false 3 $spd 100 $csum " <<<"$wire"
 }
 # busctl leaves the bus at once; the daemon still puts the accepted order on the wire first.
 check "the simulated I2C wire carried the order [$spd 100 $csum] to thruster 0" wait_until 3 on_wire
