@@ -13,7 +13,6 @@ namespace caracara {
 
 namespace {
 // Bus work runs below D-Bus so that calls are served between transactions.
-constexpr int64_t kWorkPriority = SD_EVENT_PRIORITY_NORMAL + 10;
 constexpr uint64_t kTelemetryPeriodNs = 200'000'000; // 5 Hz of PropertiesChanged
 constexpr const char* kPowerOffConfirmation = "power-off";
 // A locked bus shows as several bus-level errors in a row (timeouts, EIO, a vanished adapter),
@@ -128,7 +127,16 @@ std::string Controller::start() {
     sd_event_source_set_priority(s, kWorkPriority);
     sd_event_source_set_enabled(s, SD_EVENT_OFF);
 
-    if (config_.control.loop_rate_hz > 0) {
+    if (config_.control.loop_rate_hz == 0) {
+        // As fast as the bus allows: each cycle starts once the last one's work is done and
+        // what it announced has gone out; without this, nothing below the work would ever run.
+        r = sd_event_add_defer(event_, &s, on_next_cycle, this);
+        if (r < 0)
+            return "sd_event_add_defer: " + errno_name(-r);
+        next_cycle_source_.reset(s);
+        sd_event_source_set_priority(s, kAnnouncePriority + 1);
+        sd_event_source_set_enabled(s, SD_EVENT_OFF);
+    } else {
         uint64_t now_us = 0;
         sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
         // Accuracy 1 us: 0 would mean sd-event's default of 250 ms and a 4 Hz "50 Hz" loop.
@@ -150,6 +158,7 @@ void Controller::shutdown() {
     started_ = false;
     tick_source_.reset();
     work_source_.reset();
+    next_cycle_source_.reset();
     turn_source_.reset();
     recovery_timer_.reset();
     kill_switch_source_.reset();
@@ -197,13 +206,18 @@ int Controller::on_work(sd_event_source*, void* userdata) {
             sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
             self->in_cycle_ = false;
             self->last_cycle_ns_ = self->now();
-            if (self->config_.control.loop_rate_hz == 0)
-                self->cycle(); // as fast as the bus allows
+            if (self->next_cycle_source_)
+                sd_event_source_set_enabled(self->next_cycle_source_.get(), SD_EVENT_ONESHOT);
             return 0;
         }
         if (self->input_pending())
             return 0;
     }
+    return 0;
+}
+
+int Controller::on_next_cycle(sd_event_source*, void* userdata) {
+    static_cast<Controller*>(userdata)->cycle();
     return 0;
 }
 

@@ -2,9 +2,10 @@
 // machine, the mixing and the budget, and schedules bus work on the sd-event loop.
 //
 // Bus work is a small set of "due" flags (an order per thruster, status reads, a Teensy poll)
-// executed ONE transaction per event-loop dispatch at a lower priority than D-Bus, so a Kill
-// or a new command waits at most for the transaction already on the wire. A kill zeroes every
-// thruster synchronously before its D-Bus reply; a new command marks all orders due at once.
+// executed at a lower priority than D-Bus, several transactions per dispatch but checking for
+// a waiting message or kill switch edge between them, so a Kill or a new command waits at most
+// for the transaction already on the wire. A kill zeroes every thruster synchronously before
+// its D-Bus reply; a new command marks its changed orders due at once.
 #pragma once
 
 #include "budget.hpp"
@@ -55,6 +56,12 @@ struct Result {
     std::string message;
     bool ok() const { return status == Status::Ok; }
 };
+
+// Event-loop priorities. D-Bus, timers and the kill switch run at SD_EVENT_PRIORITY_NORMAL or
+// above; the bus work below them; announcements (PropertiesChanged) below the work, so that
+// neither an order nor the reply of the call that caused the change waits for one.
+inline constexpr int64_t kWorkPriority = SD_EVENT_PRIORITY_NORMAL + 10;
+inline constexpr int64_t kAnnouncePriority = kWorkPriority + 1;
 
 // Which vehicle properties changed, for PropertiesChanged.
 enum VehicleChange : uint32_t {
@@ -159,6 +166,7 @@ public:
 private:
     static int on_tick(sd_event_source*, uint64_t usec, void* userdata);
     static int on_work(sd_event_source*, void* userdata);
+    static int on_next_cycle(sd_event_source*, void* userdata);
     bool input_pending() const;
     static int on_turn_step(sd_event_source*, uint64_t usec, void* userdata);
     static int on_kill_switch(sd_event_source*, int fd, uint32_t revents, void* userdata);
@@ -224,6 +232,7 @@ private:
 
     dbus::SourcePtr tick_source_;
     dbus::SourcePtr work_source_;
+    dbus::SourcePtr next_cycle_source_; // loop rate 0: the next cycle, after the announcements
     dbus::SourcePtr turn_source_;
     uint64_t cycles_ = 0;
     uint64_t last_cycle_ns_ = 0;

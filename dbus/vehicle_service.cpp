@@ -488,32 +488,38 @@ int VehicleService::on_name_owner_changed(sd_bus_message* m, void* userdata, sd_
     return 0;
 }
 
-void VehicleService::vehicle_changed(uint32_t changes) {
-    // Announce after the reply that caused the change has gone out, coalesced.
-    sd_event* ev = sd_bus_get_event(bus_);
-    if (!ev) {
-        emit_vehicle_changes(changes);
-        return;
-    }
+void VehicleService::vehicle_changed(uint32_t changes) { announce(changes, false); }
+
+void VehicleService::telemetry() { announce(0, true); }
+
+void VehicleService::announce(uint32_t changes, bool telemetry) {
+    // Announced once the reply and the orders of the change (or the tick's) have gone out,
+    // coalesced: see kAnnouncePriority.
     pending_ |= changes;
-    if (!flush_) {
+    telemetry_pending_ = telemetry_pending_ || telemetry;
+    sd_event* ev = sd_bus_get_event(bus_);
+    if (!flush_ && ev) {
         sd_event_source* s = nullptr;
-        if (sd_event_add_defer(ev, &s, on_flush, this) < 0) {
-            emit_vehicle_changes(pending_);
-            pending_ = 0;
-            return;
+        if (sd_event_add_defer(ev, &s, on_flush, this) >= 0) {
+            flush_.reset(s);
+            sd_event_source_set_priority(s, kAnnouncePriority);
         }
-        flush_.reset(s);
-        sd_event_source_set_priority(s, SD_EVENT_PRIORITY_NORMAL + 1);
     }
-    sd_event_source_set_enabled(flush_.get(), SD_EVENT_ONESHOT);
+    if (flush_)
+        sd_event_source_set_enabled(flush_.get(), SD_EVENT_ONESHOT);
+    else
+        on_flush(nullptr, this); // no event loop to defer to: now
 }
 
 int VehicleService::on_flush(sd_event_source*, void* userdata) {
     auto* self = static_cast<VehicleService*>(userdata);
     const uint32_t c = self->pending_;
+    const bool telemetry = self->telemetry_pending_;
     self->pending_ = 0;
+    self->telemetry_pending_ = false;
     self->emit_vehicle_changes(c);
+    if (telemetry)
+        self->emit_telemetry();
     return 0;
 }
 
@@ -564,7 +570,7 @@ VehicleService::ThrusterSnapshot VehicleService::snapshot(size_t i) const {
     return s;
 }
 
-void VehicleService::telemetry() {
+void VehicleService::emit_telemetry() {
     counters_due_ = (++publications_ % 5) == 0;
     const char* const vehicle_names[] = {"CommandAgeMs", "Cycles", nullptr};
     emit_properties_changed(bus_, kRootPath, kVehicleIface, kVehicleVtable, this, vehicle_names);

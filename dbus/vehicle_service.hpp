@@ -48,8 +48,11 @@ private:
     ThrusterSnapshot snapshot(size_t i) const;
     void emit_bus_changes();
     void emit_vehicle_changes(uint32_t changes);
+    void emit_telemetry();
+    void announce(uint32_t changes, bool telemetry);
     static int on_flush(sd_event_source*, void* userdata);
     uint32_t pending_ = 0;
+    bool telemetry_pending_ = false;
     uint64_t publications_ = 0;
     bool counters_due_ = true;
     SourcePtr flush_;
