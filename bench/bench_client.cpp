@@ -3,7 +3,7 @@
 // (stamped with the same clock at the end of each message, and at each GPIO line change)
 // tells when the wire saw what.
 //
-//   caracara-bench rtt        --bus ADDR [--calls N] [--warmup N]
+//   caracara-bench rtt        --bus ADDR [--calls N] [--warmup N] [--settle-us US]
 //   caracara-bench cmd2wire   --bus ADDR [--samples N] [--phase-ms MS] [--seed S]
 //   caracara-bench kill2wire  --bus ADDR [--samples N] [--source dbus|switch] [--phase-ms MS]
 //   caracara-bench cycles     --bus ADDR --seconds S
@@ -219,6 +219,7 @@ struct Args {
     double seconds = 5;
     double hz = 20;
     double timeout_ms = 10000;
+    double settle_us = 2000;
     uint64_t seed = 1;
     std::string source = "dbus";
 };
@@ -245,6 +246,7 @@ Args parse(int argc, char** argv) {
         else if (k == "--seconds") a.seconds = std::strtod(v, nullptr);
         else if (k == "--hz") a.hz = std::strtod(v, nullptr);
         else if (k == "--timeout-ms") a.timeout_ms = std::strtod(v, nullptr);
+        else if (k == "--settle-us") a.settle_us = std::strtod(v, nullptr);
         else if (k == "--seed") a.seed = std::strtoull(v, nullptr, 10);
         else if (k == "--source") a.source = v;
         else {
@@ -283,12 +285,12 @@ int cmd_rtt(const Args& a) {
         return static_cast<double>(mono_ns() - t0) / 1000.0;
     };
     // Each call is made after a settle gap, so SetThrust and Ping both meet the daemon with the
-    // previous command's orders out (they take about 0.2 ms with the simulator answering at
-    // once), as a script commanding at 10-50 Hz meets it; the pair's order alternates.
+    // previous command's orders out (about 0.2 ms with the simulator answering at once, 3 ms on
+    // a 100 kHz wire), as a script commanding at 10-50 Hz meets it; the pair's order alternates.
     // Back to back, a Ping lands in the eight orders its SetThrust started, while the daemon is
     // awake and checks for messages between transactions, and the next SetThrust lands on a
     // daemon gone back to sleep: that compares unlike states (the "back_to_back" diagnostic).
-    constexpr uint64_t kSettleNs = 2'000'000;
+    const uint64_t kSettleNs = static_cast<uint64_t>(a.settle_us * 1000.0);
     auto pairs = [&](long n, std::vector<double>& st, std::vector<double>& pg) {
         for (long i = 0; i < a.warmup + n; ++i) {
             double ts = 0, tp = 0;
@@ -332,7 +334,7 @@ int cmd_rtt(const Args& a) {
                 "\"setthrust_us\": %s, \"ping_us\": %s, "
                 "\"back_to_back_setthrust_us\": %s, \"back_to_back_ping_us\": %s, "
                 "\"refused_setthrust_us\": %s, \"ping_while_killed_us\": %s}\n",
-                a.calls, kSettleNs / 1000.0, errors_accepted, errors_accepted ? last_error.c_str() : "",
+                a.calls, a.settle_us, errors_accepted, errors_accepted ? last_error.c_str() : "",
                 stats_json(st).c_str(), stats_json(pg).c_str(), stats_json(st_b2b).c_str(),
                 stats_json(pg_b2b).c_str(), stats_json(refused).c_str(), stats_json(pg_killed).c_str());
     return 0;
