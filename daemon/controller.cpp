@@ -4,6 +4,7 @@
 #include "log.hpp"
 #include "packet.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <poll.h>
 #include <systemd/sd-daemon.h>
@@ -127,16 +128,16 @@ std::string Controller::start() {
     sd_event_source_set_priority(s, kWorkPriority);
     sd_event_source_set_enabled(s, SD_EVENT_OFF);
 
-    if (config_.control.loop_rate_hz == 0) {
-        // As fast as the bus allows: each cycle starts once the last one's work is done and
-        // what it announced has gone out; without this, nothing below the work would ever run.
-        r = sd_event_add_defer(event_, &s, on_next_cycle, this);
-        if (r < 0)
-            return "sd_event_add_defer: " + errno_name(-r);
-        next_cycle_source_.reset(s);
-        sd_event_source_set_priority(s, kAnnouncePriority + 1);
-        sd_event_source_set_enabled(s, SD_EVENT_OFF);
-    } else {
+    // The work steps aside after each burst of orders and at the end of a cycle, so that what
+    // is below it (the announcements) runs even when the bus is busy all the time.
+    r = sd_event_add_defer(event_, &s, on_resume, this);
+    if (r < 0)
+        return "sd_event_add_defer: " + errno_name(-r);
+    resume_source_.reset(s);
+    sd_event_source_set_priority(s, kAnnouncePriority + 1);
+    sd_event_source_set_enabled(s, SD_EVENT_OFF);
+
+    if (config_.control.loop_rate_hz > 0) {
         uint64_t now_us = 0;
         sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
         // Accuracy 1 us: 0 would mean sd-event's default of 250 ms and a 4 Hz "50 Hz" loop.
@@ -158,7 +159,7 @@ void Controller::shutdown() {
     started_ = false;
     tick_source_.reset();
     work_source_.reset();
-    next_cycle_source_.reset();
+    resume_source_.reset();
     turn_source_.reset();
     recovery_timer_.reset();
     kill_switch_source_.reset();
@@ -199,15 +200,26 @@ bool Controller::input_pending() const {
 
 int Controller::on_work(sd_event_source*, void* userdata) {
     auto* self = static_cast<Controller*>(userdata);
+    auto step_aside = [self] {
+        self->stepped_aside_ = true;
+        sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
+        sd_event_source_set_enabled(self->resume_source_.get(), SD_EVENT_ONESHOT);
+    };
     // Transactions back to back while nothing else waits; the check between them keeps a
-    // Kill or a command at most one transaction away, as before.
+    // Kill or a command at most one transaction away.
     for (int n = 0; n < 32; ++n) {
-        if (!self->work_one()) {
-            sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
+        const Work w = self->work_one();
+        if (w == Work::None) {
             self->in_cycle_ = false;
             self->last_cycle_ns_ = self->now();
-            if (self->next_cycle_source_)
-                sd_event_source_set_enabled(self->next_cycle_source_.get(), SD_EVENT_ONESHOT);
+            if (self->config_.control.loop_rate_hz == 0 || self->cycle_overrun_)
+                step_aside(); // on_resume starts the next cycle
+            else
+                sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
+            return 0;
+        }
+        if (w == Work::Order && !self->any_order_due()) {
+            step_aside(); // the orders are out: announce, then the rest
             return 0;
         }
         if (self->input_pending())
@@ -216,9 +228,23 @@ int Controller::on_work(sd_event_source*, void* userdata) {
     return 0;
 }
 
-int Controller::on_next_cycle(sd_event_source*, void* userdata) {
-    static_cast<Controller*>(userdata)->cycle();
+int Controller::on_resume(sd_event_source*, void* userdata) {
+    auto* self = static_cast<Controller*>(userdata);
+    self->stepped_aside_ = false;
+    if (!self->in_cycle_ && (self->config_.control.loop_rate_hz == 0 || self->cycle_overrun_)) {
+        self->cycle_overrun_ = false;
+        self->cycle(); // as fast as the bus allows
+    } else {
+        self->schedule_work();
+    }
     return 0;
+}
+
+void Controller::schedule_work() {
+    // While the work has stepped aside, on_resume takes it up again right after the
+    // announcements (a tick or a command in between must not put it back in front of them).
+    if (work_source_ && !stepped_aside_)
+        sd_event_source_set_enabled(work_source_.get(), SD_EVENT_ON);
 }
 
 void Controller::cycle() {
@@ -226,9 +252,10 @@ void Controller::cycle() {
     poll_kill_switch(); // a backstop for a lost edge event
     handle(safety_.tick(t));
     if (in_cycle_) {
-        // The bus did not finish the last cycle in one period: refresh what is left rather
-        // than piling work up. Orders stay due; status reads are not stacked.
-        refresh_orders();
+        // The bus did not finish the last cycle in one period: the next one starts as soon as
+        // it is done, as at loop rate 0. Refreshing the orders now instead would put them in
+        // front of that cycle's status reads at every tick, and they would never be read.
+        cycle_overrun_ = true;
         publish_telemetry_if_due();
         return;
     }
@@ -243,21 +270,21 @@ void Controller::cycle() {
 void Controller::refresh_orders() {
     // A burst still going out (a new command's orders) already refreshes every thruster:
     // those sent are fresh, the rest are due. Restarting it would only delay the last ones.
-    bool any = false;
-    for (bool d : order_due_)
-        any = any || d;
-    if (!any)
+    if (!any_order_due())
         order_due_.fill(true);
-    if (work_source_)
-        sd_event_source_set_enabled(work_source_.get(), SD_EVENT_ON);
+    schedule_work();
 }
 
-bool Controller::work_one() {
+bool Controller::any_order_due() const {
+    return std::any_of(order_due_.begin(), order_due_.end(), [](bool d) { return d; });
+}
+
+Controller::Work Controller::work_one() {
     for (size_t i = 0; i < thrusters_.size() && !recovering_; ++i) {
         if (order_due_[i]) {
             order_due_[i] = false;
             send_order(i);
-            return true;
+            return Work::Order;
         }
     }
     if (status_due_ > 0 && !recovering_) {
@@ -265,14 +292,14 @@ bool Controller::work_one() {
         const size_t i = status_next_;
         status_next_ = (status_next_ + 1) % thrusters_.size();
         note_bus_result(thrusters_[i]->read_status());
-        return true;
+        return Work::Other;
     }
     if (teensy_due_) {
         teensy_due_ = false;
         poll_teensy();
-        return true;
+        return Work::Other;
     }
-    return false;
+    return Work::None;
 }
 
 void Controller::send_order(size_t i) {
@@ -615,8 +642,8 @@ Result Controller::accept_motors(const MotorValues& wanted, bool mix_saturated, 
     applied_ = b.motors;
     limit_ = limit;
     saturated_ = saturated;
-    if (any_due && work_source_)
-        sd_event_source_set_enabled(work_source_.get(), SD_EVENT_ON);
+    if (any_due)
+        schedule_work();
     notify((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
     return {};
 }

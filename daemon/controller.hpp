@@ -166,7 +166,7 @@ public:
 private:
     static int on_tick(sd_event_source*, uint64_t usec, void* userdata);
     static int on_work(sd_event_source*, void* userdata);
-    static int on_next_cycle(sd_event_source*, void* userdata);
+    static int on_resume(sd_event_source*, void* userdata);
     bool input_pending() const;
     static int on_turn_step(sd_event_source*, uint64_t usec, void* userdata);
     static int on_kill_switch(sd_event_source*, int fd, uint32_t revents, void* userdata);
@@ -186,7 +186,12 @@ private:
 
     uint64_t now() const;
     void cycle();
-    bool work_one();
+    enum class Work { None, Order, Other };
+    Work work_one(); // one transaction, orders first
+    void schedule_work();
+    bool stepped_aside_ = false; // the work waits for on_resume
+    bool cycle_overrun_ = false;  // a tick came while a cycle was still going
+    bool any_order_due() const;
     void refresh_orders();
     void send_order(size_t i);
     void send_due_orders(); // now, back to back
@@ -232,7 +237,7 @@ private:
 
     dbus::SourcePtr tick_source_;
     dbus::SourcePtr work_source_;
-    dbus::SourcePtr next_cycle_source_; // loop rate 0: the next cycle, after the announcements
+    dbus::SourcePtr resume_source_; // below the announcements: the rest of the work, or the next cycle at rate 0
     dbus::SourcePtr turn_source_;
     uint64_t cycles_ = 0;
     uint64_t last_cycle_ns_ = 0;

@@ -796,6 +796,56 @@ class KillTest(VehicleTestCase):
         self.assertEqual(set(seen), set(expected_iface), "every object announced its changes")
 
 
+def check_announced_while_bus_busy(test):
+    """The bus work never rests: a command's PropertiesChanged and the telemetry still go out."""
+    rig = test.rig
+    watcher = PropertyWatcher(rig, ROOT, VEHICLE)
+    try:
+        watcher.clear()
+        values = [1500, 0, 0, 0, 0, 0, 0, -1500]
+        rig.thrust(values)
+        watcher.wait_for("MotorValues", lambda v: list(v) == values, timeout=5)
+        first = watcher.wait_for("Cycles", timeout=5)
+        watcher.wait_for("Cycles", lambda v: v > first, timeout=5)
+        rig.wait_sim_speeds([speed_byte(v) for v in values], timeout=10)
+        rig.thrust([0] * MOTORS)
+        watcher.wait_for("MotorValues", lambda v: list(v) == [0] * MOTORS, timeout=5)
+    finally:
+        watcher.remove()
+
+
+class AnnouncementsAtLoopRateZeroTest(VehicleTestCase):
+    """loop_rate_hz = 0: the next cycle starts as soon as the last one's work is done."""
+
+    CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 60000, "loop_rate_hz": 0}
+
+    def test_announced_while_the_loop_runs_flat_out(self):
+        check_announced_while_bus_busy(self)
+
+
+class AnnouncementsOnASlowWireTest(VehicleTestCase):
+    """A 10 kHz wire with real waits: one cycle's transactions take about 40 ms, longer than
+    the 20 ms tick, so there is always bus work due."""
+
+    def setUp(self):
+        self.rig.sim_call("SetRealisticTiming", True, signature="b")
+        self.rig.sim_call("SetClock", dbus.UInt32(10000), signature="u")
+        self.addCleanup(self.rig.sim_call, "SetRealisticTiming", False, signature="b")
+        self.addCleanup(self.rig.sim_call, "SetClock", dbus.UInt32(100000), signature="u")
+
+    def test_announced_while_cycles_overrun_the_tick(self):
+        check_announced_while_bus_busy(self)
+
+    def test_every_thruster_still_read(self):
+        # Cycles run back to back instead of each tick re-sending the orders in front of the
+        # status reads: every thruster's status keeps being read.
+        before = self.rig.sim_counters("StatusReads")
+        poll(lambda: all(a > b for a, b in zip(self.rig.sim_counters("StatusReads"), before)), 10,
+             message="a thruster's status is no longer read")
+        cycles = self.rig.vget("Cycles")
+        poll(lambda: self.rig.vget("Cycles") >= cycles + 5, 10, message="cycles stopped")
+
+
 class KillSwitchAtStartTest(unittest.TestCase):
 
     def test_start_with_the_switch_set_is_killed(self):
