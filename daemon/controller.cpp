@@ -15,6 +15,7 @@ namespace caracara {
 namespace {
 // Bus work runs below D-Bus so that calls are served between transactions.
 constexpr uint64_t kTelemetryPeriodNs = 200'000'000; // 5 Hz of PropertiesChanged
+constexpr uint32_t kBackstopRateHz = 50;                // the tick at loop rate 0
 constexpr const char* kPowerOffConfirmation = "power-off";
 // A locked bus shows as several bus-level errors in a row (timeouts, EIO, a vanished adapter),
 // or as every thruster failing at once; one absent thruster is neither.
@@ -137,16 +138,16 @@ std::string Controller::start() {
     sd_event_source_set_priority(s, kAnnouncePriority + 1);
     sd_event_source_set_enabled(s, SD_EVENT_OFF);
 
-    if (config_.control.loop_rate_hz > 0) {
-        uint64_t now_us = 0;
-        sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
-        // Accuracy 1 us: 0 would mean sd-event's default of 250 ms and a 4 Hz "50 Hz" loop.
-        r = sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 1, on_tick, this);
-        if (r < 0)
-            return "sd_event_add_time: " + errno_name(-r);
-        tick_source_.reset(s);
-        sd_event_source_set_enabled(s, SD_EVENT_ON);
-    }
+    // At loop rate 0 the tick is a backstop: cycles follow each other at once, but while the
+    // bus is being recovered there is nothing to clock out and the tick paces them.
+    uint64_t now_us = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
+    // Accuracy 1 us: 0 would mean sd-event's default of 250 ms and a 4 Hz "50 Hz" loop.
+    r = sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 1, on_tick, this);
+    if (r < 0)
+        return "sd_event_add_time: " + errno_name(-r);
+    tick_source_.reset(s);
+    sd_event_source_set_enabled(s, SD_EVENT_ON);
     started_ = true;
     last_cycle_ns_ = now();
     cycle();
@@ -172,7 +173,8 @@ void Controller::shutdown() {
 
 int Controller::on_tick(sd_event_source* s, uint64_t usec, void* userdata) {
     auto* self = static_cast<Controller*>(userdata);
-    const uint64_t period = 1'000'000ull / self->config_.control.loop_rate_hz;
+    const uint32_t hz = self->config_.control.loop_rate_hz;
+    const uint64_t period = 1'000'000ull / (hz ? hz : kBackstopRateHz);
     // Fixed-rate schedule; after a stall skip ahead instead of bursting to catch up.
     uint64_t next = usec + period;
     uint64_t now_us = 0;
@@ -212,7 +214,8 @@ int Controller::on_work(sd_event_source*, void* userdata) {
         if (w == Work::None) {
             self->in_cycle_ = false;
             self->last_cycle_ns_ = self->now();
-            if (self->config_.control.loop_rate_hz == 0 || self->cycle_overrun_)
+            const bool flat_out = self->config_.control.loop_rate_hz == 0 && !self->recovering_;
+            if (flat_out || self->cycle_overrun_)
                 step_aside(); // on_resume starts the next cycle
             else
                 sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);

@@ -371,6 +371,35 @@ class BusRecoveryTest(VehicleTestCase):
         self.assertEqual(rig.state(), "killed", "a bus kill must be cleared explicitly")
 
 
+class BusRecoveryAtLoopRateZeroTest(VehicleTestCase):
+    """At loop rate 0 the cycles follow each other at once; while the bus is lost there is
+    nothing to clock out, and they must not turn into a busy loop."""
+    GPIO = False
+    CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 60000, "loop_rate_hz": 0}
+    EXTRA_CONFIG = {"gpio": RECOVERY_GPIO, "recovery": RECOVERY}
+
+    def test_lost_bus_paces_the_cycles(self):
+        rig = self.rig
+        rig.thrust([1200] + [0] * 7)
+        rig.wait_sim_speeds([speed_byte(1200)] + [ZERO] * 7)
+        rig.sim_call("HoldScl")
+        try:
+            rig.wait_state("killed", 30)
+            self.assertEqual(rig.vget("State", BUS_PATH, BUS_IFACE), "lost")
+            start = int(rig.vget("Cycles"))
+            time.sleep(1.0)
+            # The 50 Hz backstop tick: about 50 cycles a second (a busy loop makes tens of thousands).
+            self.assertLess(int(rig.vget("Cycles")) - start, 500)
+        finally:
+            rig.sim_call("ReleaseBus")
+        poll(lambda: rig.vget("State", BUS_PATH, BUS_IFACE) == "ok", 30, interval=0.1,
+             message="the bus never came back")
+        rig.wait_sim_zero(10)
+        # Back to flat out once the bus is back.
+        start = int(rig.vget("Cycles"))
+        poll(lambda: int(rig.vget("Cycles")) - start > 500, 10, message="cycles did not go back to flat out")
+
+
 class BusRecoveryWithoutRebindTest(VehicleTestCase):
     """A bus clear that does not give the bus back (here: no driver_id, so the pins stay GPIO,
     as on a Raspberry Pi configured without it) is a failed recovery: the vehicle must end up
