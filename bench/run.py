@@ -416,22 +416,20 @@ def phase_cost(b, p, res):
     d = b.start_daemon(cfg50, wrapper=("valgrind", "--tool=callgrind", f"--callgrind-out-file={out}"),
                        ready_timeout=120)
     time.sleep(p["cg_warm"])
+    def window(label):
+        dump, win = callgrind_window(b, d.pid, p["cg_window"], label)
+        ir = callgrind_total(dump)
+        ticks = max(1, win["cycles"])
+        return {"window_cycles": win["cycles"], "window_seconds": win["seconds"], "ir": ir,
+                "ir_per_tick": ir / ticks,
+                "inclusive_per_tick": {k: v / ticks for k, v in callgrind_inclusive(dump, CG_FUNCTIONS).items()}}
+
     cg = cost["callgrind"] = {"stream_hz": p["stream_hz"]}
-    dump, win = callgrind_window(b, d.pid, p["cg_window"], "idle")
-    ir = callgrind_total(dump)
-    cg["idle"] = {"window_cycles": win["cycles"], "window_seconds": win["seconds"], "ir": ir,
-                  "ir_per_tick": ir / max(1, win["cycles"]),
-                  "inclusive_per_tick": {k: v / max(1, win["cycles"])
-                                         for k, v in callgrind_inclusive(dump, CG_FUNCTIONS).items()}}
+    cg["idle"] = window("idle")
     stream = b.spawn([b.exe["client"], "stream", "--bus", b.bus, "--hz", str(p["stream_hz"]),
                       "--seconds", str(p["cg_window"] + 60)], "stream-cg", stdout=subprocess.PIPE)
     time.sleep(2)
-    dump, win = callgrind_window(b, d.pid, p["cg_window"], "stream")
-    ir = callgrind_total(dump)
-    cg["stream"] = {"window_cycles": win["cycles"], "window_seconds": win["seconds"], "ir": ir,
-                    "ir_per_tick": ir / max(1, win["cycles"]),
-                    "inclusive_per_tick": {k: v / max(1, win["cycles"])
-                                           for k, v in callgrind_inclusive(dump, CG_FUNCTIONS).items()}}
+    cg["stream"] = window("stream")
     b.stop(stream)
     b.stop_daemon()
 

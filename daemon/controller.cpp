@@ -13,7 +13,6 @@
 namespace caracara {
 
 namespace {
-// Bus work runs below D-Bus so that calls are served between transactions.
 constexpr uint64_t kTelemetryPeriodNs = 200'000'000; // 5 Hz of PropertiesChanged
 constexpr uint32_t kBackstopRateHz = 50;                // the tick at loop rate 0
 constexpr const char* kPowerOffConfirmation = "power-off";
@@ -203,7 +202,6 @@ bool Controller::input_pending() const {
 int Controller::on_work(sd_event_source*, void* userdata) {
     auto* self = static_cast<Controller*>(userdata);
     auto step_aside = [self] {
-        self->stepped_aside_ = true;
         sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
         sd_event_source_set_enabled(self->resume_source_.get(), SD_EVENT_ONESHOT);
     };
@@ -233,7 +231,6 @@ int Controller::on_work(sd_event_source*, void* userdata) {
 
 int Controller::on_resume(sd_event_source*, void* userdata) {
     auto* self = static_cast<Controller*>(userdata);
-    self->stepped_aside_ = false;
     if (!self->in_cycle_ && (self->config_.control.loop_rate_hz == 0 || self->cycle_overrun_)) {
         self->cycle_overrun_ = false;
         self->cycle(); // as fast as the bus allows
@@ -244,9 +241,13 @@ int Controller::on_resume(sd_event_source*, void* userdata) {
 }
 
 void Controller::schedule_work() {
-    // While the work has stepped aside, on_resume takes it up again right after the
-    // announcements (a tick or a command in between must not put it back in front of them).
-    if (work_source_ && !stepped_aside_)
+    // While the work has stepped aside (on_resume pending; sd-event turns a one-shot source off
+    // before dispatching it), on_resume takes it up again right after the announcements: a
+    // tick or a command in between must not put it back in front of them.
+    int resume_pending = SD_EVENT_OFF;
+    if (resume_source_)
+        sd_event_source_get_enabled(resume_source_.get(), &resume_pending);
+    if (work_source_ && resume_pending == SD_EVENT_OFF)
         sd_event_source_set_enabled(work_source_.get(), SD_EVENT_ON);
 }
 
@@ -282,14 +283,20 @@ bool Controller::any_order_due() const {
     return std::any_of(order_due_.begin(), order_due_.end(), [](bool d) { return d; });
 }
 
-Controller::Work Controller::work_one() {
+bool Controller::send_next_due_order() {
     for (size_t i = 0; i < thrusters_.size() && !recovering_; ++i) {
         if (order_due_[i]) {
             order_due_[i] = false;
             send_order(i);
-            return Work::Order;
+            return true;
         }
     }
+    return false;
+}
+
+Controller::Work Controller::work_one() {
+    if (send_next_due_order())
+        return Work::Order;
     if (status_due_ > 0 && !recovering_) {
         --status_due_;
         const size_t i = status_next_;
@@ -312,11 +319,8 @@ void Controller::send_order(size_t i) {
 }
 
 void Controller::send_due_orders() {
-    for (size_t i = 0; i < thrusters_.size() && !recovering_; ++i)
-        if (order_due_[i]) {
-            order_due_[i] = false;
-            send_order(i);
-        }
+    while (send_next_due_order()) {
+    }
 }
 
 void Controller::zero_now() {

@@ -189,12 +189,12 @@ private:
     enum class Work { None, Order, Other };
     Work work_one(); // one transaction, orders first
     void schedule_work();
-    bool stepped_aside_ = false; // the work waits for on_resume
     bool cycle_overrun_ = false;  // a tick came while a cycle was still going
     bool any_order_due() const;
     void refresh_orders();
     void send_order(size_t i);
-    void send_due_orders(); // now, back to back
+    bool send_next_due_order(); // false when none is due (or the bus is being recovered)
+    void send_due_orders();     // now, back to back
     void zero_now();
     void handle(const SafetyAction& a);
     Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);

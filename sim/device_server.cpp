@@ -140,8 +140,7 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
     // Realistic timing: the reply leaves when the transaction is over on the wire, and the
     // wire is shared, so a transaction waits for the one before it.
     uint64_t& free_at = self->vehicle_.bus_free_at();
-    const uint64_t start = std::max(monotonic_ns(), free_at);
-    free_at = start + wire_ns;
+    free_at = self->vehicle_.wire_start(monotonic_ns()) + wire_ns;
     if (free_at - monotonic_ns() <= kSpinLimitNs) {
         // Short waits block the simulator right here: an event-loop timer would add its own
         // wake-up lateness to every order.
@@ -255,9 +254,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         }
         if (!r.ok() || !r.at_end())
             return bad(-EBADMSG);
-        uint64_t start = monotonic_ns();
-        if (vehicle_.realistic_timing())
-            start = std::max(start, vehicle_.bus_free_at());
+        const uint64_t start = vehicle_.wire_start(monotonic_ns());
         auto res = vehicle_.i2c().transfer(msgs, start);
         begin(res.ret);
         if (res.ret >= 0)
@@ -300,9 +297,7 @@ uint64_t DeviceServer::handle(Client& c, std::span<const uint8_t> req) {
         if (!r.ok() || !r.at_end())
             return bad(-EBADMSG);
         SpiPort* port = vehicle_.spi_port(it->second.path);
-        uint64_t start = monotonic_ns();
-        if (vehicle_.realistic_timing())
-            start = std::max(start, vehicle_.bus_free_at());
+        const uint64_t start = vehicle_.wire_start(monotonic_ns());
         uint64_t wire = 0;
         int res = vehicle_.spi_message(*port, xfers, start, wire);
         begin(res);

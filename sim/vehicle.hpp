@@ -11,6 +11,7 @@
 #include "vehicle_body.hpp"
 #include "wire_log.hpp"
 
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <memory>
@@ -76,6 +77,9 @@ public:
     void set_realistic_timing(bool on) { realistic_ = on; }
     // Real-time mode: the wire is busy until this time; the next transaction starts after it.
     uint64_t& bus_free_at() { return bus_free_at_; }
+    // When a transaction asked for at `now_ns` starts on the wire: at once, or in real-time
+    // mode once the one before it is over.
+    uint64_t wire_start(uint64_t now_ns) const { return realistic_ ? std::max(now_ns, bus_free_at_) : now_ns; }
 
 private:
     SimConfig cfg_;
