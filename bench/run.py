@@ -90,9 +90,12 @@ class Bench:
 <policy context="default"><allow send_destination="*" eavesdrop="true"/><allow eavesdrop="true"/><allow own="*"/></policy>
 </busconfig>
 """)
-        self.dbusd = self.spawn(["dbus-daemon", "--nofork", f"--config-file={conf}"], "dbus-daemon")
+        # The socket file appears before dbus-daemon listens; its printed address means it does.
+        self.dbusd = self.spawn(["dbus-daemon", "--nofork", "--print-address=1", f"--config-file={conf}"],
+                                "dbus-daemon")
         self.bus = f"unix:path={path}"
-        self.wait_for(lambda: os.path.exists(path), 10, "the private dbus-daemon")
+        log = os.path.join(self.dir, "dbus-daemon.log")
+        self.wait_for(lambda: self.bus in open(log).read(), 10, "the private dbus-daemon")
 
     def wait_for(self, pred, timeout, what):
         end = time.monotonic() + timeout

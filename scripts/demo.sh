@@ -28,11 +28,15 @@ cat >"$dir/bus.conf" <<CONF
 </busconfig>
 CONF
 bus="unix:path=$dir/bus"
-dbus-daemon --nofork --config-file="$dir/bus.conf" & pids+=($!)
-for _ in $(seq 100); do [ -S "$dir/bus" ] && break; sleep 0.05; done
+# The socket file appears before dbus-daemon listens; its printed address means it does.
+dbus-daemon --nofork --print-address=1 --config-file="$dir/bus.conf" >"$dir/dbus.log" & pids+=($!)
+for _ in $(seq 200); do grep -qF "$bus" "$dir/dbus.log" 2>/dev/null && break; sleep 0.05; done
 
 "$build/sim/caracara-sim" --socket "$dir/sim.sock" --bus-address "$bus" >"$dir/sim.log" 2>&1 & pids+=($!)
-for _ in $(seq 100); do [ -S "$dir/sim.sock" ] && break; sleep 0.05; done
+# The simulator takes its bus name after it listens on its socket.
+for _ in $(seq 200); do
+  busctl --address="$bus" status org.caracara.Simulator1 >/dev/null 2>&1 && break; sleep 0.05
+done
 "$build/daemon/caracarad" --hardware="sim:$dir/sim.sock" --bus-address "$bus" & pids+=($!)
 
 ctl() { echo; echo "\$ caracaractl $*"; "$build/tools/caracaractl" --bus-address "$bus" "$@"; }

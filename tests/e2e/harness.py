@@ -371,10 +371,12 @@ class Rig:
                 raise RuntimeError("%s is not built (CARACARA_BUILD_DIR=%s)" % (binary(name), BUILD_DIR))
         with open(os.path.join(self.dir, "bus.conf"), "w") as f:
             f.write(BUS_CONF.format(dir=self.dir, extra=self.bus_policy_extra))
-        self._spawn("dbus-daemon", ["/usr/bin/dbus-daemon", "--nofork",
+        # The socket file appears at bind(), before listen(): a connect in between is refused.
+        # dbus-daemon prints its address (into its log) only once it listens.
+        self._spawn("dbus-daemon", ["/usr/bin/dbus-daemon", "--nofork", "--print-address=1",
                                     "--config-file=" + os.path.join(self.dir, "bus.conf")])
-        poll(lambda: os.path.exists(os.path.join(self.dir, "bus")) or self._died("dbus-daemon"),
-             self.START_TIMEOUT, message="dbus-daemon did not create its socket")
+        poll(lambda: self.address in self.log("dbus-daemon") or self._died("dbus-daemon"),
+             self.START_TIMEOUT, message="dbus-daemon did not print its address")
         self._check_alive("dbus-daemon")
         self.conn = dbus.bus.BusConnection(self.address, mainloop=dbus.mainloop.glib.DBusGMainLoop())
         self._spawn("caracara-sim", [binary("caracara-sim"), "--socket", self.sim_socket,

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -102,9 +103,19 @@ SimFixture::SimFixture(const std::vector<std::string>& sim_args) {
                "<busconfig><type>session</type><listen>unix:path=" + dir_ + "/bus</listen>"
                "<auth>EXTERNAL</auth><policy context=\"default\"><allow send_destination=\"*\" eavesdrop=\"true\"/>"
                "<allow eavesdrop=\"true\"/><allow own=\"*\"/></policy></busconfig>\n");
-    dbus_daemon.start({"/usr/bin/dbus-daemon", "--nofork", "--config-file=" + dir_ + "/bus.conf"}, dir_ + "/dbus.log");
-    for (int i = 0; i < 500 && access((dir_ + "/bus").c_str(), F_OK) != 0; ++i)
+    // The socket file appears at bind(), before listen(): a connect in between is refused.
+    // dbus-daemon prints its address (into its log) only once it listens.
+    dbus_daemon.start({"/usr/bin/dbus-daemon", "--nofork", "--print-address=1", "--config-file=" + dir_ + "/bus.conf"},
+                      dir_ + "/dbus.log");
+    for (int i = 0;; ++i) {
+        std::ifstream log(dir_ + "/dbus.log");
+        std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+        if (text.find(bus_address()) != std::string::npos)
+            break;
+        if (i == 3000 || !dbus_daemon.running())
+            throw std::runtime_error("the private dbus-daemon did not come up; see " + dir_ + "/dbus.log");
         std::this_thread::sleep_for(10ms);
+    }
 
     std::vector<std::string> argv = {bin("sim/caracara-sim"), "--socket", socket_, "--bus-address", bus_address()};
     argv.insert(argv.end(), sim_args.begin(), sim_args.end());
