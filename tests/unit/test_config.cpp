@@ -1,7 +1,10 @@
 #include "config.hpp"
 
 #include <catch2/catch.hpp>
+#include <cctype>
 #include <fstream>
+#include <random>
+#include <vector>
 #include <map>
 #include <sstream>
 
@@ -377,4 +380,86 @@ TEST_CASE("every problem in a file is reported at once, prefixed with the source
         CHECK_THAT(e, Catch::StartsWith("vehicle.toml: "));
     CHECK_THAT(r.error(), Catch::Contains("i2c.retries") && Catch::Contains("control.loop_rate_hz") &&
                               Catch::Contains("control.budget_policy"));
+}
+
+// In the manner of a fuzzer: the shipped example with every option enabled, one to three of its
+// values replaced by edge values of every TOML type. Whatever comes out, the parser neither
+// throws nor trips the sanitizers, every message of a refused file names its key, and a value of
+// the wrong type or out of any integer key's range is refused, with its key and line, instead of
+// being wrapped or truncated.
+TEST_CASE("mutated values: a refused file names each bad key and line, nothing is wrapped or truncated") {
+    std::ifstream f(CARACARA_EXAMPLE_CONFIG);
+    REQUIRE(f);
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(f, line);)
+        lines.push_back(line.rfind("#: ", 0) == 0 ? line.substr(3) : line);
+    std::vector<size_t> keyed; // lines "key = value" outside the matrix
+    for (size_t i = 0; i < lines.size(); ++i)
+        if (!lines[i].empty() && std::isalpha(static_cast<unsigned char>(lines[i][0])) &&
+            lines[i].find(" = ") != std::string::npos && lines[i].find('[') == std::string::npos)
+            keyed.push_back(i);
+    REQUIRE(keyed.size() > 20);
+
+    struct Edge {
+        const char* text;
+        enum { Int, OutOfRange, Float, String, Other } kind;
+    };
+    const Edge edges[] = {
+        {"0", Edge::Int}, {"1", Edge::Int}, {"255", Edge::Int}, {"65536", Edge::Int}, {"4294967295", Edge::Int},
+        {"-1", Edge::OutOfRange}, {"4294967296", Edge::OutOfRange}, {"9223372036854775807", Edge::OutOfRange},
+        {"-9223372036854775808", Edge::OutOfRange}, {"0.5", Edge::Float}, {"-0.0", Edge::Float},
+        {"1e308", Edge::Float}, {"-1e308", Edge::Float}, {"nan", Edge::Float}, {"inf", Edge::Float},
+        {"-inf", Edge::Float}, {"1e-300", Edge::Float}, {"\"\"", Edge::String}, {"\"x\"", Edge::String},
+        {"\"/dev/null\"", Edge::String}, {"true", Edge::Other}, {"false", Edge::Other}, {"[]", Edge::Other},
+        {"[1, 2]", Edge::Other}, {"{}", Edge::Other}, {"{ chip = 7 }", Edge::Other},
+        {"1979-05-27T07:32:00Z", Edge::Other},
+    };
+    const unsigned seed = 20261121;
+    INFO("seed " << seed);
+    std::mt19937 rng(seed);
+    auto pick = [&](size_t n) { return std::uniform_int_distribution<size_t>(0, n - 1)(rng); };
+    auto is_integer = [](const std::string& v) {
+        return !v.empty() && v.find_first_not_of("0123456789abcdefABCDEFx") == std::string::npos &&
+               std::isdigit(static_cast<unsigned char>(v[0]));
+    };
+    int accepted = 0, refused = 0;
+    for (int round = 0; round < 3000; ++round) {
+        std::vector<std::string> text = lines;
+        // line -> its key, for replacements no key of that kind may take
+        std::map<size_t, std::string> must_refuse;
+        for (size_t k = 1 + pick(3); k > 0; --k) {
+            const size_t at = keyed[pick(keyed.size())];
+            const size_t eq = lines[at].find(" = ");
+            const std::string key = lines[at].substr(0, eq);
+            const std::string old_value = lines[at].substr(eq + 3); // the example's own value and type
+            const Edge& e = edges[pick(std::size(edges))];
+            text[at] = key + " = " + e.text;
+            const bool old_int = is_integer(old_value);
+            const bool old_str = old_value.front() == '"';
+            if ((old_int && (e.kind == Edge::OutOfRange || e.kind == Edge::Float || e.kind == Edge::String)) ||
+                (old_str && e.kind != Edge::String))
+                must_refuse[at] = key;
+            else
+                must_refuse.erase(at);
+        }
+        std::string joined;
+        for (auto& l : text)
+            joined += l + "\n";
+        INFO("config:\n" << joined);
+        const ConfigResult r = parse_config_string(joined);
+        if (r.ok()) {
+            ++accepted;
+            CHECK(must_refuse.empty());
+            continue;
+        }
+        ++refused;
+        REQUIRE_FALSE(r.errors.empty());
+        for (const auto& err : r.errors)
+            CHECK_THAT(err, Catch::Contains(": "));
+        for (const auto& [at, key] : must_refuse)
+            CHECK_THAT(r.error(), Catch::Contains(key + ": ") && Catch::Contains("(line " + std::to_string(at + 1) + ")"));
+    }
+    // Both outcomes were reached, so the checks above saw both kinds of result.
+    CHECK(accepted > 20);
+    CHECK(refused > 1000);
 }
