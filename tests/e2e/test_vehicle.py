@@ -6,6 +6,7 @@ harness.budget_limit, harness.SEED_AXIS_MOTORS), never read back from the daemon
 """
 
 import math
+import random
 import signal
 import time
 import unittest
@@ -1180,18 +1181,26 @@ class InvalidInputTest(VehicleTestCase):
         self.rig.thrust(self.values)
         self.rig.wait_sim_speeds([speed_byte(v) for v in self.values])
 
-    def check_refused(self, expected_error, fn, *args, **kwargs):
+    def vehicle_view(self):
+        """What a refused call must leave alone: the thrusters' orders on the simulated wire, the
+        requested values, the LEDs on the simulated Teensy."""
         rig = self.rig
-        before = rig.sim_snapshot()
-        requested = list(rig.vget("RequestedValues"))
-        leds = tuple(rig.sim_teensy("Leds"))
-        self.assertEqual(error_name(fn, *args, **kwargs), expected_error)
+        return rig.sim_snapshot(), list(rig.vget("RequestedValues")), tuple(rig.sim_teensy("Leds"))
+
+    def check_unchanged(self, before):
+        rig = self.rig
         rig.wait_orders_refreshed()
-        self.assertEqual(rig.sim_snapshot(), before, "the simulated thrusters changed")
-        self.assertEqual(list(rig.vget("RequestedValues")), requested)
-        self.assertEqual(tuple(rig.sim_teensy("Leds")), leds)
+        snapshot, requested, leds = self.vehicle_view()
+        self.assertEqual(snapshot, before[0], "the simulated thrusters changed")
+        self.assertEqual(requested, before[1])
+        self.assertEqual(leds, before[2])
         self.assertEqual(rig.state(), "ready")
         self.assertEqual(rig.vget("Controller"), rig.conn.get_unique_name())
+
+    def check_refused(self, expected_error, fn, *args, **kwargs):
+        before = self.vehicle_view()
+        self.assertEqual(error_name(fn, *args, **kwargs), expected_error)
+        self.check_unchanged(before)
 
     def test_set_thrust(self):
         rig = self.rig
@@ -1279,6 +1288,66 @@ class InvalidInputTest(VehicleTestCase):
                                    iface=TEENSY_IFACE)
                 self.assertEqual(list(rig.sim_teensy("Servos")), servos)
                 self.assertEqual(rig.sim_teensy("Task"), "idle")
+
+
+    def test_random_calls(self):
+        """In the manner of a fuzzer: calls with random argument vectors (lengths, values at and
+        past every limit, NaN and infinities, arguments of other types). Each is accepted or
+        refused with a named error, and a refused one changes nothing (check_unchanged)."""
+        rig = self.rig
+        rng = random.Random(20261121)
+        # Each value is valid but for a one-in-ten chance of one at or past a limit, so that
+        # calls are accepted about as often as they are refused.
+        def value(good, bad):
+            return rng.choice(bad) if rng.random() < 0.1 else rng.choice(good)
+
+        def motor():
+            return value([0, 1, -1, 100, -2500, 8850, -8850], [8851, -8851, 2 ** 31 - 1, -2 ** 31])
+
+        def thrust():
+            n = 8 if rng.random() < 0.85 else rng.choice([0, 1, 7, 9, 13])
+            return "SetThrust", (dbus.Array([motor() for _ in range(n)], signature="i"),), "ai"
+
+        def motion():
+            axis = [value([0.0, -0.0, 0.25, -1.0, 1.0, 5e-324], [1.0000001, -1.5, NAN, INF, -INF, 1e308])
+                    for _ in range(6)]
+            return "SetMotion", tuple(axis), "dddddd"
+
+        def apply_packet():
+            # killState stays 0 and powerOffState is never 1: a kill or a power-off is a valid
+            # call whose effect is the point, not a refusal (KillTest and PowerOffTest).
+            words = [motor() for _ in range(8)] + [0, value([0], [2, -1, 7])]
+            words += [value([0, 40, 255], [256, -1]) for _ in range(3)]
+            n = 13 if rng.random() < 0.9 else rng.choice([12, 14])
+            return "ApplyPacket", (dbus.Array((words + [0])[:n], signature="i"),), "ai"
+
+        def other_types():
+            method = rng.choice(["SetThrust", "SetMotion", "ApplyPacket", "SetLeds", "PowerOff"])
+            sig, args = rng.choice([("s", ("x",)), ("ad", (dbus.Array([0.5] * 8, signature="d"),)),
+                                    ("au", (dbus.Array([1] * 13, signature="u"),)), ("iii", (1, 2, 3)),
+                                    ("ddddd", (0.0,) * 5), ("", ()), ("ay", (dbus.ByteArray(b"\x01" * 8),))])
+            return method, args, sig
+
+        outcomes = {}
+        for i in range(150):
+            method, args, sig = rng.choice([thrust, motion, apply_packet, other_types])()
+            with self.subTest(i=i, method=method, signature=sig, args=repr(args)[:200]):
+                before = self.vehicle_view()
+                err = error_name(rig.vcall, method, *args, signature=sig)
+                outcomes[err] = outcomes.get(err, 0) + 1
+                if err is None:
+                    # Accepted: let its orders (and a packet's LEDs) reach the vehicle, so that
+                    # the next refusal is compared with a settled vehicle.
+                    rig.wait_orders_refreshed()
+                    if method == "ApplyPacket":
+                        poll(lambda: tuple(rig.sim_teensy("Leds")) == tuple(args[0][10:13]), 10)
+                    self.assertEqual(rig.state(), "ready")
+                    continue
+                self.assertTrue(err.startswith(ERR) or err == INVALID_ARGS, "unnamed error %s" % err)
+                self.check_unchanged(before)
+        # Both outcomes and several kinds of refusal were reached.
+        self.assertGreater(outcomes.get(None, 0), 10, outcomes)
+        self.assertGreaterEqual(len([e for e in outcomes if e]), 4, outcomes)
 
 
 # --------------------------------------------------------------------------------------------
