@@ -133,6 +133,9 @@ int main(int argc, char** argv) {
     sd_event_add_signal(event.get(), nullptr, SIGTERM, on_signal, nullptr);
     sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
     sd_event_add_signal(event.get(), nullptr, SIGHUP, on_signal, nullptr);
+    // A closed log pipe (caracarad | head) is an EPIPE, not the end of the daemon; systemd's
+    // IgnoreSIGPIPE= does the same for the service.
+    signal(SIGPIPE, SIG_IGN);
 
     Controller controller(event.get(), *hw.io, *hw.gpio, *cr.config);
     if (std::string e = controller.start(); !e.empty()) {

@@ -74,7 +74,7 @@ void EmergencyStop::install_fatal_handlers(EmergencyStop* stop) {
     sa.sa_handler = on_fatal;
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = SA_RESETHAND | SA_NODEFER;
-    for (int sig : {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT})
+    for (int sig : kFatalSignals)
         sigaction(sig, &sa, nullptr);
 }
 

@@ -7,6 +7,7 @@
 #include "thruster.hpp"
 
 #include <array>
+#include <csignal>
 #include <linux/i2c.h>
 #include <memory>
 #include <span>
@@ -23,8 +24,16 @@ public:
     void fire() noexcept;
     bool armed() const { return fd_ >= 0; }
 
-    // Installs handlers for SIGSEGV, SIGBUS, SIGILL, SIGFPE and SIGABRT that fire `stop`, then
-    // let the signal take its default course (core dump, and systemd restarts the service).
+    // Every signal whose default action ends the process and that the daemon does not handle
+    // itself (SIGTERM, SIGINT and SIGHUP stop it cleanly through the event loop; SIGPIPE is
+    // ignored): crashes, and stray signals such as SIGQUIT or SIGUSR1 that would otherwise end it
+    // with the thrusters still running.
+    static constexpr int kFatalSignals[] = {SIGSEGV, SIGBUS,  SIGILL,  SIGFPE,    SIGABRT, SIGQUIT,  SIGTRAP,
+                                            SIGSYS,  SIGXCPU, SIGXFSZ, SIGUSR1,   SIGUSR2, SIGALRM,  SIGVTALRM,
+                                            SIGPROF, SIGIO,   SIGPWR,  SIGSTKFLT};
+    // Installs handlers for kFatalSignals that fire `stop`, then let the signal take its default
+    // course (the process ends, with a core dump where the signal makes one, and systemd restarts
+    // the service).
     static void install_fatal_handlers(EmergencyStop* stop);
 
 private:
