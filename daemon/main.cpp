@@ -134,8 +134,10 @@ int main(int argc, char** argv) {
     sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
     sd_event_add_signal(event.get(), nullptr, SIGHUP, on_signal, nullptr);
     // A closed log pipe (caracarad | head) is an EPIPE, not the end of the daemon; systemd's
-    // IgnoreSIGPIPE= does the same for the service.
-    signal(SIGPIPE, SIG_IGN);
+    // IgnoreSIGPIPE= does the same for the service. Terminal stop signals (Ctrl-Z, a background
+    // daemon writing to its terminal) would freeze it with the thrusters running.
+    for (int sig : {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU})
+        signal(sig, SIG_IGN);
 
     Controller controller(event.get(), *hw.io, *hw.gpio, *cr.config);
     if (std::string e = controller.start(); !e.empty()) {

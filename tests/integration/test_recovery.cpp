@@ -5,7 +5,11 @@
 
 #include <catch2/catch.hpp>
 #include <csignal>
+#include <chrono>
 #include <ctime>
+#include <fstream>
+#include <string>
+#include <thread>
 
 using namespace caracara::test;
 
@@ -286,4 +290,34 @@ TEST_CASE("a crashing daemon, or one ended by a stray signal, zeroes the thruste
         CHECK(all_at(f, std::vector<int32_t>(8, 0)));
         CHECK(f.sim.terminate() == 0);
     }
+}
+
+TEST_CASE("terminal stop signals do not freeze a daemon that is driving the thrusters") {
+    // Ctrl-Z, or a background daemon writing to its terminal, would stop it with the thrusters
+    // running and no command timeout able to fire. Only SIGSTOP, which nothing can catch, can.
+    SimFixture f;
+    DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"));
+    const std::vector<int32_t> v = {1500, 1500, 1500, 1500, 1500, 1500, 1500, 1500};
+    REQUIRE(d.set_thrust(v) == "");
+    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    auto stopped = [&] {
+        std::ifstream stat("/proc/" + std::to_string(d.daemon.pid()) + "/stat");
+        std::string line;
+        std::getline(stat, line);
+        const auto paren = line.rfind(')');
+        return paren != std::string::npos && paren + 2 < line.size() && line[paren + 2] == 'T';
+    };
+    for (int sig : {SIGTSTP, SIGTTIN, SIGTTOU}) {
+        INFO("signal " << sig);
+        kill(d.daemon.pid(), sig);
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        CHECK_FALSE(stopped());
+        kill(d.daemon.pid(), SIGCONT); // keeps a failure from hanging the calls below
+        const uint64_t before = d.bus_u64("Transactions");
+        CHECK(d.wait_for([&] { return d.bus_u64("Transactions") > before + 20; }));
+    }
+    REQUIRE(d.set_thrust(std::vector<int32_t>(8, 0)) == "");
+    CHECK(d.wait_for([&] { return all_at(f, std::vector<int32_t>(8, 0)); }));
+    CHECK(d.daemon.terminate() == 0);
+    CHECK(f.sim.terminate() == 0);
 }
