@@ -195,6 +195,8 @@ int main(int argc, char** argv) {
                dbus::kBusName);
 
     int r = sd_event_loop(event.get());
+    if (r > 0) // only sd-bus's exit on disconnect leaves the loop with a failure status
+        log_error("lost its connection to the bus: thrusters to zero, exiting");
     controller.set_observer(nullptr);
     controller.shutdown();
     EmergencyStop::install_fatal_handlers(nullptr);

@@ -9,12 +9,14 @@ namespace caracara::test {
 
 using namespace std::chrono_literals;
 
-DaemonFixture::DaemonFixture(SimFixture& sim, const std::string& config, bool wait_ready) : sim_(sim) {
+DaemonFixture::DaemonFixture(SimFixture& sim, const std::string& config, bool wait_ready,
+                             const std::string& bus_address)
+    : sim_(sim) {
+    const std::string address = bus_address.empty() ? sim.bus_address() : bus_address;
     const std::string cfg = sim.write_file("caracarad.toml", config);
-    daemon.start({bin("daemon/caracarad"), "--config", cfg, "--hardware=sim:" + sim.socket(), "--bus-address",
-                  sim.bus_address()},
+    daemon.start({bin("daemon/caracarad"), "--config", cfg, "--hardware=sim:" + sim.socket(), "--bus-address", address},
                  sim.dir() + "/caracarad.log");
-    dbus::BusChoice choice{dbus::BusChoice::Kind::Address, sim.bus_address()};
+    dbus::BusChoice choice{dbus::BusChoice::Kind::Address, address};
     if (dbus::open_bus(choice, "caracara-test-client", bus_) < 0)
         throw std::runtime_error("cannot connect to the private bus");
     const bool up = wait_for([&] {

@@ -11,9 +11,10 @@ namespace caracara::test {
 
 class DaemonFixture {
 public:
-    // Writes `config` (TOML) and starts caracarad; waits until the name is owned and, if
-    // `wait_ready`, until State is "ready".
-    DaemonFixture(SimFixture& sim, const std::string& config, bool wait_ready = true);
+    // Writes `config` (TOML) and starts caracarad on the simulator's bus, or on `bus_address`
+    // when given; waits until the name is owned and, if `wait_ready`, until State is "ready".
+    DaemonFixture(SimFixture& sim, const std::string& config, bool wait_ready = true,
+                  const std::string& bus_address = {});
     ~DaemonFixture();
 
     sd_bus* bus() { return bus_.get(); }

@@ -90,32 +90,40 @@ void Process::stop(int sig) {
     }
 }
 
+std::string start_private_bus(Process& daemon, const std::string& dir, const std::string& name) {
+    const std::string path = dir + "/" + name;
+    const std::string address = "unix:path=" + path;
+    // An open policy: the tests are its only users.
+    {
+        std::ofstream conf(path + ".conf");
+        conf << "<!DOCTYPE busconfig PUBLIC \"-//freedesktop//DTD D-Bus Bus Configuration 1.0//EN\"\n"
+                " \"http://www.freedesktop.org/standards/dbus/1.0/busconfig.dtd\">\n"
+                "<busconfig><type>session</type><listen>" + address + "</listen>"
+                "<auth>EXTERNAL</auth><policy context=\"default\"><allow send_destination=\"*\" eavesdrop=\"true\"/>"
+                "<allow eavesdrop=\"true\"/><allow own=\"*\"/></policy></busconfig>\n";
+    }
+    // The socket file appears at bind(), before listen(): a connect in between is refused.
+    // dbus-daemon prints its address (into its log) only once it listens.
+    const std::string log_path = path + "-dbus.log";
+    daemon.start({"/usr/bin/dbus-daemon", "--nofork", "--print-address=1", "--config-file=" + path + ".conf"}, log_path);
+    for (int i = 0;; ++i) {
+        std::ifstream log(log_path);
+        std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+        if (text.find(address) != std::string::npos)
+            return address;
+        if (i == 3000 || !daemon.running())
+            throw std::runtime_error("the private dbus-daemon did not come up; see " + log_path);
+        std::this_thread::sleep_for(10ms);
+    }
+}
+
 SimFixture::SimFixture(const std::vector<std::string>& sim_args) {
     char tmpl[] = "/tmp/caracara-test-XXXXXX";
     if (!mkdtemp(tmpl))
         throw std::runtime_error("mkdtemp failed");
     dir_ = tmpl;
     socket_ = dir_ + "/sim.sock";
-    // A private bus with an open policy: the tests are its only users.
-    write_file("bus.conf",
-               "<!DOCTYPE busconfig PUBLIC \"-//freedesktop//DTD D-Bus Bus Configuration 1.0//EN\"\n"
-               " \"http://www.freedesktop.org/standards/dbus/1.0/busconfig.dtd\">\n"
-               "<busconfig><type>session</type><listen>unix:path=" + dir_ + "/bus</listen>"
-               "<auth>EXTERNAL</auth><policy context=\"default\"><allow send_destination=\"*\" eavesdrop=\"true\"/>"
-               "<allow eavesdrop=\"true\"/><allow own=\"*\"/></policy></busconfig>\n");
-    // The socket file appears at bind(), before listen(): a connect in between is refused.
-    // dbus-daemon prints its address (into its log) only once it listens.
-    dbus_daemon.start({"/usr/bin/dbus-daemon", "--nofork", "--print-address=1", "--config-file=" + dir_ + "/bus.conf"},
-                      dir_ + "/dbus.log");
-    for (int i = 0;; ++i) {
-        std::ifstream log(dir_ + "/dbus.log");
-        std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
-        if (text.find(bus_address()) != std::string::npos)
-            break;
-        if (i == 3000 || !dbus_daemon.running())
-            throw std::runtime_error("the private dbus-daemon did not come up; see " + dir_ + "/dbus.log");
-        std::this_thread::sleep_for(10ms);
-    }
+    start_private_bus(dbus_daemon, dir_, "bus");
 
     std::vector<std::string> argv = {bin("sim/caracara-sim"), "--socket", socket_, "--bus-address", bus_address()};
     argv.insert(argv.end(), sim_args.begin(), sim_args.end());

@@ -81,4 +81,8 @@ private:
 // Directory of the built binaries, set by CMake.
 std::string bin(const char* name);
 
+// Starts a private dbus-daemon listening on DIR/NAME (config DIR/NAME.conf, log DIR/NAME-dbus.log)
+// and waits until it listens; returns its address.
+std::string start_private_bus(Process& daemon, const std::string& dir, const std::string& name);
+
 } // namespace caracara::test

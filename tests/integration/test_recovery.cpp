@@ -8,6 +8,7 @@
 #include <chrono>
 #include <ctime>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 
@@ -319,5 +320,25 @@ TEST_CASE("terminal stop signals do not freeze a daemon that is driving the thru
     REQUIRE(d.set_thrust(std::vector<int32_t>(8, 0)) == "");
     CHECK(d.wait_for([&] { return all_at(f, std::vector<int32_t>(8, 0)); }));
     CHECK(d.daemon.terminate() == 0);
+    CHECK(f.sim.terminate() == 0);
+}
+
+TEST_CASE("a daemon that loses its D-Bus connection zeroes the thrusters and exits for a restart") {
+    // The daemon on a bus of its own, so that the bus daemon can die under it while the
+    // simulator's inspection API stays reachable on the other.
+    SimFixture f;
+    Process daemon_bus;
+    const std::string address = start_private_bus(daemon_bus, f.dir(), "daemon-bus");
+    DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"), true, address);
+    const std::vector<int32_t> v = {-1800, 1800, -1800, 1800, -1800, 1800, -1800, 1800};
+    REQUIRE(d.set_thrust(v) == "");
+    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    daemon_bus.stop(SIGKILL);
+    // A failure exit, so that systemd's Restart=on-failure brings it back.
+    CHECK(d.daemon.wait_exit(10000) == 1);
+    CHECK(all_at(f, std::vector<int32_t>(8, 0)));
+    std::ifstream log(f.dir() + "/caracarad.log");
+    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    CHECK_THAT(text, Catch::Contains("lost its connection to the bus"));
     CHECK(f.sim.terminate() == 0);
 }
