@@ -90,6 +90,11 @@ void Process::stop(int sig) {
     }
 }
 
+std::string read_file(const std::string& path) {
+    std::ifstream in(path);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 std::string start_private_bus(Process& daemon, const std::string& dir, const std::string& name) {
     const std::string path = dir + "/" + name;
     const std::string address = "unix:path=" + path;
@@ -107,9 +112,7 @@ std::string start_private_bus(Process& daemon, const std::string& dir, const std
     const std::string log_path = path + "-dbus.log";
     daemon.start({"/usr/bin/dbus-daemon", "--nofork", "--print-address=1", "--config-file=" + path + ".conf"}, log_path);
     for (int i = 0;; ++i) {
-        std::ifstream log(log_path);
-        std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
-        if (text.find(address) != std::string::npos)
+        if (read_file(log_path).find(address) != std::string::npos)
             return address;
         if (i == 3000 || !daemon.running())
             throw std::runtime_error("the private dbus-daemon did not come up; see " + log_path);

@@ -81,6 +81,9 @@ private:
 // Directory of the built binaries, set by CMake.
 std::string bin(const char* name);
 
+// The whole file; "" when it cannot be read.
+std::string read_file(const std::string& path);
+
 // Starts a private dbus-daemon listening on DIR/NAME (config DIR/NAME.conf, log DIR/NAME-dbus.log)
 // and waits until it listens; returns its address.
 std::string start_private_bus(Process& daemon, const std::string& dir, const std::string& name);

@@ -8,7 +8,6 @@
 #include <chrono>
 #include <ctime>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <thread>
 
@@ -49,6 +48,12 @@ bool all_at(SimFixture& f, const std::vector<int32_t>& v) {
     return true;
 }
 
+// Commands `v` and waits until every simulated thruster holds it.
+void drive(DaemonFixture& d, SimFixture& f, const std::vector<int32_t>& v) {
+    REQUIRE(d.set_thrust(v) == "");
+    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+}
+
 uint64_t now_ns() {
     timespec ts{};
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -62,8 +67,7 @@ TEST_CASE("a slave holding SDA for k = 1..9 pulses: cleared with exactly k pulse
     DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000",
                               "enabled = true\ndriver_id = \"fe804000.i2c\"\nattempts = 3\nbackoff_ms = 50"));
     const std::vector<int32_t> v = {2000, -2000, 3000, -3000, 1000, -1000, 4000, -4000};
-    REQUIRE(d.set_thrust(v) == "");
-    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    drive(d, f, v);
 
     for (uint32_t k = 1; k <= 9; ++k) {
         INFO("k = " << k);
@@ -144,8 +148,7 @@ TEST_CASE("a kill that arrives during recovery reaches every thruster first once
     DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000",
                               "enabled = true\ndriver_id = \"fe804000.i2c\"\nattempts = 5\nbackoff_ms = 400"));
     const std::vector<int32_t> v = {3000, 3000, 3000, 3000, 0, 0, 0, 0};
-    REQUIRE(d.set_thrust(v) == "");
-    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    drive(d, f, v);
     // SCL stuck: the first attempt fails and the daemon backs off; the kill lands meanwhile.
     REQUIRE(f.call(kSim, kSimIface, "HoldScl", "") == "");
     REQUIRE(d.wait_for([&] { return d.bus_u64("RecoveryFailures") >= 1; }));
@@ -177,8 +180,7 @@ TEST_CASE("the kill switch kills at its edge, not at the next tick, and blocks a
     // A 1 Hz loop: a kill found by polling at the tick could take a whole second.
     DaemonFixture d(f, config("loop_rate_hz = 1\narming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"));
     const std::vector<int32_t> v = {2500, 2500, 2500, 2500, 2500, 2500, 2500, 2500};
-    REQUIRE(d.set_thrust(v) == "");
-    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    drive(d, f, v);
     CHECK_FALSE(f.root_bool("KillOutput"));
 
     REQUIRE(f.call(kSim, kSimIface, "ClearWireLog", "") == "");
@@ -238,8 +240,7 @@ TEST_CASE("the kill switch kills at its edge, not at the next tick, and blocks a
     CHECK_FALSE(f.root_bool("KillOutput"));
     CHECK(d.set_thrust(v) == "org.caracara.Vehicle1.Error.Arming");
     REQUIRE(d.wait_for([&] { return d.vehicle_string("State") == "ready"; }, 5000));
-    REQUIRE(d.set_thrust(v) == "");
-    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    drive(d, f, v);
     // Clean exits: a sanitizer report or a crash would show here.
     CHECK(d.daemon.terminate() == 0);
     CHECK(f.sim.terminate() == 0);
@@ -278,8 +279,7 @@ TEST_CASE("a crashing daemon, or one ended by a stray signal, zeroes the thruste
         SimFixture f;
         DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"));
         const std::vector<int32_t> v = {2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000};
-        REQUIRE(d.set_thrust(v) == "");
-        REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+        drive(d, f, v);
         kill(d.daemon.pid(), sig);
         const int status = d.daemon.wait_exit(10000);
         // Died of that signal, as it would have without the handler (ASan may turn SIGSEGV into
@@ -299,8 +299,7 @@ TEST_CASE("terminal stop signals do not freeze a daemon that is driving the thru
     SimFixture f;
     DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"));
     const std::vector<int32_t> v = {1500, 1500, 1500, 1500, 1500, 1500, 1500, 1500};
-    REQUIRE(d.set_thrust(v) == "");
-    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    drive(d, f, v);
     auto stopped = [&] {
         std::ifstream stat("/proc/" + std::to_string(d.daemon.pid()) + "/stat");
         std::string line;
@@ -331,14 +330,11 @@ TEST_CASE("a daemon that loses its D-Bus connection zeroes the thrusters and exi
     const std::string address = start_private_bus(daemon_bus, f.dir(), "daemon-bus");
     DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"), true, address);
     const std::vector<int32_t> v = {-1800, 1800, -1800, 1800, -1800, 1800, -1800, 1800};
-    REQUIRE(d.set_thrust(v) == "");
-    REQUIRE(d.wait_for([&] { return all_at(f, v); }));
+    drive(d, f, v);
     daemon_bus.stop(SIGKILL);
     // A failure exit, so that systemd's Restart=on-failure brings it back.
     CHECK(d.daemon.wait_exit(10000) == 1);
     CHECK(all_at(f, std::vector<int32_t>(8, 0)));
-    std::ifstream log(f.dir() + "/caracarad.log");
-    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
-    CHECK_THAT(text, Catch::Contains("lost its connection to the bus"));
+    CHECK_THAT(read_file(f.dir() + "/caracarad.log"), Catch::Contains("lost its connection to the bus"));
     CHECK(f.sim.terminate() == 0);
 }

@@ -22,6 +22,12 @@
 using namespace caracara;
 using caracara::test::SimFixture;
 
+namespace {
+// A stop order (SPEED 0x80, INFO 100) for the thruster at MT 0x52 (7-bit 0x29), with the
+// checksum over the address byte.
+const uint8_t kOrder[] = {0x80, 0x64, static_cast<uint8_t>(0x52 + 0x80 + 0x64)};
+} // namespace
+
 TEST_CASE("i2c-dev open checks I2C_FUNCS and unknown nodes fail like the kernel") {
     SimFixture f;
     SimDeviceIo io;
@@ -75,8 +81,7 @@ TEST_CASE("wire time is accounted at the configured clock") {
     REQUIRE(io.connect(f.socket()) == 0);
     I2cDev bus(io, "/dev/i2c-1");
     REQUIRE(bus.open() == 0);
-    const uint8_t order[] = {0x80, 0x64, static_cast<uint8_t>(0x52 + 0x80 + 0x64)};
-    REQUIRE(bus.write(0x29, order) == IoError::None);
+    REQUIRE(bus.write(0x29, kOrder) == IoError::None);
     // START + 4 bytes x 9 bits + STOP = 38 bit times of 10 us at 100 kHz.
     uint64_t wire = 0;
     sd_bus_error e = SD_BUS_ERROR_NULL;
@@ -91,11 +96,10 @@ TEST_CASE("realistic timing really waits the wire time") {
     REQUIRE(io.connect(f.socket()) == 0);
     I2cDev bus(io, "/dev/i2c-1");
     REQUIRE(bus.open() == 0);
-    const uint8_t order[] = {0x80, 0x64, static_cast<uint8_t>(0x52 + 0x80 + 0x64)};
     timespec a{}, b{};
     clock_gettime(CLOCK_MONOTONIC, &a);
     for (int i = 0; i < 20; ++i)
-        REQUIRE(bus.write(0x29, order) == IoError::None);
+        REQUIRE(bus.write(0x29, kOrder) == IoError::None);
     clock_gettime(CLOCK_MONOTONIC, &b);
     const double elapsed_us = static_cast<double>(b.tv_sec - a.tv_sec) * 1e6 + static_cast<double>(b.tv_nsec - a.tv_nsec) / 1e3;
     // 20 transactions of 380 us each cannot complete sooner than 7.6 ms of wire time.
@@ -118,14 +122,24 @@ int raw_connect(const std::string& path) {
     REQUIRE(connect(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0);
     return s;
 }
-int32_t reply_result(int s) {
-    uint8_t buf[256];
+// One reply for one request, within the receive timeout of raw_connect, with a reply's header:
+// its result; nullopt when none came.
+std::optional<int32_t> got_reply(int s) {
+    uint8_t buf[simproto::kMaxMessage];
     ssize_t n = recv(s, buf, sizeof buf, 0);
-    REQUIRE(n >= 16);
+    if (n < static_cast<ssize_t>(simproto::kHeaderSize + 4))
+        return std::nullopt;
     simproto::Reader r({buf, static_cast<size_t>(n)});
     simproto::Header h;
-    REQUIRE(r.header(h));
+    if (!r.header(h) || !(h.op & simproto::kReplyBit))
+        return std::nullopt;
     return r.i32();
+}
+// The result of the one reply that must come.
+int32_t reply_result(int s) {
+    const auto result = got_reply(s);
+    REQUIRE(result);
+    return *result;
 }
 } // namespace
 
@@ -176,19 +190,6 @@ template <typename Fill> std::vector<uint8_t> request(simproto::Op op, uint32_t 
     return buf;
 }
 
-// One reply for one request, within the receive timeout of raw_connect, with a reply's header:
-// its result; nullopt when none came.
-std::optional<int32_t> got_reply(int s) {
-    uint8_t buf[simproto::kMaxMessage];
-    ssize_t n = recv(s, buf, sizeof buf, 0);
-    if (n < static_cast<ssize_t>(simproto::kHeaderSize + 4))
-        return std::nullopt;
-    simproto::Reader r({buf, static_cast<size_t>(n)});
-    simproto::Header h;
-    if (!r.header(h) || !(h.op & simproto::kReplyBit))
-        return std::nullopt;
-    return r.i32();
-}
 } // namespace
 
 // In the manner of a fuzzer, without one: every kind of request, valid, then mutated at random
@@ -253,9 +254,8 @@ TEST_CASE("mutated requests of every kind get a reply and never bring the simula
     corpus.push_back(request(Op::Open, 10, [](simproto::Writer& w) { w.str("/dev/i2c-1"); w.i32(O_RDWR); }));
     corpus.push_back(request(Op::Close, 11, [](simproto::Writer& w) { w.i32(4); }));
     corpus.push_back(request(Op::I2cRdwr, 12, [](simproto::Writer& w) {
-        const uint8_t order[] = {0x80, 0x64, static_cast<uint8_t>(0x52 + 0x80 + 0x64)};
-        w.i32(4); w.u32(1);
-        w.u16(0x29); w.u16(0); w.u16(3); w.bytes(order, 3);
+            w.i32(4); w.u32(1);
+        w.u16(0x29); w.u16(0); w.u16(3); w.bytes(kOrder, sizeof kOrder);
     }));
     corpus.push_back(request(Op::I2cRdwr, 13, [](simproto::Writer& w) {
         w.i32(4); w.u32(2);
@@ -340,8 +340,7 @@ TEST_CASE("mutated requests of every kind get a reply and never bring the simula
     REQUIRE(io.connect(f.socket()) == 0);
     I2cDev bus(io, "/dev/i2c-1");
     REQUIRE(bus.open() == 0);
-    const uint8_t order[] = {0x80, 0x64, static_cast<uint8_t>(0x52 + 0x80 + 0x64)};
-    CHECK(bus.write(0x29, order) == IoError::None);
-    CHECK(f.wire_log().back().data == std::vector<uint8_t>(order, order + 3));
+    CHECK(bus.write(0x29, kOrder) == IoError::None);
+    CHECK(f.wire_log().back().data == std::vector<uint8_t>(std::begin(kOrder), std::end(kOrder)));
     CHECK(f.sim.running());
 }
