@@ -29,7 +29,7 @@ cat >"$dir/bus.conf" <<CONF
 CONF
 bus="unix:path=$dir/bus"
 # The socket file appears before dbus-daemon listens; its printed address means it does.
-dbus-daemon --nofork --print-address=1 --config-file="$dir/bus.conf" >"$dir/dbus.log" & pids+=($!)
+dbus-daemon --nofork --print-address=1 --config-file="$dir/bus.conf" >"$dir/dbus.log" 2>&1 & pids+=($!)
 for _ in $(seq 200); do grep -qF "$bus" "$dir/dbus.log" 2>/dev/null && break; sleep 0.05; done
 
 "$build/sim/caracara-sim" --socket "$dir/sim.sock" --bus-address "$bus" >"$dir/sim.log" 2>&1 & pids+=($!)
