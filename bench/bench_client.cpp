@@ -11,9 +11,9 @@
 //   caracara-bench wait-ready --bus ADDR [--timeout-ms MS]
 //
 // Every measuring command prints one JSON object on stdout.
-#include "bench_common.hpp"
-#include "sdbus.hpp"
-#include "seabotix.hpp"
+#include "bench/bench_common.hpp"
+#include "dbus/sdbus.hpp"
+#include "protocol/seabotix.hpp"
 
 #include <array>
 #include <cerrno>

@@ -9,13 +9,13 @@
 //   caracara-bench-floor --socket PATH [--config FILE] --burst N           (8 orders back to back)
 //
 // Prints one JSON object: cycles, seconds, rate_hz, cpu_s (CLOCK_PROCESS_CPUTIME_ID).
-#include "bench_common.hpp"
-#include "config.hpp"
-#include "i2c_dev.hpp"
-#include "sim_device_io.hpp"
-#include "spi_dev.hpp"
-#include "teensy_link.hpp"
-#include "thruster.hpp"
+#include "bench/bench_common.hpp"
+#include "core/config.hpp"
+#include "platform/i2c_dev.hpp"
+#include "platform/sim/sim_device_io.hpp"
+#include "platform/spi_dev.hpp"
+#include "devices/teensy_link.hpp"
+#include "devices/thruster_driver.hpp"
 
 #include <cstdio>
 #include <cstdlib>

@@ -1,8 +1,8 @@
-#include "controller.hpp"
+#include "daemon/controller.hpp"
 
-#include "i2c_recovery.hpp"
-#include "log.hpp"
-#include "packet.hpp"
+#include "devices/i2c_bus_clear.hpp"
+#include "daemon/log.hpp"
+#include "core/packet.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -188,12 +188,11 @@ int Controller::on_tick(sd_event_source* s, uint64_t usec, void* userdata) {
 bool Controller::input_pending() const {
     // Something for a higher-priority source: a D-Bus message (read already, or on the
     // socket) or a kill switch edge. One poll() instead of a full event-loop iteration.
-    if (!bus_)
+    if (!input_)
         return true;
-    uint64_t queued = 0;
-    if (sd_bus_get_n_queued_read(bus_, &queued) >= 0 && queued > 0)
+    if (input_->queued())
         return true;
-    pollfd fds[2]{{sd_bus_get_fd(bus_), POLLIN, 0}, {-1, POLLIN, 0}};
+    pollfd fds[2]{{input_->fd(), POLLIN, 0}, {-1, POLLIN, 0}};
     if (kill_switch_)
         fds[1].fd = kill_switch_->event_fd();
     return ::poll(fds, 2, 0) != 0;

@@ -8,17 +8,18 @@
 // its D-Bus reply; a new command marks its changed orders due at once.
 #pragma once
 
-#include "budget.hpp"
-#include "config.hpp"
-#include "device_io.hpp"
-#include "gpio.hpp"
-#include "i2c_dev.hpp"
-#include "mixing.hpp"
-#include "safety.hpp"
-#include "sdbus.hpp"
-#include "spi_dev.hpp"
-#include "teensy_link.hpp"
-#include "thruster.hpp"
+#include "core/budget.hpp"
+#include "core/config.hpp"
+#include "platform/device_io.hpp"
+#include "platform/gpio_backend.hpp"
+#include "platform/i2c_dev.hpp"
+#include "core/mixing.hpp"
+#include "core/safety.hpp"
+#include "daemon/input_probe.hpp"
+#include "platform/event_loop.hpp"
+#include "platform/spi_dev.hpp"
+#include "devices/teensy_link.hpp"
+#include "devices/thruster_driver.hpp"
 
 #include <array>
 #include <cstdint>
@@ -122,7 +123,7 @@ public:
     // Orders zero to every thruster (SIGTERM, fatal errors). Safe to call more than once.
     void shutdown();
     void set_observer(ControllerObserver* o) { observer_ = o; }
-    void set_bus(sd_bus* bus) { bus_ = bus; }
+    void set_input_probe(const InputProbe* p) { input_ = p; }
 
     Result set_thrust(std::span<const int32_t> values, std::string_view client);
     Result set_motion(const AxisDemand& demand, std::string_view client);
@@ -218,7 +219,7 @@ private:
     TeensyLink teensy_link_;
     SafetyMachine safety_;
     ControllerObserver* observer_ = nullptr;
-    sd_bus* bus_ = nullptr;
+    const InputProbe* input_ = nullptr;
 
     MotorValues requested_{};
     MotorValues applied_{};
@@ -235,10 +236,10 @@ private:
     unsigned teensy_poll_index_ = 0;
     bool in_cycle_ = false;
 
-    dbus::SourcePtr tick_source_;
-    dbus::SourcePtr work_source_;
-    dbus::SourcePtr resume_source_; // below the announcements: the rest of the work, or the next cycle at rate 0
-    dbus::SourcePtr turn_source_;
+    SourcePtr tick_source_;
+    SourcePtr work_source_;
+    SourcePtr resume_source_; // below the announcements: the rest of the work, or the next cycle at rate 0
+    SourcePtr turn_source_;
     uint64_t cycles_ = 0;
     uint64_t last_cycle_ns_ = 0;
     uint64_t last_telemetry_ns_ = 0;
@@ -253,7 +254,7 @@ private:
     std::unique_ptr<GpioLine> kill_switch_;
     std::unique_ptr<GpioLine> kill_out_;
     std::unique_ptr<GpioLine> power_off_out_;
-    dbus::SourcePtr kill_switch_source_;
+    SourcePtr kill_switch_source_;
 
     enum class RecoveryPhase { Idle, WaitingNode, Backoff };
     RecoveryPhase recovery_phase_ = RecoveryPhase::Idle;
@@ -264,7 +265,7 @@ private:
     uint64_t recovery_started_ns_ = 0;
     uint64_t node_deadline_ns_ = 0;
     uint32_t last_pulses_ = 0;
-    dbus::SourcePtr recovery_timer_;
+    SourcePtr recovery_timer_;
 };
 
 } // namespace caracara

@@ -1,12 +1,13 @@
 // caracarad: the Caracara vehicle daemon. One sd-event loop; see DESIGN.md.
-#include "config.hpp"
-#include "controller.hpp"
-#include "hardware.hpp"
-#include "emergency_stop.hpp"
-#include "errors.hpp"
-#include "log.hpp"
-#include "sdbus.hpp"
-#include "vehicle_service.hpp"
+#include "core/config.hpp"
+#include "daemon/controller.hpp"
+#include "platform/hardware.hpp"
+#include "devices/emergency_stop.hpp"
+#include "platform/io_error.hpp"
+#include "daemon/log.hpp"
+#include "dbus/bus_input_probe.hpp"
+#include "dbus/sdbus.hpp"
+#include "dbus/vehicle_service.hpp"
 
 #include <csignal>
 #include <cstdio>
@@ -174,7 +175,8 @@ int main(int argc, char** argv) {
     // Losing the bus ends the loop; the thrusters are zeroed on the way out and systemd restarts us.
     sd_bus_set_exit_on_disconnect(bus.get(), 1);
     sd_bus_attach_event(bus.get(), event.get(), SD_EVENT_PRIORITY_NORMAL);
-    controller.set_bus(bus.get());
+    dbus::BusInputProbe input_probe(bus.get());
+    controller.set_input_probe(&input_probe);
 
     uint64_t wd_usec = 0;
     Watchdog wd{&controller, 0};

@@ -1,4 +1,4 @@
-#include "sdbus.hpp"
+#include "dbus/sdbus.hpp"
 
 namespace caracara::dbus {
 

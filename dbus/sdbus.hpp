@@ -1,5 +1,7 @@
-// Thin RAII over sd-bus / sd-event handles, and opening the bus a program was told to use.
+// Thin RAII over sd-bus handles (sd-event ones are in platform/event_loop.hpp), and opening the bus a program was told to use.
 #pragma once
+
+#include "platform/event_loop.hpp"
 
 #include <memory>
 #include <string>
@@ -11,14 +13,12 @@ namespace caracara::dbus {
 struct BusUnref { void operator()(sd_bus* b) const { sd_bus_flush_close_unref(b); } };
 struct SlotUnref { void operator()(sd_bus_slot* s) const { sd_bus_slot_unref(s); } };
 struct MessageUnref { void operator()(sd_bus_message* m) const { sd_bus_message_unref(m); } };
-struct EventUnref { void operator()(sd_event* e) const { sd_event_unref(e); } };
-struct SourceUnref { void operator()(sd_event_source* s) const { sd_event_source_disable_unref(s); } };
 
 using BusPtr = std::unique_ptr<sd_bus, BusUnref>;
 using SlotPtr = std::unique_ptr<sd_bus_slot, SlotUnref>;
 using MessagePtr = std::unique_ptr<sd_bus_message, MessageUnref>;
-using EventPtr = std::unique_ptr<sd_event, EventUnref>;
-using SourcePtr = std::unique_ptr<sd_event_source, SourceUnref>;
+using caracara::EventPtr;
+using caracara::SourcePtr;
 
 // Which bus to connect to: the system bus (default), the user's session bus, or an explicit
 // address such as "unix:path=/tmp/bus" (tests run a private dbus-daemon).

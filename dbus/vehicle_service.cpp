@@ -1,6 +1,6 @@
-#include "vehicle_service.hpp"
+#include "dbus/vehicle_service.hpp"
 
-#include "seabotix.hpp"
+#include "protocol/seabotix.hpp"
 
 #include <array>
 #include <cerrno>

@@ -3,9 +3,9 @@
 // this header.
 #pragma once
 
-#include "controller.hpp"
-#include "sdbus.hpp"
-#include "vehicle_names.hpp"
+#include "daemon/controller.hpp"
+#include "dbus/sdbus.hpp"
+#include "dbus/vehicle_names.hpp"
 
 #include <array>
 #include <string>

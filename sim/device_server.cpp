@@ -1,6 +1,6 @@
-#include "device_server.hpp"
+#include "sim/device_server.hpp"
 
-#include "sim_protocol.hpp"
+#include "protocol/sim_protocol.hpp"
 
 #include <cerrno>
 #include <cstring>

@@ -2,9 +2,9 @@
 // the simulator's stand-in for the kernel's i2c-dev and spidev.
 #pragma once
 
-#include "sdbus.hpp"
-#include "sim_protocol.hpp"
-#include "vehicle.hpp"
+#include "dbus/sdbus.hpp"
+#include "protocol/sim_protocol.hpp"
+#include "sim/vehicle.hpp"
 
 #include <array>
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "gpio_model.hpp"
+#include "sim/gpio_model.hpp"
 
 #include <cerrno>
 

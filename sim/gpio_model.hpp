@@ -8,9 +8,9 @@
 // logged as I2C line events instead ({bus "i2c-lines", result "scl-pulse", "start", "stop"}).
 #pragma once
 
-#include "i2c_bus_model.hpp"
-#include "sim_protocol.hpp"
-#include "wire_log.hpp"
+#include "sim/i2c_bus_model.hpp"
+#include "protocol/sim_protocol.hpp"
+#include "sim/wire_log.hpp"
 
 #include <cstdint>
 #include <functional>

@@ -1,4 +1,4 @@
-#include "i2c_bus_model.hpp"
+#include "sim/i2c_bus_model.hpp"
 
 #include <cerrno>
 #include <linux/i2c.h>

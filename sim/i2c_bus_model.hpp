@@ -2,8 +2,8 @@
 // them, wire time at the configured clock, and the wire log. One call = one I2C_RDWR.
 #pragma once
 
-#include "slave.hpp"
-#include "wire_log.hpp"
+#include "sim/slave.hpp"
+#include "sim/wire_log.hpp"
 
 #include <cstdint>
 #include <map>

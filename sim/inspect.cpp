@@ -1,6 +1,6 @@
-#include "inspect.hpp"
+#include "sim/inspect.hpp"
 
-#include "device_server.hpp"
+#include "sim/device_server.hpp"
 
 #include <cerrno>
 #include <string>

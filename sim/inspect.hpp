@@ -5,8 +5,8 @@
 // The interface is documented in sim/org.caracara.Simulator1.xml.
 #pragma once
 
-#include "sdbus.hpp"
-#include "vehicle.hpp"
+#include "dbus/sdbus.hpp"
+#include "sim/vehicle.hpp"
 
 #include <vector>
 

@@ -1,11 +1,11 @@
 // caracara-sim: plays the Caracara vehicle's hardware for caracarad (device protocol on a
 // Unix socket) and for people and tests (org.caracara.Simulator1 on D-Bus).
-#include "device_server.hpp"
-#include "errors.hpp"
-#include "inspect.hpp"
-#include "sdbus.hpp"
-#include "sim_config.hpp"
-#include "vehicle.hpp"
+#include "sim/device_server.hpp"
+#include "platform/io_error.hpp"
+#include "sim/inspect.hpp"
+#include "dbus/sdbus.hpp"
+#include "sim/sim_config.hpp"
+#include "sim/vehicle.hpp"
 
 #include <csignal>
 #include <cstdio>

@@ -2,7 +2,7 @@
 // The [[thruster]] tables use the same keys as caracarad.toml so one file can describe both.
 #pragma once
 
-#include "thruster_model.hpp"
+#include "sim/thruster_model.hpp"
 
 #include <string>
 #include <vector>

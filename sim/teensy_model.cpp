@@ -1,4 +1,4 @@
-#include "teensy_model.hpp"
+#include "sim/teensy_model.hpp"
 
 #include <bit>
 #include <cmath>

@@ -40,8 +40,8 @@
 // Not thread-safe: the simulator drives all models from one thread.
 #pragma once
 
-#include "slave.hpp"
-#include "vehicle_body.hpp"
+#include "sim/slave.hpp"
+#include "sim/vehicle_body.hpp"
 
 #include <array>
 #include <cstddef>

@@ -1,4 +1,4 @@
-#include "thruster_model.hpp"
+#include "sim/thruster_model.hpp"
 
 #include <algorithm>
 #include <cmath>

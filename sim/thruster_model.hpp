@@ -2,7 +2,7 @@
 // the spec independently of the daemon's codec so that each checks the other.
 #pragma once
 
-#include "slave.hpp"
+#include "sim/slave.hpp"
 
 #include <array>
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "vehicle.hpp"
+#include "sim/vehicle.hpp"
 
 #include <cerrno>
 #include <linux/spi/spidev.h>

@@ -2,14 +2,14 @@
 // server and the inspection API both work on this one object.
 #pragma once
 
-#include "gpio_model.hpp"
-#include "i2c_bus_model.hpp"
-#include "sim_config.hpp"
-#include "slave.hpp"
-#include "teensy_model.hpp"
-#include "thruster_model.hpp"
-#include "vehicle_body.hpp"
-#include "wire_log.hpp"
+#include "sim/gpio_model.hpp"
+#include "sim/i2c_bus_model.hpp"
+#include "sim/sim_config.hpp"
+#include "sim/slave.hpp"
+#include "sim/teensy_model.hpp"
+#include "sim/thruster_model.hpp"
+#include "sim/vehicle_body.hpp"
+#include "sim/wire_log.hpp"
 
 #include <algorithm>
 #include <functional>

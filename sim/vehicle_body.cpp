@@ -1,4 +1,4 @@
-#include "vehicle_body.hpp"
+#include "sim/vehicle_body.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 // system; pitch and roll also feel a restoring moment because the vehicle is bottom-heavy.
 #pragma once
 
-#include "slave.hpp"
+#include "sim/slave.hpp"
 
 #include <array>
 #include <cstdint>

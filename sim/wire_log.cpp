@@ -1,4 +1,4 @@
-#include "wire_log.hpp"
+#include "sim/wire_log.hpp"
 
 #include <algorithm>
 #include <ctime>

@@ -1,10 +1,10 @@
 // caracaractl: query and command caracarad (org.caracara.Vehicle1) from the shell, in the style
 // of timedatectl. Arguments are parsed completely before anything is sent; value ranges are the
 // daemon's business (it answers with named errors), only the D-Bus wire types are checked here.
-#include "client.hpp"
-#include "hold.hpp"
-#include "monitor.hpp"
-#include "render.hpp"
+#include "tools/client.hpp"
+#include "tools/hold.hpp"
+#include "tools/monitor.hpp"
+#include "tools/render.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -1,4 +1,4 @@
-#include "client.hpp"
+#include "tools/client.hpp"
 
 #include <cerrno>
 #include <cstring>

@@ -2,12 +2,12 @@
 // to exit codes, and a generic decoder for property values.
 #pragma once
 
-#include "sdbus.hpp"
+#include "dbus/sdbus.hpp"
 
 #include <cstdint>
 #include <functional>
 #include <map>
-#include "vehicle_names.hpp"
+#include "dbus/vehicle_names.hpp"
 
 #include <string>
 #include <vector>

@@ -1,6 +1,6 @@
-#include "hold.hpp"
+#include "tools/hold.hpp"
 
-#include "render.hpp"
+#include "tools/render.hpp"
 
 #include <algorithm>
 #include <cerrno>

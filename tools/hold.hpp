@@ -3,7 +3,7 @@
 // last command leaves the bus, so a command only lasts as long as its sender keeps it alive.
 #pragma once
 
-#include "client.hpp"
+#include "tools/client.hpp"
 
 #include <cstdint>
 #include <string>

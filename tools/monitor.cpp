@@ -1,6 +1,6 @@
-#include "monitor.hpp"
+#include "tools/monitor.hpp"
 
-#include "render.hpp"
+#include "tools/render.hpp"
 
 #include <csignal>
 #include <cstring>

@@ -1,7 +1,7 @@
 // caracaractl monitor: live PropertiesChanged of every org.caracara.Vehicle1 object.
 #pragma once
 
-#include "client.hpp"
+#include "tools/client.hpp"
 
 #include <string_view>
 

@@ -1,4 +1,4 @@
-#include "render.hpp"
+#include "tools/render.hpp"
 
 #include <algorithm>
 #include <cmath>

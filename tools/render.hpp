@@ -1,7 +1,7 @@
 // Text output of caracaractl: values, the status report and the monitor's lines.
 #pragma once
 
-#include "client.hpp"
+#include "tools/client.hpp"
 
 #include <ostream>
 #include <string>

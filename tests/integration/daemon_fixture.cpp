@@ -1,4 +1,4 @@
-#include "daemon_fixture.hpp"
+#include "tests/integration/daemon_fixture.hpp"
 
 #include <chrono>
 #include <cstdarg>

@@ -2,7 +2,7 @@
 // stays open (the daemon zeroes the thrusters when its commanding client leaves).
 #pragma once
 
-#include "sim_fixture.hpp"
+#include "tests/integration/sim_fixture.hpp"
 
 #include <string>
 #include <vector>

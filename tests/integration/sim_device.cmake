@@ -1,1 +1,1 @@
-caracara_integration_test(test_sim_device SOURCES integration/test_sim_device.cpp LIBS caracara_drivers DEPENDS caracara-sim)
+caracara_integration_test(test_sim_device SOURCES integration/test_sim_device.cpp LIBS caracara_devices DEPENDS caracara-sim)

@@ -1,4 +1,4 @@
-#include "sim_fixture.hpp"
+#include "tests/integration/sim_fixture.hpp"
 
 #include <cerrno>
 #include <chrono>

@@ -1,7 +1,7 @@
 // I2C bus-lockup recovery, the kill switch and the kill / power-off outputs: caracarad on the
 // simulator, everything checked on the simulator's side of the wire.
-#include "daemon_fixture.hpp"
-#include "sim_fixture.hpp"
+#include "tests/integration/daemon_fixture.hpp"
+#include "tests/integration/sim_fixture.hpp"
 
 #include <catch2/catch.hpp>
 #include <csignal>

@@ -1,9 +1,9 @@
 // The device seam against the real simulator: the i2c-dev marshalling code, the errno the
 // kernel would return, and the simulator's robustness against bad input.
-#include "i2c_dev.hpp"
-#include "sim_device_io.hpp"
-#include "sim_fixture.hpp"
-#include "sim_protocol.hpp"
+#include "platform/i2c_dev.hpp"
+#include "platform/sim/sim_device_io.hpp"
+#include "tests/integration/sim_fixture.hpp"
+#include "protocol/sim_protocol.hpp"
 
 #include <catch2/catch.hpp>
 #include <cerrno>

@@ -1,10 +1,10 @@
 // The Teensy link through the real spidev marshalling code against the simulated Teensy,
 // checked through the simulator's inspection API.
-#include "sim_device_io.hpp"
-#include "sim_fixture.hpp"
-#include "spi_dev.hpp"
-#include "teensy_codec.hpp"
-#include "teensy_link.hpp"
+#include "platform/sim/sim_device_io.hpp"
+#include "tests/integration/sim_fixture.hpp"
+#include "platform/spi_dev.hpp"
+#include "protocol/teensy_codec.hpp"
+#include "devices/teensy_link.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>

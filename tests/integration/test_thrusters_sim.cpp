@@ -1,10 +1,10 @@
 // The SeaBotix driver through the real i2c-dev marshalling code against caracara-sim,
 // checked on the simulator's side of the wire.
-#include "i2c_dev.hpp"
-#include "seabotix.hpp"
-#include "sim_device_io.hpp"
-#include "sim_fixture.hpp"
-#include "thruster.hpp"
+#include "platform/i2c_dev.hpp"
+#include "protocol/seabotix.hpp"
+#include "platform/sim/sim_device_io.hpp"
+#include "tests/integration/sim_fixture.hpp"
+#include "devices/thruster_driver.hpp"
 
 #include <catch2/catch.hpp>
 #include <memory>

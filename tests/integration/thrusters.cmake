@@ -1,1 +1,1 @@
-caracara_integration_test(test_thrusters_sim SOURCES integration/test_thrusters_sim.cpp LIBS caracara_drivers DEPENDS caracara-sim)
+caracara_integration_test(test_thrusters_sim SOURCES integration/test_thrusters_sim.cpp LIBS caracara_devices DEPENDS caracara-sim)

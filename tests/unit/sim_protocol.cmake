@@ -1,1 +1,1 @@
-caracara_unit_test(test_sim_protocol SOURCES unit/test_sim_protocol.cpp LIBS caracara_drivers)
+caracara_unit_test(test_sim_protocol SOURCES unit/test_sim_protocol.cpp LIBS caracara_platform)

@@ -1,4 +1,4 @@
-#include "budget.hpp"
+#include "core/budget.hpp"
 
 #include <catch2/catch.hpp>
 #include <cstdlib>

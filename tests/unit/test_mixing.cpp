@@ -1,4 +1,4 @@
-#include "mixing.hpp"
+#include "core/mixing.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "packet.hpp"
+#include "core/packet.hpp"
 
 #include <catch2/catch.hpp>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "safety.hpp"
+#include "core/safety.hpp"
 
 #include <catch2/catch.hpp>
 

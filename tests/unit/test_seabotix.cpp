@@ -2,10 +2,11 @@
 // (section 8) and the Caracara packet seed; the arithmetic is next to each one. The driver is
 // exercised over a scripted DeviceIo that records the i2c_msg arrays of every I2C_RDWR, the
 // same arrays the kernel (or caracara-sim) would receive.
-#include "device_io.hpp"
-#include "i2c_dev.hpp"
-#include "seabotix.hpp"
-#include "thruster.hpp"
+#include "platform/linux/linux_device_io.hpp"
+#include "platform/device_io.hpp"
+#include "platform/i2c_dev.hpp"
+#include "protocol/seabotix.hpp"
+#include "devices/thruster_driver.hpp"
 
 #include <catch2/catch.hpp>
 #include <cerrno>

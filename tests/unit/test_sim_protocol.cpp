@@ -1,5 +1,5 @@
-#include "errors.hpp"
-#include "sim_protocol.hpp"
+#include "platform/io_error.hpp"
+#include "protocol/sim_protocol.hpp"
 
 #include <catch2/catch.hpp>
 #include <cerrno>

@@ -1,7 +1,7 @@
 // The simulated Teensy driven with raw frames exactly as spidev would clock them, with every
 // expected byte encoded by hand (not through a codec), and the attitude model's signs.
-#include "teensy_model.hpp"
-#include "vehicle_body.hpp"
+#include "sim/teensy_model.hpp"
+#include "sim/vehicle_body.hpp"
 
 #include <algorithm>
 #include <catch2/catch.hpp>

@@ -1,8 +1,8 @@
 // Teensy SPI link: codec vectors worked by hand, reply classification, the retry decision,
 // the Confirm handshake, and SpiDev / TeensyLink over an in-process fake of the device seam.
-#include "spi_dev.hpp"
-#include "teensy_codec.hpp"
-#include "teensy_link.hpp"
+#include "platform/spi_dev.hpp"
+#include "protocol/teensy_codec.hpp"
+#include "devices/teensy_link.hpp"
 
 #include <algorithm>
 #include <catch2/catch.hpp>

@@ -1,0 +1,593 @@
+#include "core/config.hpp"
+
+#include "core/hex.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace caracara {
+
+std::array<ThrusterConfig, kMotorCount> default_thrusters() {
+    static constexpr std::array<uint8_t, kMotorCount> mts{0x52, 0x56, 0x58, 0x5A, 0x5C, 0x5E, 0x60, 0x62};
+    std::array<ThrusterConfig, kMotorCount> t{};
+    for (std::size_t i = 0; i < kMotorCount; ++i) {
+        t[i].mt = mts[i];
+        t[i].variant = Variant::SeaBotix;
+    }
+    return t;
+}
+
+std::string ConfigResult::error() const {
+    std::string out;
+    for (const std::string& e : errors) {
+        if (!out.empty())
+            out += '\n';
+        out += e;
+    }
+    return out;
+}
+
+SafetyConfig safety_config(const DaemonConfig& config) {
+    SafetyConfig s;
+    s.arming_delay_ns = ms_to_ns(config.control.arming_delay_ms);
+    s.command_timeout_ns = ms_to_ns(config.control.command_timeout_ms);
+    return s;
+}
+
+namespace {
+
+// What the user wrote, for "got ..." in messages.
+std::string written(const toml::node& n) {
+    if (auto s = n.as_string())
+        return "\"" + s->get() + "\"";
+    if (auto i = n.as_integer())
+        return std::to_string(i->get());
+    if (auto f = n.as_floating_point()) {
+        std::ostringstream os;
+        os << f->get();
+        return os.str();
+    }
+    if (auto b = n.as_boolean())
+        return b->get() ? "true" : "false";
+    if (n.is_table())
+        return "a table";
+    if (n.is_array())
+        return "an array";
+    return "a date/time";
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j)
+        row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diag = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0u : 1u)});
+            diag = up;
+        }
+    }
+    return row[b.size()];
+}
+
+using Keys = std::initializer_list<std::string_view>;
+
+// Collects every problem instead of stopping at the first, so one run of the daemon shows
+// the user everything to fix.
+class Checker {
+public:
+    std::vector<std::string> errors;
+
+    void fail(const std::string& key, const std::string& problem, const toml::node* at = nullptr) {
+        std::string m = key + ": " + problem;
+        if (at && at->source().begin.line > 0)
+            m += " (line " + std::to_string(at->source().begin.line) + ")";
+        errors.push_back(std::move(m));
+    }
+
+    // Unknown keys are errors: a misspelt key would otherwise silently keep its default.
+    void only_keys(const toml::table& t, const std::string& prefix, Keys allowed) {
+        for (auto&& [k, v] : t) {
+            const std::string_view name = k.str();
+            if (std::find(allowed.begin(), allowed.end(), name) != allowed.end())
+                continue;
+            std::string hint;
+            for (std::string_view a : allowed)
+                if (edit_distance(name, a) <= 2) {
+                    hint = "; did you mean '" + prefix + std::string(a) + "'?";
+                    break;
+                }
+            if (hint.empty()) {
+                hint = "; known keys: ";
+                bool first = true;
+                for (std::string_view a : allowed) {
+                    hint += (first ? "" : ", ") + std::string(a);
+                    first = false;
+                }
+            }
+            std::string m = "unknown key '" + prefix + std::string(name) + "'" + hint;
+            if (v.source().begin.line > 0)
+                m += " (line " + std::to_string(v.source().begin.line) + ")";
+            errors.push_back(std::move(m));
+        }
+    }
+
+    const toml::table* table(const toml::table& parent, const std::string& prefix, std::string_view key) {
+        const toml::node* n = parent.get(key);
+        if (!n)
+            return nullptr;
+        if (!n->is_table()) {
+            fail(prefix + std::string(key), "must be a table, got " + written(*n), n);
+            return nullptr;
+        }
+        return n->as_table();
+    }
+
+    // Integer in lo..hi; `range` replaces the default "between lo and hi" wording.
+    template <typename T>
+    bool integer(const toml::table& t, const std::string& prefix, std::string_view key, int64_t lo, int64_t hi,
+                 T& out, const std::string& range = {}) {
+        const toml::node* n = t.get(key);
+        if (!n)
+            return false;
+        const std::string full = prefix + std::string(key);
+        const auto* iv = n->as_integer();
+        if (!iv) {
+            fail(full, "must be an integer, got " + written(*n), n);
+            return false;
+        }
+        const int64_t v = iv->get();
+        if (v < lo || v > hi) {
+            fail(full,
+                 "must be " + (range.empty() ? "between " + std::to_string(lo) + " and " + std::to_string(hi) : range) +
+                     ", got " + std::to_string(v),
+                 n);
+            return false;
+        }
+        out = static_cast<T>(v);
+        return true;
+    }
+
+    template <typename T>
+    bool integer(const toml::table& t, const std::string& prefix, std::string_view key, int64_t lo, int64_t hi,
+                 std::optional<T>& out, const std::string& range = {}) {
+        T v{};
+        if (!integer(t, prefix, key, lo, hi, v, range))
+            return false;
+        out = v;
+        return true;
+    }
+
+    bool boolean(const toml::table& t, const std::string& prefix, std::string_view key, bool& out) {
+        const toml::node* n = t.get(key);
+        if (!n)
+            return false;
+        const auto* b = n->as_boolean();
+        if (!b) {
+            fail(prefix + std::string(key), "must be true or false, got " + written(*n), n);
+            return false;
+        }
+        out = b->get();
+        return true;
+    }
+
+    bool string(const toml::table& t, const std::string& prefix, std::string_view key, std::string& out,
+                bool allow_empty = false) {
+        const toml::node* n = t.get(key);
+        if (!n)
+            return false;
+        const auto* s = n->as_string();
+        if (!s) {
+            fail(prefix + std::string(key), "must be a string, got " + written(*n), n);
+            return false;
+        }
+        if (!allow_empty && s->get().empty()) {
+            fail(prefix + std::string(key), "must not be empty", n);
+            return false;
+        }
+        out = s->get();
+        return true;
+    }
+
+    bool path(const toml::table& t, const std::string& prefix, std::string_view key, std::string& out) {
+        std::string v;
+        if (!string(t, prefix, key, v))
+            return false;
+        if (v.front() != '/') {
+            fail(prefix + std::string(key), "must be an absolute path, got \"" + v + "\"", t.get(key));
+            return false;
+        }
+        out = v;
+        return true;
+    }
+};
+
+void parse_i2c(Checker& c, const toml::table& t, I2cSettings& out) {
+    const std::string p = "i2c.";
+    c.only_keys(t, p, {"device", "clock_hz", "timeout_ms", "retries"});
+    c.path(t, p, "device", out.device);
+    c.integer(t, p, "clock_hz", 1000, 3400000, out.clock_hz);
+    c.integer(t, p, "timeout_ms", 10, 60000, out.timeout_ms);
+    c.integer(t, p, "retries", 0, 16, out.retries);
+}
+
+void parse_spi(Checker& c, const toml::table& t, SpiSettings& out) {
+    const std::string p = "spi.";
+    c.only_keys(t, p,
+                {"device", "speed_hz", "per_byte_delay_us", "busy_retries", "busy_delay_us", "servos",
+                 "distance_sensors"});
+    c.path(t, p, "device", out.device);
+    c.integer(t, p, "speed_hz", 1000, 50000000, out.spi.speed_hz);
+    c.integer(t, p, "per_byte_delay_us", 0, 10000, out.spi.byte_delay_us);
+    c.integer(t, p, "busy_retries", 0, 255, out.teensy.retry.max_busy_retries);
+    c.integer(t, p, "busy_delay_us", 0, 1000000, out.teensy.retry.busy_delay_us);
+    // Servo and sensor ids travel as uint8, so at most 256 of each can be addressed.
+    c.integer(t, p, "servos", 0, 256, out.teensy.limits.servo_count, "between 0 and 256 (ids are uint8)");
+    c.integer(t, p, "distance_sensors", 0, 256, out.teensy.limits.distance_sensor_count,
+              "between 0 and 256 (ids are uint8)");
+}
+
+std::string segment_name(const ThrusterConfig& t) {
+    if (!t.mux)
+        return "on the main bus";
+    return "behind mux " + hex(t.mux->addr7) + " channel " + std::to_string(t.mux->channel);
+}
+
+// Returns false when this thruster has an error (so the set checks skip it).
+bool parse_thruster(Checker& c, const toml::table& t, std::size_t i, ThrusterConfig& out) {
+    const std::string p = "thruster[" + std::to_string(i) + "].";
+    const std::size_t before = c.errors.size();
+    // "brushless" describes the simulated motor (caracara-sim reads the same file).
+    c.only_keys(t, p, {"address", "variant", "info", "mux_address", "mux_channel", "reversed", "brushless"});
+
+    const toml::node* an = t.get("address");
+    if (!an) {
+        c.fail(p + "address", "missing (the thruster's 8-bit write address byte, e.g. 0x52)", &t);
+    } else if (const auto* iv = an->as_integer(); !iv) {
+        c.fail(p + "address", "must be an integer, got " + written(*an), an);
+    } else {
+        const int64_t v = iv->get();
+        if (v < 0 || v > 0xFF)
+            c.fail(p + "address", "must be an 8-bit address byte (MT), got " + hex(v), an);
+        else if (v & 1)
+            c.fail(p + "address",
+                   hex(v) + " is a read address byte; must be even (the write byte, e.g. " + hex(v - 1) + ")", an);
+        else if (!is_valid_mt(static_cast<uint8_t>(v)))
+            c.fail(p + "address",
+                   hex(v) + " is a reserved I2C address (7-bit " + hex(v >> 1) + "); must be between 0x10 and 0xEE",
+                   an);
+        else
+            out.mt = static_cast<uint8_t>(v);
+    }
+
+    std::string variant;
+    if (c.string(t, p, "variant", variant)) {
+        if (auto v = parse_variant(variant))
+            out.variant = *v;
+        else
+            c.fail(p + "variant", "must be \"seabotix\" or \"legacy\", got \"" + variant + "\"", t.get("variant"));
+    }
+    c.integer(t, p, "info", 0, 255, out.info);
+    c.boolean(t, p, "reversed", out.reversed);
+    bool brushless = true;
+    c.boolean(t, p, "brushless", brushless);
+
+    const toml::node* mux_addr = t.get("mux_address");
+    const toml::node* mux_chan = t.get("mux_channel");
+    if (mux_addr && !mux_chan) {
+        c.fail(p + "mux_channel", "missing: mux_address and mux_channel go together", mux_addr);
+    } else if (!mux_addr && mux_chan) {
+        c.fail(p + "mux_address", "missing: mux_address and mux_channel go together", mux_chan);
+    } else if (mux_addr && mux_chan) {
+        MuxRoute route;
+        bool good = true;
+        const auto* iv = mux_addr->as_integer();
+        if (iv && iv->get() >= 0xE0 && iv->get() <= 0xEE && (iv->get() & 1) == 0) {
+            c.fail(p + "mux_address",
+                   hex(iv->get()) + " looks like an 8-bit address byte; use the 7-bit address " +
+                       hex(iv->get() >> 1) + " (PCA9544A: 0x70..0x77)",
+                   mux_addr);
+            good = false;
+        } else {
+            good = c.integer(t, p, "mux_address", kMuxAddrMin, kMuxAddrMax, route.addr7,
+                             "a 7-bit PCA9544A address between 0x70 and 0x77 (112..119)");
+        }
+        good = c.integer(t, p, "mux_channel", 0, kMuxChannels - 1, route.channel) && good;
+        if (good)
+            out.mux = route;
+    }
+    return c.errors.size() == before;
+}
+
+void check_thruster_set(Checker& c, const std::array<ThrusterConfig, kMotorCount>& set,
+                        const std::array<bool, kMotorCount>& valid) {
+    auto name = [](std::size_t i) { return "thruster[" + std::to_string(i) + "]"; };
+    for (std::size_t i = 0; i < kMotorCount; ++i) {
+        if (!valid[i])
+            continue;
+        const ThrusterConfig& a = set[i];
+        const uint16_t a7 = mt_addr7(a.mt);
+        for (std::size_t m = 0; m < kMotorCount; ++m) {
+            if (valid[m] && set[m].mux && set[m].mux->addr7 == a7) {
+                c.fail(name(i) + ".address",
+                       hex(a.mt) + " (7-bit " + hex(a7) + ") is the address of the multiplexer used by " + name(m));
+                break;
+            }
+        }
+        for (std::size_t j = i + 1; j < kMotorCount; ++j) {
+            if (!valid[j] || mt_addr7(set[j].mt) != a7)
+                continue;
+            const ThrusterConfig& b = set[j];
+            if (a.mux && b.mux && (a.mux->addr7 != b.mux->addr7 || a.mux->channel != b.mux->channel))
+                continue;  // separate segments: the driver enables one channel at a time
+            std::string why;
+            if (!a.mux && !b.mux)
+                why = "both are on the main bus";
+            else if (a.mux && b.mux)
+                why = "both are " + segment_name(a);
+            else
+                why = name(a.mux ? j : i) + " is on the main bus, which an enabled mux channel joins to " +
+                      name(a.mux ? i : j) + "'s segment";
+            c.fail(name(j) + ".address", hex(b.mt) + " is also the address of " + name(i) + "; " + why);
+        }
+    }
+}
+
+void parse_thrusters(Checker& c, const toml::table& root, std::array<ThrusterConfig, kMotorCount>& out) {
+    const toml::node* n = root.get("thruster");
+    if (!n)
+        return;  // the default vehicle
+    const toml::array* arr = n->as_array();
+    if (!arr || !arr->is_array_of_tables()) {
+        c.fail("thruster", "must be an array of tables ([[thruster]] sections), got " + written(*n), n);
+        return;
+    }
+    if (arr->size() != kMotorCount) {
+        c.fail("thruster",
+               "expected exactly " + std::to_string(kMotorCount) + " [[thruster]] sections (motors 0..7), got " +
+                   std::to_string(arr->size()),
+               n);
+    }
+    std::array<ThrusterConfig, kMotorCount> set{};
+    std::array<bool, kMotorCount> valid{};
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+        ThrusterConfig tc;
+        const bool ok = parse_thruster(c, *(*arr)[i].as_table(), i, tc);
+        if (i < kMotorCount) {
+            set[i] = tc;
+            valid[i] = ok;
+        }
+    }
+    if (arr->size() != kMotorCount)
+        return;
+    const std::size_t before = c.errors.size();
+    check_thruster_set(c, set, valid);
+    if (c.errors.size() == before && std::all_of(valid.begin(), valid.end(), [](bool v) { return v; })) {
+        // The driver's own rules; these checks mirror them, this catches any drift.
+        const std::string err = validate_thruster_set(set);
+        if (!err.empty())
+            c.fail("thruster", err, n);
+    }
+    out = set;
+}
+
+void parse_mixing(Checker& c, const toml::table& t, MixMatrix& out) {
+    c.only_keys(t, "mixing.", {"matrix"});
+    const toml::node* n = t.get("matrix");
+    if (!n)
+        return;
+    const toml::array* rows = n->as_array();
+    if (!rows || rows->size() != kMotorCount) {
+        c.fail("mixing.matrix",
+               "must be an array of 8 rows (one per motor), got " +
+                   (rows ? std::to_string(rows->size()) + " rows" : written(*n)),
+               n);
+        return;
+    }
+    MixMatrix m{};
+    bool good = true;
+    for (std::size_t i = 0; i < kMotorCount; ++i) {
+        const std::string rk = "mixing.matrix[" + std::to_string(i) + "]";
+        const toml::node& rn = *rows->get(i);
+        const toml::array* row = rn.as_array();
+        if (!row || row->size() != kAxisCount) {
+            c.fail(rk,
+                   "must be an array of 6 numbers (x, y, z, yaw, pitch, roll), got " +
+                       (row ? std::to_string(row->size()) + " values" : written(rn)),
+                   &rn);
+            good = false;
+            continue;
+        }
+        for (std::size_t j = 0; j < kAxisCount; ++j) {
+            const toml::node& vn = *row->get(j);
+            const std::string vk = rk + "[" + std::to_string(j) + "] (motor " + std::to_string(i) + ", " +
+                                   std::string(axis_name(j)) + ")";
+            double v = 0.0;
+            if (const auto* iv = vn.as_integer())
+                v = static_cast<double>(iv->get());
+            else if (const auto* fv = vn.as_floating_point())
+                v = fv->get();
+            else {
+                c.fail(vk, "must be a number, got " + written(vn), &vn);
+                good = false;
+                continue;
+            }
+            if (!std::isfinite(v) || v < -1.0 || v > 1.0) {
+                c.fail(vk, "must be a number between -1 and 1, got " + written(vn), &vn);
+                good = false;
+                continue;
+            }
+            m[i][j] = v;
+        }
+    }
+    if (good)
+        out = m;
+}
+
+void parse_control(Checker& c, const toml::table& t, ControlSettings& out) {
+    const std::string p = "control.";
+    c.only_keys(t, p,
+                {"loop_rate_hz", "status_reads_per_tick", "command_timeout_ms", "arming_delay_ms", "budget_policy"});
+    c.integer(t, p, "loop_rate_hz", 0, 1000, out.loop_rate_hz,
+              "between 0 and 1000 (0 = as fast as the bus allows)");
+    c.integer(t, p, "status_reads_per_tick", 1, static_cast<int64_t>(kMotorCount), out.status_reads_per_tick);
+    c.integer(t, p, "command_timeout_ms", 10, 60000, out.command_timeout_ms);
+    c.integer(t, p, "arming_delay_ms", 0, 60000, out.arming_delay_ms);
+    std::string policy;
+    if (c.string(t, p, "budget_policy", policy)) {
+        if (policy == "scale")
+            out.budget_policy = BudgetPolicy::Scale;
+        else if (policy == "reject")
+            out.budget_policy = BudgetPolicy::Reject;
+        else
+            c.fail(p + "budget_policy", "must be \"scale\" or \"reject\", got \"" + policy + "\"",
+                   t.get("budget_policy"));
+    }
+}
+
+std::optional<GpioLineSettings> parse_gpio_line(Checker& c, const toml::table& gpio, std::string_view role) {
+    const std::string key = "gpio." + std::string(role);
+    const toml::table* t = c.table(gpio, "gpio.", role);
+    if (!t)
+        return std::nullopt;
+    const std::string p = key + ".";
+    const std::size_t before = c.errors.size();
+    c.only_keys(*t, p, {"chip", "line", "active_low"});
+    GpioLineSettings s;
+    c.string(*t, p, "chip", s.chip);
+    c.boolean(*t, p, "active_low", s.active_low);
+    const toml::node* ln = t->get("line");
+    if (!ln) {
+        c.fail(p + "line", "missing (a line name string or an offset integer)", t);
+    } else if (ln->is_string()) {
+        c.string(*t, p, "line", s.name);
+    } else if (ln->is_integer()) {
+        c.integer(*t, p, "line", 0, 65535, s.offset, "a line offset between 0 and 65535");
+    } else {
+        c.fail(p + "line", "must be a line name string or an offset integer, got " + written(*ln), ln);
+    }
+    if (c.errors.size() != before)
+        return std::nullopt;
+    return s;
+}
+
+std::string line_text(const GpioLineSettings& l) {
+    return (l.offset ? "line " + std::to_string(*l.offset) : "line \"" + l.name + "\"") + " on " + l.chip;
+}
+
+void parse_gpio(Checker& c, const toml::table& t, GpioSettings& out) {
+    c.only_keys(t, "gpio.", {"kill_switch", "kill_output", "power_off_output", "scl", "sda"});
+    out.kill_switch = parse_gpio_line(c, t, "kill_switch");
+    out.kill_output = parse_gpio_line(c, t, "kill_output");
+    out.power_off_output = parse_gpio_line(c, t, "power_off_output");
+    out.scl = parse_gpio_line(c, t, "scl");
+    out.sda = parse_gpio_line(c, t, "sda");
+    if (t.get("scl") && !t.get("sda"))
+        c.fail("gpio.sda", "missing: gpio.scl and gpio.sda go together (the bus clear needs both)");
+    if (t.get("sda") && !t.get("scl"))
+        c.fail("gpio.scl", "missing: gpio.scl and gpio.sda go together (the bus clear needs both)");
+
+    // One physical line cannot serve two roles.
+    const std::array<std::pair<std::string_view, const std::optional<GpioLineSettings>*>, 5> roles{{
+        {"kill_switch", &out.kill_switch},
+        {"kill_output", &out.kill_output},
+        {"power_off_output", &out.power_off_output},
+        {"scl", &out.scl},
+        {"sda", &out.sda},
+    }};
+    for (std::size_t i = 0; i < roles.size(); ++i) {
+        for (std::size_t j = i + 1; j < roles.size(); ++j) {
+            const auto& a = *roles[i].second;
+            const auto& b = *roles[j].second;
+            if (a && b && a->chip == b->chip && a->offset == b->offset && a->name == b->name)
+                c.fail("gpio." + std::string(roles[j].first),
+                       line_text(*b) + " is also used by gpio." + std::string(roles[i].first));
+        }
+    }
+}
+
+void parse_recovery(Checker& c, const toml::table& t, RecoverySettings& out) {
+    const std::string p = "recovery.";
+    c.only_keys(t, p,
+                {"enabled", "attempts", "backoff_ms", "unbind_path", "bind_path", "driver_id", "device_wait_ms"});
+    c.boolean(t, p, "enabled", out.enabled);
+    c.integer(t, p, "attempts", 1, 10, out.attempts);
+    c.integer(t, p, "backoff_ms", 0, 60000, out.backoff_ms);
+    c.path(t, p, "unbind_path", out.unbind_path);
+    c.path(t, p, "bind_path", out.bind_path);
+    if (c.string(t, p, "driver_id", out.driver_id, true) &&
+        out.driver_id.find_first_of("/ \t\n") != std::string::npos)
+        c.fail(p + "driver_id", "must be a device name such as \"fe804000.i2c\", got \"" + out.driver_id + "\"",
+               t.get("driver_id"));
+    c.integer(t, p, "device_wait_ms", 0, 60000, out.device_wait_ms);
+}
+
+} // namespace
+
+ConfigResult parse_config_string(std::string_view text, std::string_view source) {
+    ConfigResult r;
+    const std::string prefix = source.empty() ? std::string() : std::string(source) + ": ";
+    toml::table root;
+    try {
+        root = toml::parse(text, source);
+    } catch (const toml::parse_error& e) {
+        r.errors.push_back(prefix + "line " + std::to_string(e.source().begin.line) + ", column " +
+                           std::to_string(e.source().begin.column) + ": " + std::string(e.description()));
+        return r;
+    }
+
+    Checker c;
+    DaemonConfig cfg;
+    // [sim] belongs to caracara-sim, which reads the same file; it is not checked here.
+    c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "sim"});
+    if (const toml::table* t = c.table(root, "", "i2c"))
+        parse_i2c(c, *t, cfg.i2c);
+    if (const toml::table* t = c.table(root, "", "spi"))
+        parse_spi(c, *t, cfg.spi);
+    parse_thrusters(c, root, cfg.thrusters);
+    if (const toml::table* t = c.table(root, "", "mixing"))
+        parse_mixing(c, *t, cfg.mixing);
+    if (const toml::table* t = c.table(root, "", "control"))
+        parse_control(c, *t, cfg.control);
+    if (const toml::table* t = c.table(root, "", "gpio"))
+        parse_gpio(c, *t, cfg.gpio);
+    if (const toml::table* t = c.table(root, "", "recovery"))
+        parse_recovery(c, *t, cfg.recovery);
+    c.table(root, "", "sim");
+
+    // Only when neither line is given: one without the other is already reported.
+    if (cfg.recovery.enabled && !root["gpio"]["scl"] && !root["gpio"]["sda"])
+        c.fail("recovery.enabled", "bus recovery needs gpio.scl and gpio.sda", root["recovery"]["enabled"].node());
+
+    if (!c.errors.empty()) {
+        for (std::string& e : c.errors)
+            r.errors.push_back(prefix + e);
+        return r;
+    }
+    r.config = std::move(cfg);
+    return r;
+}
+
+ConfigResult parse_config_file(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) {
+        const int err = errno;
+        ConfigResult r;
+        r.errors.push_back(path + ": cannot read: " + std::strerror(err));
+        return r;
+    }
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    return parse_config_string(ss.str(), path);
+}
+
+} // namespace caracara

@@ -1,0 +1,107 @@
+// caracarad.toml: parsed into plain structs with defaults and strict validation. An invalid
+// file is refused as a whole; every problem is reported as "<key>: <problem>" (with the
+// line when known), and unknown keys are errors so a typo cannot silently fall back to a
+// default. daemon/caracarad.toml.example documents every key.
+//
+// The driver-level settings are produced directly as the drivers' own config structs
+// (ThrusterConfig, SpiConfig, TeensyLinkConfig), and the thruster set is cross-checked
+// with validate_thruster_set(), so a file this parser accepts is one the drivers accept.
+#pragma once
+
+#include "core/budget.hpp"
+#include "core/mixing.hpp"
+#include "core/safety.hpp"
+#include "core/link_config.hpp"
+#include "core/thruster_config.hpp"
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace caracara {
+
+struct I2cSettings {
+    std::string device = "/dev/i2c-1";
+    // The bus clock is set by the device tree (dtparam=i2c_arm_baudrate), not by the
+    // daemon; the key describes the vehicle (caracara-sim reads it from the same file).
+    uint32_t clock_hz = 100000;
+    std::optional<uint32_t> timeout_ms;  // I2C_TIMEOUT (kernel units of 10 ms); unset: kernel default
+    std::optional<uint32_t> retries;     // I2C_RETRIES; unset: kernel default
+};
+
+struct SpiSettings {
+    std::string device = "/dev/spidev0.0";
+    SpiConfig spi;              // speed_hz, byte_delay_us (per_byte_delay_us in the file)
+    TeensyLinkConfig teensy;    // busy retries/delay, servo and distance sensor counts
+};
+
+struct GpioLineSettings {
+    std::string chip = "gpiochip0";
+    std::string name;                 // the line's name, or empty when `offset` is used
+    std::optional<uint32_t> offset;   // the line's offset on `chip`
+    bool active_low = false;
+};
+
+struct GpioSettings {
+    std::optional<GpioLineSettings> kill_switch;       // input: set = kill
+    std::optional<GpioLineSettings> kill_output;       // output: asserted = thrusters de-energized
+    std::optional<GpioLineSettings> power_off_output;  // output: asserted = power off
+    std::optional<GpioLineSettings> scl;               // bus-clear lines (both or neither)
+    std::optional<GpioLineSettings> sda;
+};
+
+struct ControlSettings {
+    uint32_t loop_rate_hz = 50;           // 0: as fast as the bus allows
+    uint32_t status_reads_per_tick = 1;   // thrusters polled for status per tick, round robin
+    uint32_t command_timeout_ms = 500;    // silent command stream -> zero output (not a kill)
+    uint32_t arming_delay_ms = 3000;      // zero output after a kill is cleared
+    BudgetPolicy budget_policy = BudgetPolicy::Scale;
+};
+
+struct RecoverySettings {
+    bool enabled = false;  // needs gpio.scl and gpio.sda
+    uint32_t attempts = 3;
+    uint32_t backoff_ms = 100;  // wait between failed attempts
+    // Raspberry Pi: taking GPIO2/3 as GPIO steals them from the I2C controller, and only
+    // unbinding and rebinding its platform driver gives them back. Paths and the device id
+    // differ per board; an empty driver_id skips the rebind (boards or the simulator that
+    // do not need it).
+    std::string unbind_path = "/sys/bus/platform/drivers/i2c-bcm2835/unbind";
+    std::string bind_path = "/sys/bus/platform/drivers/i2c-bcm2835/bind";
+    std::string driver_id;
+    uint32_t device_wait_ms = 1000;  // how long to wait for the i2c device node to return
+};
+
+// The default vehicle: eight SeaBotix controllers at MT 0x52, 0x56, 0x58, 0x5A, 0x5C,
+// 0x5E, 0x60, 0x62 (distinct even addresses, all on the main bus).
+std::array<ThrusterConfig, kMotorCount> default_thrusters();
+
+struct DaemonConfig {
+    I2cSettings i2c;
+    SpiSettings spi;
+    std::array<ThrusterConfig, kMotorCount> thrusters = default_thrusters();
+    MixMatrix mixing = default_mix_matrix();
+    ControlSettings control;
+    GpioSettings gpio;
+    RecoverySettings recovery;
+};
+
+struct ConfigResult {
+    std::optional<DaemonConfig> config;  // set when valid
+    std::vector<std::string> errors;     // every problem found, "<key>: <problem>"
+    std::string error() const;           // errors joined by newlines; "" when valid
+    bool ok() const { return config.has_value(); }
+};
+
+// `source` names the text in messages (a file path); empty: messages carry no prefix.
+ConfigResult parse_config_string(std::string_view text, std::string_view source = {});
+// Reads and parses the file; messages are prefixed with the path.
+ConfigResult parse_config_file(const std::string& path);
+
+// The safety machine's timing from [control].
+SafetyConfig safety_config(const DaemonConfig& config);
+
+} // namespace caracara

@@ -1,0 +1,53 @@
+// Zero orders for every thruster, prepared in advance on a device connection of their own, so
+// a fatal signal handler can send them without allocating, locking or touching state the
+// crash may have left half-written. Only async-signal-safe calls happen in fire().
+#pragma once
+
+#include "platform/device_io.hpp"
+#include "devices/thruster_driver.hpp"
+
+#include <array>
+#include <csignal>
+#include <linux/i2c.h>
+#include <memory>
+#include <span>
+#include <string>
+
+namespace caracara {
+
+class EmergencyStop {
+public:
+    // Opens `i2c_path` on `io` (its own connection / file description) and encodes a zero order
+    // per thruster, with its mux select. Returns "" or why it could not.
+    std::string arm(std::unique_ptr<DeviceIo> io, const std::string& i2c_path, std::span<const ThrusterConfig> thrusters);
+    // Sends the zero orders. Async-signal-safe; errors are ignored (there is no one to tell).
+    void fire() noexcept;
+    bool armed() const { return fd_ >= 0; }
+
+    // Every signal whose default action ends the process and that the daemon does not handle
+    // itself (SIGTERM, SIGINT and SIGHUP stop it cleanly through the event loop; SIGPIPE is
+    // ignored): crashes, and stray signals such as SIGQUIT or SIGUSR1 that would otherwise end it
+    // with the thrusters still running.
+    static constexpr int kFatalSignals[] = {SIGSEGV, SIGBUS,  SIGILL,  SIGFPE,    SIGABRT, SIGQUIT,  SIGTRAP,
+                                            SIGSYS,  SIGXCPU, SIGXFSZ, SIGUSR1,   SIGUSR2, SIGALRM,  SIGVTALRM,
+                                            SIGPROF, SIGIO,   SIGPWR,  SIGSTKFLT};
+    // Installs handlers for kFatalSignals that fire `stop`, then let the signal take its default
+    // course (the process ends, with a core dump where the signal makes one, and systemd restarts
+    // the service).
+    static void install_fatal_handlers(EmergencyStop* stop);
+
+private:
+    struct Prepared {
+        std::array<uint8_t, 3> order{};
+        uint8_t mux_control = 0;
+        uint16_t addr7 = 0;
+        uint16_t mux_addr7 = 0;
+        bool has_mux = false;
+    };
+    std::unique_ptr<DeviceIo> io_;
+    int fd_ = -1;
+    std::array<Prepared, 8> prepared_{};
+    size_t count_ = 0;
+};
+
+} // namespace caracara

@@ -1,0 +1,31 @@
+#include "platform/hardware.hpp"
+
+#include "platform/io_error.hpp"
+#include "platform/linux/libgpiod_backend.hpp"
+#include "platform/linux/linux_device_io.hpp"
+#include "platform/sim/sim_gpio_backend.hpp"
+#include "platform/sim/sim_device_io.hpp"
+
+namespace caracara {
+
+bool make_hardware(const std::string& spec, Hardware& out, std::string& error) {
+    if (spec == "linux") {
+        out.io = std::make_unique<LinuxDeviceIo>();
+        out.gpio = make_libgpiod_backend("caracarad");
+        return true;
+    }
+    if (spec.rfind("sim:", 0) == 0 && spec.size() > 4) {
+        auto io = std::make_unique<SimDeviceIo>();
+        if (int r = io->connect(spec.substr(4)); r < 0) {
+            error = "cannot connect to caracara-sim at " + spec.substr(4) + ": " + errno_name(-r);
+            return false;
+        }
+        out.gpio = make_sim_gpio_backend(*io);
+        out.io = std::move(io);
+        return true;
+    }
+    error = "--hardware must be 'linux' or 'sim:SOCKET', got '" + spec + "'";
+    return false;
+}
+
+} // namespace caracara

@@ -1,0 +1,43 @@
+// i2c-dev access through the device seam: one I2C_RDWR per transaction, exactly the
+// struct i2c_msg array the SBC's kernel receives (bcm2835 allows only one read, last).
+#pragma once
+
+#include "platform/device_io.hpp"
+#include "platform/io_error.hpp"
+
+#include <cstdint>
+#include <linux/i2c.h>
+#include <span>
+#include <string>
+
+namespace caracara {
+
+class I2cDev {
+public:
+    I2cDev(DeviceIo& io, std::string path) : io_(io), path_(std::move(path)) {}
+    ~I2cDev() { close(); }
+    I2cDev(const I2cDev&) = delete;
+    I2cDev& operator=(const I2cDev&) = delete;
+
+    // Opens the node and checks I2C_FUNCS for plain I2C (I2C_FUNC_I2C). Returns -errno
+    // (-EOPNOTSUPP when the adapter cannot do plain I2C transfers).
+    int open();
+    void close();
+    bool is_open() const { return fd_ >= 0; }
+    const std::string& path() const { return path_; }
+
+    // One I2C_RDWR ioctl carrying `msgs`. Returns IoError::None or the typed failure;
+    // last_errno() keeps the raw errno of the last failure.
+    IoError transfer(std::span<i2c_msg> msgs);
+    IoError write(uint16_t addr7, std::span<const uint8_t> data);
+    IoError read(uint16_t addr7, std::span<uint8_t> data);
+    int last_errno() const { return last_errno_; }
+
+private:
+    DeviceIo& io_;
+    std::string path_;
+    int fd_ = -1;
+    int last_errno_ = 0;
+};
+
+} // namespace caracara

@@ -1,0 +1,52 @@
+// DeviceIo that hands each open/ioctl/close to caracara-sim over its Unix socket and copies
+// the replies and errno back exactly as the kernel would. No allocation per call.
+#pragma once
+
+#include "platform/device_io.hpp"
+#include "protocol/sim_protocol.hpp"
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace caracara {
+
+class SimDeviceIo final : public DeviceIo {
+public:
+    SimDeviceIo() = default;
+    ~SimDeviceIo() override;
+    SimDeviceIo(const SimDeviceIo&) = delete;
+    SimDeviceIo& operator=(const SimDeviceIo&) = delete;
+
+    int connect(const std::string& socket_path); // -errno on failure
+    int open(const char* path, int flags) override;
+    int ioctl(int fd, unsigned long request, void* arg) override;
+    int close(int fd) override;
+    int write(int fd, const void* buf, size_t len) override;
+
+    // GPIO lines of the simulated vehicle (see GpioBackend); results as the ops above.
+    int gpio_request(const std::string& chip, const std::string& name, int offset, simproto::GpioMode mode,
+                     bool active_low, int initial);
+    int gpio_get(int line);
+    int gpio_set(int line, int value);
+    int gpio_release(int line);
+    const std::string& socket_path() const { return path_; }
+
+private:
+    // Sends tx_[0..len) and waits for the matching reply in rx_; returns the reply's result
+    // and leaves `payload` positioned after it.
+    int roundtrip(size_t len, simproto::Op op, simproto::Reader& payload);
+    int i2c_rdwr(int fd, void* arg);
+    int spi_message(int fd, unsigned long request, void* arg);
+    int small_ioctl(int fd, unsigned long request, void* arg);
+
+    int simple(simproto::Op op, int32_t a, int32_t b = -1); // ops carrying one or two i32
+    int sock_ = -1;
+    std::string path_;
+    uint32_t seq_ = 0;
+    size_t rx_len_ = 0;
+    std::array<uint8_t, simproto::kMaxMessage> tx_{};
+    std::array<uint8_t, simproto::kMaxMessage> rx_{};
+};
+
+} // namespace caracara
