@@ -8,7 +8,6 @@
 #include <cmath>
 #include <poll.h>
 #include <systemd/sd-daemon.h>
-#include <ctime>
 
 namespace caracara {
 
@@ -62,27 +61,6 @@ Result teensy_result(teensy::TeensyError e, std::string_view what) {
 }
 } // namespace
 
-std::string_view status_name(Status s) {
-    switch (s) {
-    case Status::Ok: return "Ok";
-    case Status::InvalidLength: return "InvalidLength";
-    case Status::OutOfRange: return "OutOfRange";
-    case Status::InvalidValue: return "InvalidValue";
-    case Status::Killed: return "Killed";
-    case Status::Arming: return "Arming";
-    case Status::PoweredOff: return "PoweredOff";
-    case Status::OverBudget: return "OverBudget";
-    case Status::NotKilled: return "NotKilled";
-    case Status::KillSwitchSet: return "KillSwitchSet";
-    case Status::ConfirmationRequired: return "ConfirmationRequired";
-    case Status::Busy: return "Busy";
-    case Status::Timeout: return "Timeout";
-    case Status::LinkError: return "LinkError";
-    case Status::Hardware: return "Hardware";
-    }
-    return "Hardware";
-}
-
 Controller::Controller(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config)
     : event_(event),
       io_(io),
@@ -100,11 +78,7 @@ Controller::Controller(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonC
 
 Controller::~Controller() { shutdown(); }
 
-uint64_t Controller::now() const {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
+uint64_t Controller::now() const { return monotonic_ns(); }
 
 std::string Controller::start() {
     if (int r = i2c_.open(); r < 0)

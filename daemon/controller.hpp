@@ -9,6 +9,8 @@
 #pragma once
 
 #include "core/budget.hpp"
+#include "core/clock.hpp"
+#include "core/status.hpp"
 #include "core/config.hpp"
 #include "platform/device_io.hpp"
 #include "platform/gpio_backend.hpp"
@@ -31,32 +33,6 @@
 #include <vector>
 
 namespace caracara {
-
-// Outcome of a command, mapped 1:1 to org.caracara.Vehicle1.Error.<name> by dbus/.
-enum class Status {
-    Ok,
-    InvalidLength,
-    OutOfRange,
-    InvalidValue,
-    Killed,
-    Arming,
-    PoweredOff,
-    OverBudget,
-    NotKilled,
-    KillSwitchSet,
-    ConfirmationRequired,
-    Busy,
-    Timeout,
-    LinkError,
-    Hardware,
-};
-std::string_view status_name(Status s); // "OutOfRange", ...
-
-struct Result {
-    Status status = Status::Ok;
-    std::string message;
-    bool ok() const { return status == Status::Ok; }
-};
 
 // Event-loop priorities. D-Bus, timers and the kill switch run at SD_EVENT_PRIORITY_NORMAL or
 // above; the bus work below them; announcements (PropertiesChanged) below the work, so that

@@ -5,12 +5,6 @@
 
 namespace caracara::sim {
 
-uint64_t monotonic_ns() {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
-
 uint64_t WireLog::append(WireEntry e) {
     e.index = next_++;
     entries_.push_back(std::move(e));

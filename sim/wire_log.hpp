@@ -3,15 +3,14 @@
 // cannot eat memory.
 #pragma once
 
+#include "core/clock.hpp"
+
 #include <cstdint>
 #include <deque>
 #include <string>
 #include <vector>
 
 namespace caracara::sim {
-
-// CLOCK_MONOTONIC in nanoseconds: the clock of the wire log, shared with the daemon's host.
-uint64_t monotonic_ns();
 
 // The kinds of entry, by bus (consumers filter on it):
 //   "i2c"        one I2C message: addr = 7-bit address, read, data = the bytes after the
