@@ -1,6 +1,6 @@
 // caracarad: the Caracara vehicle daemon. One sd-event loop; see DESIGN.md.
 #include "core/config.hpp"
-#include "daemon/controller.hpp"
+#include "daemon/vehicle_daemon.hpp"
 #include "platform/hardware.hpp"
 #include "devices/emergency_stop.hpp"
 #include "platform/io_error.hpp"
@@ -36,20 +36,6 @@ void usage(FILE* f) {
                "  --check-config         validate the configuration and exit\n"
                "  -h, --help             this text\n",
                f);
-}
-
-struct Watchdog {
-    Controller* controller;
-    uint64_t interval_us;
-};
-
-int on_watchdog(sd_event_source* s, uint64_t usec, void* userdata) {
-    auto* w = static_cast<Watchdog*>(userdata);
-    // Only a control loop that keeps completing cycles keeps systemd from restarting us.
-    if (w->controller->healthy(usec * 1000))
-        sd_notify(0, "WATCHDOG=1");
-    sd_event_source_set_time(s, usec + w->interval_us);
-    return 0;
 }
 
 int on_signal(sd_event_source* s, const signalfd_siginfo* si, void*) {
@@ -140,8 +126,8 @@ int main(int argc, char** argv) {
     for (int sig : {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU})
         signal(sig, SIG_IGN);
 
-    Controller controller(event.get(), *hw.io, *hw.gpio, *cr.config);
-    if (std::string e = controller.start(); !e.empty()) {
+    VehicleDaemon daemon(event.get(), *hw.io, *hw.gpio, *cr.config);
+    if (std::string e = daemon.start(); !e.empty()) {
         log_error("%s", e.c_str());
         sd_notifyf(0, "STATUS=%s", e.c_str());
         return 1;
@@ -164,10 +150,10 @@ int main(int argc, char** argv) {
     dbus::BusPtr bus;
     if (int r = dbus::open_bus(bus_choice, "caracarad", bus); r < 0) {
         log_error("cannot connect to %s: %s", bus_choice.describe().c_str(), errno_name(-r).c_str());
-        return 1; // the Controller destructor has zeroed the thrusters
+        return 1; // the VehicleDaemon destructor has zeroed the thrusters
     }
-    dbus::VehicleService service(bus.get(), controller);
-    controller.set_observer(&service);
+    dbus::VehicleService service(bus.get(), daemon);
+    daemon.events().attach(&service);
     if (int r = service.start(); r < 0) {
         log_error("cannot publish %s on %s: %s", dbus::kBusName, bus_choice.describe().c_str(), errno_name(-r).c_str());
         return 1;
@@ -176,33 +162,21 @@ int main(int argc, char** argv) {
     sd_bus_set_exit_on_disconnect(bus.get(), 1);
     sd_bus_attach_event(bus.get(), event.get(), SD_EVENT_PRIORITY_NORMAL);
     dbus::BusInputProbe input_probe(bus.get());
-    controller.set_input_probe(&input_probe);
+    daemon.loop().set_input_probe(&input_probe);
 
-    uint64_t wd_usec = 0;
-    Watchdog wd{&controller, 0};
-    dbus::SourcePtr wd_source;
-    if (sd_watchdog_enabled(0, &wd_usec) > 0) {
-        wd.interval_us = wd_usec / 2;
-        uint64_t now_us = 0;
-        sd_event_now(event.get(), CLOCK_MONOTONIC, &now_us);
-        sd_event_source* s = nullptr;
-        sd_event_add_time(event.get(), &s, CLOCK_MONOTONIC, now_us + wd.interval_us, 1000, on_watchdog, &wd);
-        sd_event_source_set_enabled(s, SD_EVENT_ON);
-        wd_source.reset(s);
-    }
+    daemon.status().start_watchdog();
 
     log_notice("serving %s on %s with %zu thrusters on %s (%s)", dbus::kBusName, bus_choice.describe().c_str(),
-               controller.thruster_count(), cr.config->i2c.device.c_str(), hardware.c_str());
-    sd_notifyf(0, "READY=1\nSTATUS=Thrusters zeroed; %s; serving %s", std::string(controller.state_name()).c_str(),
-               dbus::kBusName);
+               daemon.bus().size(), cr.config->i2c.device.c_str(), hardware.c_str());
+    daemon.status().ready(dbus::kBusName);
 
     int r = sd_event_loop(event.get());
     if (r > 0) // only sd-bus's exit on disconnect leaves the loop with a failure status
         log_error("lost its connection to the bus: thrusters to zero, exiting");
-    controller.set_observer(nullptr);
-    controller.shutdown();
+    daemon.events().attach(static_cast<VehicleObserver*>(nullptr));
+    daemon.shutdown();
     EmergencyStop::install_fatal_handlers(nullptr);
-    sd_notify(0, "STOPPING=1\nSTATUS=Thrusters zeroed; stopped");
+    daemon.status().stopping();
     if (r < 0) {
         log_error("event loop failed: %s", errno_name(-r).c_str());
         return 1;

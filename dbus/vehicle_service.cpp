@@ -11,11 +11,11 @@ namespace caracara::dbus {
 
 namespace {
 
-Controller& ctl(void* userdata) { return static_cast<VehicleService*>(userdata)->controller(); }
+VehicleDaemon& ctl(void* userdata) { return static_cast<VehicleService*>(userdata)->controller(); }
 VehicleService::ThrusterObject& tobj(void* userdata) { return *static_cast<VehicleService::ThrusterObject*>(userdata); }
 const ThrusterDriver& thr(void* userdata) {
     auto& o = tobj(userdata);
-    return o.service->controller().thruster(o.index);
+    return o.service->controller().bus().thruster(o.index);
 }
 
 // Status fields of either controller variant, as the Thruster interface presents them.
@@ -133,7 +133,7 @@ int m_set_thrust(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     std::vector<int32_t> v;
     if (int r = read_int_array(m, v); r < 0)
         return r;
-    return reply_result(m, ctl(userdata).set_thrust(v, sender(m)), err);
+    return reply_result(m, ctl(userdata).vehicle().set_thrust(v, sender(m)), err);
 }
 
 int m_set_motion(sd_bus_message* m, void* userdata, sd_bus_error* err) {
@@ -141,22 +141,22 @@ int m_set_motion(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     int r = sd_bus_message_read(m, "dddddd", &d[0], &d[1], &d[2], &d[3], &d[4], &d[5]);
     if (r < 0)
         return r;
-    return reply_result(m, ctl(userdata).set_motion(d, sender(m)), err);
+    return reply_result(m, ctl(userdata).vehicle().set_motion(d, sender(m)), err);
 }
 
 int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     std::vector<int32_t> v;
     if (int r = read_int_array(m, v); r < 0)
         return r;
-    return reply_result(m, ctl(userdata).apply_packet(v, sender(m)), err);
+    return reply_result(m, ctl(userdata).vehicle().apply_packet(v, sender(m)), err);
 }
 
 int m_kill(sd_bus_message* m, void* userdata, sd_bus_error* err) {
-    return reply_result(m, ctl(userdata).kill(KillSource::DBus, "Kill() from " + sender(m)), err);
+    return reply_result(m, ctl(userdata).vehicle().kill(KillSource::DBus, "Kill() from " + sender(m)), err);
 }
 
 int m_clear_kill(sd_bus_message* m, void* userdata, sd_bus_error* err) {
-    return reply_result(m, ctl(userdata).clear_kill(), err);
+    return reply_result(m, ctl(userdata).vehicle().clear_kill(), err);
 }
 
 int m_power_off(sd_bus_message* m, void* userdata, sd_bus_error* err) {
@@ -164,7 +164,7 @@ int m_power_off(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     int r = sd_bus_message_read(m, "s", &confirmation);
     if (r < 0)
         return r;
-    return reply_result(m, ctl(userdata).power_off(confirmation), err);
+    return reply_result(m, ctl(userdata).vehicle().power_off(confirmation), err);
 }
 
 int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error* err) {
@@ -172,28 +172,28 @@ int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     int r = sd_bus_message_read(m, "yyy", &red, &green, &blue);
     if (r < 0)
         return r;
-    return reply_result(m, ctl(userdata).set_leds(red, green, blue), err);
+    return reply_result(m, ctl(userdata).vehicle().set_leds(red, green, blue), err);
 }
 
-PROP(p_state) { return sd_bus_message_append(reply, "s", std::string(ctl(userdata).state_name()).c_str()); }
-PROP(p_kill_source) { return sd_bus_message_append(reply, "s", std::string(ctl(userdata).kill_source_name()).c_str()); }
-PROP(p_motor_values) { return append_ints(reply, ctl(userdata).motor_values()); }
-PROP(p_requested_values) { return append_ints(reply, ctl(userdata).requested_values()); }
-PROP(p_budget_limit) { return sd_bus_message_append(reply, "i", ctl(userdata).budget_limit()); }
-PROP(p_saturated) { return sd_bus_message_append(reply, "b", static_cast<int>(ctl(userdata).saturated())); }
+PROP(p_state) { return sd_bus_message_append(reply, "s", std::string(ctl(userdata).vehicle().state_name()).c_str()); }
+PROP(p_kill_source) { return sd_bus_message_append(reply, "s", std::string(ctl(userdata).vehicle().kill_source_name()).c_str()); }
+PROP(p_motor_values) { return append_ints(reply, ctl(userdata).vehicle().motor_values()); }
+PROP(p_requested_values) { return append_ints(reply, ctl(userdata).vehicle().requested_values()); }
+PROP(p_budget_limit) { return sd_bus_message_append(reply, "i", ctl(userdata).vehicle().budget_limit()); }
+PROP(p_saturated) { return sd_bus_message_append(reply, "b", static_cast<int>(ctl(userdata).vehicle().saturated())); }
 PROP(p_policy) {
     return sd_bus_message_append(reply, "s", std::string(policy_name(ctl(userdata).config().control.budget_policy)).c_str());
 }
 PROP(p_leds) {
-    auto l = ctl(userdata).leds();
+    auto l = ctl(userdata).teensy().leds();
     return sd_bus_message_append(reply, "(yyy)", l[0], l[1], l[2]);
 }
-PROP(p_command_age) { return sd_bus_message_append(reply, "x", ctl(userdata).command_age_ms()); }
-PROP(p_controller) { return sd_bus_message_append(reply, "s", ctl(userdata).controller_client().c_str()); }
+PROP(p_command_age) { return sd_bus_message_append(reply, "x", ctl(userdata).vehicle().command_age_ms()); }
+PROP(p_controller) { return sd_bus_message_append(reply, "s", ctl(userdata).vehicle().controller_client().c_str()); }
 PROP(p_timeout) { return sd_bus_message_append(reply, "u", ctl(userdata).config().control.command_timeout_ms); }
 PROP(p_arming) { return sd_bus_message_append(reply, "u", ctl(userdata).config().control.arming_delay_ms); }
 PROP(p_rate) { return sd_bus_message_append(reply, "d", static_cast<double>(ctl(userdata).config().control.loop_rate_hz)); }
-PROP(p_cycles) { return sd_bus_message_append(reply, "t", ctl(userdata).cycles()); }
+PROP(p_cycles) { return sd_bus_message_append(reply, "t", ctl(userdata).loop().cycles()); }
 
 constexpr uint64_t kUnpriv = SD_BUS_VTABLE_UNPRIVILEGED; // access is the bus policy's job
 constexpr uint64_t kChange = SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE;
@@ -243,7 +243,7 @@ PROP(t_reversed) { return sd_bus_message_append(reply, "b", static_cast<int>(thr
 PROP(t_online) { return sd_bus_message_append(reply, "b", static_cast<int>(thr(userdata).online())); }
 PROP(t_ordered_value) {
     auto& o = tobj(userdata);
-    return sd_bus_message_append(reply, "i", o.service->controller().ordered_value(o.index));
+    return sd_bus_message_append(reply, "i", o.service->controller().bus().ordered_value(o.index));
 }
 PROP(t_ordered_speed) { return sd_bus_message_append(reply, "y", thr(userdata).last_speed().value_or(0x80)); }
 PROP(t_actual_speed) {
@@ -312,7 +312,7 @@ int m_t_set_speed(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     int r = sd_bus_message_read(m, "ii", &l, &r2);
     if (r < 0)
         return r;
-    return reply_result(m, ctl(userdata).teensy_set_speed(l, r2), err);
+    return reply_result(m, ctl(userdata).teensy().set_speed(l, r2), err);
 }
 
 int m_t_stop(sd_bus_message* m, void* userdata, sd_bus_error* err) {
@@ -320,7 +320,7 @@ int m_t_stop(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     int r = sd_bus_message_read(m, "y", &duty);
     if (r < 0)
         return r;
-    return reply_result(m, ctl(userdata).teensy_stop(duty), err);
+    return reply_result(m, ctl(userdata).teensy().stop(duty), err);
 }
 
 int m_t_servo(sd_bus_message* m, void* userdata, sd_bus_error* err) {
@@ -328,7 +328,7 @@ int m_t_servo(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     int r = sd_bus_message_read(m, "yy", &id, &deg);
     if (r < 0)
         return r;
-    return reply_result(m, ctl(userdata).teensy_servo(id, deg), err);
+    return reply_result(m, ctl(userdata).teensy().servo(id, deg), err);
 }
 
 int m_t_distance(sd_bus_message* m, void* userdata, sd_bus_error* err) {
@@ -337,7 +337,7 @@ int m_t_distance(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     if (r < 0)
         return r;
     uint16_t mm = 0;
-    Result res = ctl(userdata).teensy_distance(id, mm);
+    Result res = ctl(userdata).teensy().distance(id, mm);
     if (!res.ok())
         return reply_result(m, res, err);
     return sd_bus_reply_method_return(m, "q", mm);
@@ -351,7 +351,7 @@ int turn(sd_bus_message* m, void* userdata, sd_bus_error* err, bool absolute) {
     // Reply later, when the Teensy confirms; other calls are served meanwhile.
     sd_bus_message_ref(m);
     auto pending = std::shared_ptr<sd_bus_message>(m, sd_bus_message_unref);
-    Result res = ctl(userdata).teensy_turn(rad, absolute, [pending](const Result& done) {
+    Result res = ctl(userdata).teensy().turn(rad, absolute, [pending](const Result& done) {
         if (done.ok()) {
             sd_bus_reply_method_return(pending.get(), "");
         } else {
@@ -368,22 +368,22 @@ int m_t_turn(sd_bus_message* m, void* userdata, sd_bus_error* err) { return turn
 int m_t_turn_to(sd_bus_message* m, void* userdata, sd_bus_error* err) { return turn(m, userdata, err, true); }
 
 PROP(te_orientation) {
-    const auto& o = ctl(userdata).teensy().orientation;
+    const auto& o = ctl(userdata).teensy().telemetry().orientation;
     return sd_bus_message_append(reply, "(ddd)", o[0], o[1], o[2]);
 }
 PROP(te_distances) {
-    const auto& d = ctl(userdata).teensy().distances;
+    const auto& d = ctl(userdata).teensy().telemetry().distances;
     return sd_bus_message_append_array(reply, 'q', d.data(), d.size() * sizeof(uint16_t));
 }
 PROP(te_servos) {
-    const auto& s = ctl(userdata).teensy().servos;
+    const auto& s = ctl(userdata).teensy().telemetry().servos;
     return sd_bus_message_append_array(reply, 'y', s.data(), s.size());
 }
-PROP(te_task) { return sd_bus_message_append(reply, "s", ctl(userdata).teensy().turning ? "turning" : "idle"); }
-PROP(te_online) { return sd_bus_message_append(reply, "b", static_cast<int>(ctl(userdata).teensy().online)); }
-PROP(te_frames) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy_counters().frames); }
-PROP(te_busy) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy_counters().busy_retries); }
-PROP(te_errors) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy_counters().link_errors); }
+PROP(te_task) { return sd_bus_message_append(reply, "s", ctl(userdata).teensy().telemetry().turning ? "turning" : "idle"); }
+PROP(te_online) { return sd_bus_message_append(reply, "b", static_cast<int>(ctl(userdata).teensy().telemetry().online)); }
+PROP(te_frames) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy().counters().frames); }
+PROP(te_busy) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy().counters().busy_retries); }
+PROP(te_errors) { return sd_bus_message_append(reply, "t", ctl(userdata).teensy().counters().link_errors); }
 
 const sd_bus_vtable kTeensyVtable[] = {
     SD_BUS_VTABLE_START(0),
@@ -407,15 +407,15 @@ const sd_bus_vtable kTeensyVtable[] = {
 // --- Bus -------------------------------------------------------------------------------------
 
 PROP(b_device) { return sd_bus_message_append(reply, "s", ctl(userdata).config().i2c.device.c_str()); }
-PROP(b_state) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().state.c_str()); }
-PROP(b_transactions) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().transactions); }
-PROP(b_errors) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().errors); }
-PROP(b_last_error) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().last_error.c_str()); }
-PROP(b_recoveries) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().recoveries); }
-PROP(b_failures) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().recovery_failures); }
-PROP(b_pulses) { return sd_bus_message_append(reply, "u", ctl(userdata).bus().last_pulses); }
-PROP(b_recovery_ms) { return sd_bus_message_append(reply, "d", ctl(userdata).bus().last_recovery_ms); }
-PROP(b_recovery_error) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().last_recovery_error.c_str()); }
+PROP(b_state) { return sd_bus_message_append(reply, "s", std::string(bus_state_name(ctl(userdata).bus().telemetry().state)).c_str()); }
+PROP(b_transactions) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().telemetry().transactions); }
+PROP(b_errors) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().telemetry().errors); }
+PROP(b_last_error) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().telemetry().last_error.c_str()); }
+PROP(b_recoveries) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().telemetry().recoveries); }
+PROP(b_failures) { return sd_bus_message_append(reply, "t", ctl(userdata).bus().telemetry().recovery_failures); }
+PROP(b_pulses) { return sd_bus_message_append(reply, "u", ctl(userdata).bus().telemetry().last_pulses); }
+PROP(b_recovery_ms) { return sd_bus_message_append(reply, "d", ctl(userdata).bus().telemetry().last_recovery_ms); }
+PROP(b_recovery_error) { return sd_bus_message_append(reply, "s", ctl(userdata).bus().telemetry().last_recovery_error.c_str()); }
 
 const sd_bus_vtable kBusVtable[] = {
     SD_BUS_VTABLE_START(0),
@@ -453,7 +453,7 @@ int VehicleService::start() {
     int r = keep(sd_bus_add_object_manager(bus_, &slot, kRootPath));
     if (r >= 0)
         r = keep(sd_bus_add_object_vtable(bus_, &slot, kRootPath, kVehicleIface, kVehicleVtable, this));
-    for (size_t i = 0; r >= 0 && i < controller_.thruster_count(); ++i) {
+    for (size_t i = 0; r >= 0 && i < controller_.bus().size(); ++i) {
         auto obj = std::make_unique<ThrusterObject>(
             ThrusterObject{this, i, std::string(kRootPath) + "/thruster/" + std::to_string(i)});
         r = keep(sd_bus_add_object_vtable(bus_, &slot, obj->path.c_str(), kThrusterIface, kThrusterVtable, obj.get()));
@@ -474,7 +474,7 @@ int VehicleService::start() {
                                   on_name_owner_changed, this));
     if (r < 0)
         return r;
-    for (size_t i = 0; i < controller_.thruster_count(); ++i)
+    for (size_t i = 0; i < controller_.bus().size(); ++i)
         published_.push_back(snapshot(i));
     return sd_bus_request_name(bus_, kBusName, 0);
 }
@@ -484,7 +484,7 @@ int VehicleService::on_name_owner_changed(sd_bus_message* m, void* userdata, sd_
     if (sd_bus_message_read(m, "sss", &name, &old_owner, &new_owner) < 0)
         return 0;
     if (name && name[0] == ':' && new_owner && new_owner[0] == '\0')
-        static_cast<VehicleService*>(userdata)->controller_.client_left(name);
+        static_cast<VehicleService*>(userdata)->controller_.vehicle().client_left(name);
     return 0;
 }
 
@@ -547,10 +547,10 @@ void VehicleService::emit_vehicle_changes(uint32_t changes) {
 }
 
 VehicleService::ThrusterSnapshot VehicleService::snapshot(size_t i) const {
-    const ThrusterDriver& t = controller_.thruster(i);
+    const ThrusterDriver& t = controller_.bus().thruster(i);
     ThrusterSnapshot s;
     s.online = t.online();
-    s.ordered_value = controller_.ordered_value(i);
+    s.ordered_value = controller_.bus().ordered_value(i);
     s.ordered_speed = t.last_speed().value_or(0x80);
     if (const auto& st = t.last_status()) {
         s.actual_speed = actual_speed(*st);
@@ -606,8 +606,8 @@ void VehicleService::emit_telemetry() {
         published_[i] = std::move(now);
     }
 
-    const TeensyTelemetry& te = controller_.teensy();
-    const auto& tc = controller_.teensy_counters();
+    const TeensyTelemetry& te = controller_.teensy().telemetry();
+    const auto& tc = controller_.teensy().counters();
     ChangedNames tn;
     if (te.orientation != published_teensy_.orientation) tn.add("Orientation");
     if (te.distances != published_teensy_.distances) tn.add("Distances");
@@ -630,7 +630,7 @@ void VehicleService::emit_telemetry() {
 }
 
 void VehicleService::emit_bus_changes() {
-    const BusTelemetry& b = controller_.bus();
+    const BusTelemetry& b = controller_.bus().telemetry();
     ChangedNames bn;
     if (b.state != published_bus_.state) bn.add("State");
     if (counters_due_ && b.transactions != published_bus_.transactions) bn.add("Transactions");

@@ -3,7 +3,7 @@
 // this header.
 #pragma once
 
-#include "daemon/controller.hpp"
+#include "daemon/vehicle_daemon.hpp"
 #include "dbus/sdbus.hpp"
 #include "dbus/vehicle_names.hpp"
 
@@ -13,9 +13,9 @@
 
 namespace caracara::dbus {
 
-class VehicleService final : public ControllerObserver {
+class VehicleService final : public VehicleObserver {
 public:
-    VehicleService(sd_bus* bus, Controller& controller) : bus_(bus), controller_(controller) {}
+    VehicleService(sd_bus* bus, VehicleDaemon& controller) : bus_(bus), controller_(controller) {}
     ~VehicleService() override;
     // Registers the objects and the client-tracking match, then requests the bus name.
     int start();
@@ -25,7 +25,7 @@ public:
     void bus_lost(const std::string& reason) override;
     void bus_restored(uint32_t pulses, double milliseconds) override;
 
-    Controller& controller() { return controller_; }
+    VehicleDaemon& controller() { return controller_; }
     sd_bus* bus() { return bus_; }
 
     struct ThrusterObject {
@@ -59,7 +59,7 @@ private:
     static int on_name_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*);
 
     sd_bus* bus_;
-    Controller& controller_;
+    VehicleDaemon& controller_;
     std::vector<SlotPtr> slots_;
     std::vector<std::unique_ptr<ThrusterObject>> thruster_objects_;
     std::vector<ThrusterSnapshot> published_;

@@ -1,0 +1,43 @@
+// What the bus does next, in the order the daemon promises: changed orders first (a new
+// command's burst), then the status reads of this cycle round robin, then the Teensy's slot.
+// Pure: the control loop asks next() and carries the item out; time never enters here.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace caracara {
+
+class OrderSchedule {
+public:
+    enum class Kind { None, Order, Status, Teensy };
+    struct Item {
+        Kind kind = Kind::None;
+        std::size_t index = 0; // the thruster, for Order and Status
+    };
+
+    explicit OrderSchedule(std::size_t thrusters) : order_due_(thrusters, false) {}
+
+    // A new cycle: every order is refreshed, unless a burst is still going out (those sent are
+    // fresh, the rest already due: restarting it would only delay the last ones).
+    void start_cycle(uint32_t status_reads, bool teensy);
+    void mark_order(std::size_t i) { order_due_[i] = true; }
+    bool any_order_due() const;
+    // The bus is closed (recovery) or the orders were all sent at once (a kill's zeros).
+    void drop_orders();
+    void drop_bus_work();
+    // Orders first, then status reads, then the Teensy. While the I2C bus is unusable only the
+    // Teensy's slot is handed out; its orders and reads stay as they are.
+    Item next(bool bus_usable);
+    // Just the next due order (a client that leaves gets its orders out before the zeros).
+    bool pop_order(std::size_t& i);
+
+private:
+    std::vector<bool> order_due_;
+    uint32_t status_due_ = 0;
+    std::size_t status_next_ = 0;
+    bool teensy_due_ = false;
+};
+
+} // namespace caracara

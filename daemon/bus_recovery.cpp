@@ -1,0 +1,161 @@
+#include "daemon/bus_recovery.hpp"
+
+#include "core/clock.hpp"
+#include "daemon/line_spec.hpp"
+#include "daemon/log.hpp"
+#include "devices/i2c_bus_clear.hpp"
+#include "platform/io_error.hpp"
+
+#include <cerrno>
+
+namespace caracara {
+
+namespace {
+constexpr uint64_t kNodePollNs = 5'000'000;
+} // namespace
+
+BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio,
+                         ThrusterBus& bus, Vehicle& vehicle, VehicleEvents& events)
+    : event_(event),
+      config_(config),
+      io_(io),
+      gpio_(gpio),
+      bus_(bus),
+      vehicle_(vehicle),
+      events_(events),
+      policy_(config.recovery.attempts, config.recovery.backoff_ms) {}
+
+void BusRecovery::bus_locked_up(const std::string& reason) {
+    BusTelemetry& tm = bus_.telemetry();
+    if (bus_.recovering() || tm.state == BusState::Lost)
+        return;
+    if (!config_.recovery.enabled) {
+        // Nothing to clear the bus with: report it and keep trying the transfers each tick.
+        tm.state = BusState::Lost;
+        tm.last_recovery_error = reason;
+        log_error("I2C bus %s lost (%s); recovery is not configured", bus_.device().c_str(), reason.c_str());
+        events_.bus_lost(reason);
+        events_.changed(kChangeState | kChangeBus);
+        return;
+    }
+    bus_.set_recovering(true);
+    policy_.begin(monotonic_ns());
+    tm.state = BusState::Recovering;
+    tm.last_recovery_error = reason;
+    log_warning("I2C bus %s locked up (%s): recovering", bus_.device().c_str(), reason.c_str());
+    events_.bus_lost(reason);
+    events_.changed(kChangeBus);
+    // From the event loop, not from inside the transfer that noticed it.
+    schedule(0);
+}
+
+void BusRecovery::schedule(uint64_t delay_ns) {
+    const uint64_t at_us = (monotonic_ns() + delay_ns) / 1000;
+    if (!timer_) {
+        sd_event_source* s = nullptr;
+        if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, at_us, 1, on_timer, this) < 0) {
+            log_error("cannot schedule the bus recovery");
+            return;
+        }
+        timer_.reset(s);
+    }
+    sd_event_source_set_time(timer_.get(), at_us);
+    sd_event_source_set_enabled(timer_.get(), SD_EVENT_ONESHOT);
+}
+
+int BusRecovery::on_timer(sd_event_source*, uint64_t, void* userdata) {
+    auto* self = static_cast<BusRecovery*>(userdata);
+    if (self->phase_ == Phase::WaitingNode)
+        self->wait_node();
+    else
+        self->attempt();
+    return 0;
+}
+
+void BusRecovery::attempt() {
+    const RecoverySettings& rc = config_.recovery;
+    policy_.next_attempt();
+    phase_ = Phase::Idle;
+    bus_.close(); // before unbinding: the driver cannot go while the node is open
+    bus_.mux().invalidate();
+    const bool rebind = !rc.driver_id.empty();
+    if (rebind) {
+        if (int r = sysfs_write(io_, rc.unbind_path, rc.driver_id); r < 0 && r != -ENODEV)
+            log_warning("unbinding %s via %s: %s", rc.driver_id.c_str(), rc.unbind_path.c_str(), errno_name(-r).c_str());
+    }
+    BusClearResult bc = i2c_bus_clear(gpio_, line_spec(*config_.gpio.scl), line_spec(*config_.gpio.sda));
+    last_pulses_ = bc.pulses;
+    if (rebind) {
+        // Even after a failed clear: the node must come back for the next attempt.
+        if (int r = sysfs_write(io_, rc.bind_path, rc.driver_id); r < 0 && r != -EBUSY)
+            log_warning("binding %s via %s: %s", rc.driver_id.c_str(), rc.bind_path.c_str(), errno_name(-r).c_str());
+    }
+    if (!bc.ok()) {
+        failed(bc.message);
+        return;
+    }
+    log_info("bus clear: SDA released after %u clock pulses, STOP sent", bc.pulses);
+    node_deadline_ns_ = monotonic_ns() + ms_to_ns(rc.device_wait_ms);
+    phase_ = Phase::WaitingNode;
+    wait_node();
+}
+
+void BusRecovery::wait_node() {
+    const int r = bus_.open();
+    if (r == 0) {
+        finish();
+        return;
+    }
+    if (monotonic_ns() >= node_deadline_ns_) {
+        failed("the I2C device node did not come back: " + errno_name(-r));
+        return;
+    }
+    schedule(kNodePollNs);
+}
+
+void BusRecovery::finish() {
+    phase_ = Phase::Idle;
+    // The current orders go out at once, a pending kill first: zeros while the vehicle may not
+    // drive. Still flagged as recovering, so these transfers decide the outcome below instead
+    // of starting a new recovery.
+    if (vehicle_.may_drive())
+        for (size_t i = 0; i < bus_.size(); ++i)
+            bus_.send_order(i, vehicle_.order_value(i));
+    else
+        bus_.zero_all();
+    if (!bus_.any_online()) {
+        // The lines were cleared and the node is back, but nothing gets through: not recovered.
+        bus_.close();
+        failed("no thruster answers after the bus clear");
+        return;
+    }
+    bus_.set_recovering(false);
+    BusTelemetry& tm = bus_.telemetry();
+    const bool was_lost = tm.state == BusState::Lost;
+    tm.state = BusState::Ok;
+    ++tm.recoveries;
+    tm.last_pulses = last_pulses_;
+    tm.last_recovery_ms = policy_.elapsed_ms(monotonic_ns());
+    log_notice("I2C bus recovered after %u pulse(s), %.1f ms, attempt %u; orders re-sent", last_pulses_,
+               tm.last_recovery_ms, policy_.attempt());
+    events_.bus_restored(last_pulses_, tm.last_recovery_ms);
+    events_.changed(kChangeBus | (was_lost ? kChangeState : 0u));
+}
+
+void BusRecovery::failed(const std::string& why) {
+    BusTelemetry& tm = bus_.telemetry();
+    ++tm.recovery_failures;
+    tm.last_recovery_error = why;
+    phase_ = Phase::Backoff;
+    log_error("I2C bus recovery attempt %u failed: %s", policy_.attempt(), why.c_str());
+    const RecoveryPolicy::Failure f = policy_.failed();
+    if (f.lost) {
+        tm.state = BusState::Lost;
+        vehicle_.kill(KillSource::Fault, "I2C bus recovery failed: " + why);
+        events_.changed(kChangeState);
+    }
+    events_.changed(kChangeBus);
+    schedule(f.retry_in_ns);
+}
+
+} // namespace caracara

@@ -1,0 +1,53 @@
+// Recovering a locked I2C bus (DESIGN.md, NXP UM10204 "bus clear"): close the adapter, unbind
+// its platform driver, clock SCL through the GPIO lines until SDA is released and send a STOP,
+// rebind, wait for the device node, re-send the current orders (a pending kill first). Bounded
+// attempts with backoff (RecoveryPolicy); when they are used up the vehicle is killed and the
+// bus reported lost, and slow retries go on in the background. Owns its timer.
+#pragma once
+
+#include "core/config.hpp"
+#include "core/recovery_policy.hpp"
+#include "daemon/thruster_bus.hpp"
+#include "daemon/vehicle.hpp"
+#include "daemon/vehicle_events.hpp"
+#include "platform/device_io.hpp"
+#include "platform/event_loop.hpp"
+#include "platform/gpio_backend.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace caracara {
+
+class BusRecovery final : public ThrusterBus::Listener {
+public:
+    BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio, ThrusterBus& bus,
+                Vehicle& vehicle, VehicleEvents& events);
+
+    void bus_locked_up(const std::string& reason) override;
+    void stop() { timer_.reset(); }
+
+private:
+    enum class Phase { Idle, WaitingNode, Backoff };
+    static int on_timer(sd_event_source*, uint64_t usec, void* userdata);
+    void schedule(uint64_t delay_ns);
+    void attempt();
+    void wait_node();
+    void finish();
+    void failed(const std::string& why);
+
+    sd_event* event_;
+    const DaemonConfig& config_;
+    DeviceIo& io_;
+    GpioBackend& gpio_;
+    ThrusterBus& bus_;
+    Vehicle& vehicle_;
+    VehicleEvents& events_;
+    RecoveryPolicy policy_;
+    Phase phase_ = Phase::Idle;
+    uint64_t node_deadline_ns_ = 0;
+    uint32_t last_pulses_ = 0;
+    SourcePtr timer_;
+};
+
+} // namespace caracara

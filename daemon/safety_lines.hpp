@@ -1,0 +1,53 @@
+// The vehicle's safety lines, in the manner of logind's button: the kill switch (an input
+// whose edges wake the loop above D-Bus and the bus work), the kill output and the power-off
+// output. It reads and drives lines; what a switch change means is the Vehicle's business.
+#pragma once
+
+#include "core/config.hpp"
+#include "platform/event_loop.hpp"
+#include "platform/gpio_backend.hpp"
+
+#include <memory>
+#include <string>
+
+namespace caracara {
+
+class SafetyLines {
+public:
+    class Listener {
+    public:
+        virtual ~Listener() = default;
+        // The switch's current reading (set = kill), on every edge and every backstop poll.
+        virtual void kill_switch_read(bool set) = 0;
+    };
+
+    SafetyLines(sd_event* event, GpioBackend& gpio, const GpioSettings& settings)
+        : event_(event), gpio_(gpio), settings_(settings) {}
+
+    // Requests the configured lines (the kill output starting at `kill_asserted`) and watches
+    // the switch's edges. "" or what could not be had.
+    std::string open(bool kill_asserted, Listener* listener);
+    void close();
+
+    // Reads the switch and reports it (a backstop for a lost edge event).
+    void poll();
+    void set_kill_output(bool asserted);
+    bool has_power_off() const { return power_off_ != nullptr; }
+    void assert_power_off();
+    // The switch's event fd (for the loop's "is anything waiting" check), or -1.
+    int kill_switch_fd() const { return kill_switch_ ? kill_switch_->event_fd() : -1; }
+
+private:
+    static int on_kill_switch(sd_event_source*, int fd, uint32_t revents, void* userdata);
+
+    sd_event* event_;
+    GpioBackend& gpio_;
+    const GpioSettings& settings_;
+    Listener* listener_ = nullptr;
+    std::unique_ptr<GpioLine> kill_switch_;
+    std::unique_ptr<GpioLine> kill_out_;
+    std::unique_ptr<GpioLine> power_off_;
+    SourcePtr kill_switch_source_;
+};
+
+} // namespace caracara

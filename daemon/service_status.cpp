@@ -1,0 +1,44 @@
+#include "daemon/service_status.hpp"
+
+#include <systemd/sd-daemon.h>
+
+namespace caracara {
+
+void ServiceStatus::publish() const {
+    const std::string state(vehicle_.state_name());
+    const std::string ks(vehicle_.kill_source_name());
+    sd_notifyf(0, "STATUS=%s%s%s; I2C bus %s; %zu thrusters", state.c_str(), ks.empty() ? "" : " by ", ks.c_str(),
+               std::string(bus_state_name(bus_.telemetry().state)).c_str(), bus_.size());
+}
+
+void ServiceStatus::start_watchdog() {
+    uint64_t wd_usec = 0;
+    if (sd_watchdog_enabled(0, &wd_usec) <= 0)
+        return;
+    interval_us_ = wd_usec / 2;
+    uint64_t now_us = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
+    sd_event_source* s = nullptr;
+    if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us + interval_us_, 1000, on_watchdog, this) < 0)
+        return;
+    sd_event_source_set_enabled(s, SD_EVENT_ON);
+    watchdog_.reset(s);
+}
+
+int ServiceStatus::on_watchdog(sd_event_source* s, uint64_t usec, void* userdata) {
+    auto* self = static_cast<ServiceStatus*>(userdata);
+    // Only a control loop that keeps completing cycles keeps systemd from restarting us.
+    if (self->loop_.healthy(usec * 1000))
+        sd_notify(0, "WATCHDOG=1");
+    sd_event_source_set_time(s, usec + self->interval_us_);
+    return 0;
+}
+
+void ServiceStatus::ready(const char* bus_name) const {
+    sd_notifyf(0, "READY=1\nSTATUS=Thrusters zeroed; %s; serving %s", std::string(vehicle_.state_name()).c_str(),
+               bus_name);
+}
+
+void ServiceStatus::stopping() const { sd_notify(0, "STOPPING=1\nSTATUS=Thrusters zeroed; stopped"); }
+
+} // namespace caracara

@@ -1,0 +1,37 @@
+// What systemd sees of the daemon: the STATUS= line (`systemctl status caracarad`), READY=1,
+// STOPPING=1, and the watchdog, fed only while the control loop keeps completing cycles.
+#pragma once
+
+#include "daemon/control_loop.hpp"
+#include "daemon/thruster_bus.hpp"
+#include "daemon/vehicle.hpp"
+#include "platform/event_loop.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace caracara {
+
+class ServiceStatus {
+public:
+    ServiceStatus(sd_event* event, const Vehicle& vehicle, const ThrusterBus& bus, const ControlLoop& loop)
+        : event_(event), vehicle_(vehicle), bus_(bus), loop_(loop) {}
+
+    void publish() const;
+    // Starts feeding the watchdog if systemd asked for one (WatchdogSec=).
+    void start_watchdog();
+    void ready(const char* bus_name) const;
+    void stopping() const;
+
+private:
+    static int on_watchdog(sd_event_source* s, uint64_t usec, void* userdata);
+
+    sd_event* event_;
+    const Vehicle& vehicle_;
+    const ThrusterBus& bus_;
+    const ControlLoop& loop_;
+    uint64_t interval_us_ = 0;
+    SourcePtr watchdog_;
+};
+
+} // namespace caracara

@@ -1,0 +1,209 @@
+#include "daemon/teensy_port.hpp"
+
+#include "core/clock.hpp"
+#include "daemon/log.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace caracara {
+
+namespace {
+
+Status teensy_status(teensy::TeensyError e) {
+    using E = teensy::TeensyError;
+    switch (e) {
+    case E::None: return Status::Ok;
+    case E::SpeedOutOfRange:
+    case E::DutyOutOfRange:
+    case E::ServoIdOutOfRange:
+    case E::ServoAngleOutOfRange:
+    case E::SensorIdOutOfRange:
+    case E::AxisOutOfRange:
+    case E::LedValueOutOfRange: return Status::OutOfRange;
+    case E::AngleNotFinite: return Status::InvalidValue;
+    case E::Busy:
+    case E::BusyExhausted: return Status::Busy;
+    case E::ConfirmTimeout: return Status::Timeout;
+    case E::LinkError:
+    case E::BadAnswer:
+    case E::Io:
+    case E::ConfirmAckFailed: return Status::LinkError;
+    }
+    return Status::LinkError;
+}
+
+Result teensy_result(teensy::TeensyError e, std::string_view what) {
+    if (e == teensy::TeensyError::None)
+        return {};
+    return {teensy_status(e), std::string(what) + ": " + std::string(teensy::teensy_error_name(e))};
+}
+
+} // namespace
+
+TeensyPort::TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, const CommandGate& gate,
+                       VehicleEvents& events)
+    : event_(event), gate_(gate), events_(events), spi_(io, settings.device, settings.spi), link_(spi_, settings.teensy) {
+    tm_.distances.assign(static_cast<size_t>(settings.teensy.limits.distance_sensor_count), 0);
+    tm_.servos.assign(static_cast<size_t>(settings.teensy.limits.servo_count), 0);
+}
+
+int TeensyPort::open() {
+    const int r = spi_.open();
+    tm_.online = r >= 0;
+    return r;
+}
+
+void TeensyPort::close() {
+    if (turn_done_)
+        finish_turn({Status::Hardware, "the daemon is shutting down"});
+    turn_source_.reset();
+    spi_.close();
+}
+
+void TeensyPort::poll() {
+    const unsigned sensors = static_cast<unsigned>(tm_.distances.size());
+    const unsigned slots = 3 + (sensors ? 1 : 0);
+    const unsigned slot = poll_index_ % slots;
+    ++poll_index_;
+    bool ok = false;
+    if (slot < 3) {
+        auto r = link_.get_orientation(static_cast<int>(slot));
+        ok = r.ok();
+        if (ok)
+            tm_.orientation[slot] = r.value;
+    } else {
+        const unsigned sensor = (poll_index_ / slots) % sensors;
+        auto r = link_.get_distance(static_cast<int>(sensor));
+        ok = r.ok();
+        if (ok)
+            tm_.distances[sensor] = r.value;
+    }
+    tm_.online = ok;
+}
+
+void TeensyPort::stop_motion() {
+    if (!spi_.is_open())
+        return;
+    if (auto e = link_.stop(0); e != teensy::TeensyError::None)
+        log_error("Teensy Stop on kill failed: %s", std::string(teensy::teensy_error_name(e)).c_str());
+}
+
+void TeensyPort::cancel_turn(const Result& r) {
+    if (turn_done_)
+        finish_turn(r);
+}
+
+Result TeensyPort::set_leds(int red, int green, int blue) {
+    for (int v : {red, green, blue})
+        if (v < 0 || v > 255)
+            return {Status::OutOfRange, "LED values are 0..255"};
+    if (!spi_.is_open())
+        return {Status::LinkError, "the Teensy is not connected"};
+    if (Result r = teensy_result(link_.set_leds(red, green, blue), "Set LEDs"); !r.ok())
+        return r;
+    leds_ = {static_cast<uint8_t>(red), static_cast<uint8_t>(green), static_cast<uint8_t>(blue)};
+    events_.changed(kChangeLeds);
+    return {};
+}
+
+Result TeensyPort::set_speed(int left, int right) {
+    // Drive motors are motors: only a ready vehicle moves them (stopping is always allowed).
+    if (Result r = gate_.state_error(); !r.ok() && (left != 0 || right != 0))
+        return r;
+    return teensy_result(link_.set_speed(left, right), "Set Speed");
+}
+
+Result TeensyPort::stop(int duty) { return teensy_result(link_.stop(duty), "Stop"); }
+
+Result TeensyPort::servo(int id, int degrees) {
+    if (gate_.powered_off())
+        return gate_.state_error();
+    Result r = teensy_result(link_.servo(id, degrees), "Servo");
+    if (r.ok())
+        tm_.servos[static_cast<size_t>(id)] = static_cast<uint8_t>(degrees);
+    return r;
+}
+
+Result TeensyPort::distance(int sensor, uint16_t& mm) {
+    auto r = link_.get_distance(sensor);
+    if (!r.ok())
+        return teensy_result(r.error, "Get distance");
+    mm = r.value;
+    if (sensor >= 0 && static_cast<size_t>(sensor) < tm_.distances.size())
+        tm_.distances[static_cast<size_t>(sensor)] = mm;
+    return {};
+}
+
+Result TeensyPort::turn(double radians, bool absolute, std::function<void(const Result&)> done) {
+    if (Result r = gate_.state_error(); !r.ok())
+        return r;
+    if (turn_done_)
+        return {Status::Busy, "a turn is already running"};
+    if (!std::isfinite(radians))
+        return {Status::InvalidValue, "the angle must be a finite number of radians"};
+    auto e = absolute ? link_.turn_to(radians) : link_.turn(radians);
+    if (Result r = teensy_result(e, absolute ? "Turn to" : "Turn"); !r.ok())
+        return r;
+    turn_done_ = std::move(done);
+    tm_.turning = true;
+    handshake_ = teensy::ConfirmHandshake();
+    handshake_.start(monotonic_ns());
+    sd_event_source* s = nullptr;
+    uint64_t now_us = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
+    if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us, 1, on_turn_step, this) < 0) {
+        finish_turn({Status::Hardware, "cannot schedule the confirmation handshake"});
+        return {};
+    }
+    turn_source_.reset(s);
+    return {};
+}
+
+int TeensyPort::on_turn_step(sd_event_source*, uint64_t, void* userdata) {
+    static_cast<TeensyPort*>(userdata)->turn_step();
+    return 0;
+}
+
+void TeensyPort::turn_step() {
+    // Drive the handshake without blocking: send what it asks for, then sleep until it
+    // wants the next poll.
+    for (;;) {
+        auto step = handshake_.next(monotonic_ns());
+        switch (step.action) {
+        case teensy::ConfirmHandshake::Action::Send: {
+            auto reply = link_.execute(step.frame);
+            teensy::TeensyResult<uint8_t> res;
+            if (!reply.ok())
+                res.error = reply.error;
+            else
+                res = teensy::decode_confirm(reply.value);
+            handshake_.on_result(res, monotonic_ns());
+            continue;
+        }
+        case teensy::ConfirmHandshake::Action::Wait:
+            sd_event_source_set_time(turn_source_.get(), step.at_ns / 1000);
+            sd_event_source_set_enabled(turn_source_.get(), SD_EVENT_ONESHOT);
+            return;
+        case teensy::ConfirmHandshake::Action::Done:
+            finish_turn({});
+            return;
+        case teensy::ConfirmHandshake::Action::Failed:
+        case teensy::ConfirmHandshake::Action::Idle:
+            finish_turn(teensy_result(step.error == teensy::TeensyError::None ? teensy::TeensyError::LinkError : step.error,
+                                      "turn confirmation"));
+            return;
+        }
+    }
+}
+
+void TeensyPort::finish_turn(const Result& r) {
+    tm_.turning = false;
+    auto done = std::move(turn_done_);
+    turn_done_ = nullptr;
+    turn_source_.reset();
+    if (done)
+        done(r);
+}
+
+} // namespace caracara

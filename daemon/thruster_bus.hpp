@@ -1,0 +1,89 @@
+// The I2C bus to the thrusters: the adapter, the PCA9544A state, one driver per thruster,
+// the schedule of what goes on the wire next, lockup detection and the bus's telemetry.
+// Every transfer's outcome passes through note(), which spots a locked bus and tells the
+// listener (BusRecovery).
+#pragma once
+
+#include "core/config.hpp"
+#include "core/lockup_detector.hpp"
+#include "core/order_schedule.hpp"
+#include "daemon/vehicle_events.hpp"
+#include "devices/mux_tracker.hpp"
+#include "devices/thruster_driver.hpp"
+#include "platform/device_io.hpp"
+#include "platform/i2c_dev.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace caracara {
+
+enum class BusState { Ok, Recovering, Lost };
+std::string_view bus_state_name(BusState s); // "ok", "recovering", "lost"
+
+struct BusTelemetry {
+    BusState state = BusState::Ok;
+    uint64_t transactions = 0;
+    uint64_t errors = 0;
+    std::string last_error;
+    uint64_t recoveries = 0;       // completed bus recoveries
+    uint64_t recovery_failures = 0;
+    uint32_t last_pulses = 0;      // SCL pulses the last bus clear needed
+    double last_recovery_ms = 0;   // time from detection to orders re-sent
+    std::string last_recovery_error;
+};
+
+class ThrusterBus {
+public:
+    class Listener {
+    public:
+        virtual ~Listener() = default;
+        virtual void bus_locked_up(const std::string& reason) = 0;
+    };
+
+    ThrusterBus(DeviceIo& io, const DaemonConfig& config, VehicleEvents& events);
+
+    int open() { return i2c_.open(); } // 0 or -errno
+    void close() { i2c_.close(); }
+    void set_listener(Listener* l) { listener_ = l; }
+
+    void send_order(std::size_t i, int32_t value);
+    // Zero to every thruster, back to back: nothing may come between a kill and its zeros.
+    void zero_all();
+    void read_status(std::size_t i);
+
+    OrderSchedule& schedule() { return schedule_; }
+    // While recovering, the adapter is closed on purpose: no bus work, and failures say nothing.
+    bool recovering() const { return recovering_; }
+    void set_recovering(bool r);
+    MuxTracker& mux() { return mux_; }
+    bool any_online() const;
+
+    std::size_t size() const { return thrusters_.size(); }
+    const ThrusterDriver& thruster(std::size_t i) const { return *thrusters_[i]; }
+    int32_t ordered_value(std::size_t i) const { return ordered_[i]; }
+    BusTelemetry& telemetry() { return tm_; }
+    const BusTelemetry& telemetry() const { return tm_; }
+    const std::string& device() const { return device_; }
+
+private:
+    void note(IoError e);
+
+    VehicleEvents& events_;
+    std::string device_;
+    I2cDev i2c_;
+    MuxTracker mux_;
+    std::vector<std::unique_ptr<ThrusterDriver>> thrusters_;
+    std::vector<int32_t> ordered_;
+    OrderSchedule schedule_;
+    LockupDetector lockup_;
+    BusTelemetry tm_;
+    bool recovering_ = false;
+    Listener* listener_ = nullptr;
+};
+
+} // namespace caracara

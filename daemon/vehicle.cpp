@@ -1,0 +1,245 @@
+#include "daemon/vehicle.hpp"
+
+#include "core/clock.hpp"
+#include "core/packet.hpp"
+#include "daemon/control_loop.hpp"
+#include "daemon/log.hpp"
+
+namespace caracara {
+
+namespace {
+constexpr const char* kPowerOffConfirmation = "power-off";
+} // namespace
+
+Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
+                 VehicleEvents& events)
+    : config_(config),
+      bus_(bus),
+      lines_(lines),
+      teensy_(teensy),
+      events_(events),
+      safety_(safety_config(config), false, monotonic_ns()) {}
+
+Result Vehicle::state_error() const {
+    switch (safety_.state()) {
+    case SafetyState::Ready: return {};
+    case SafetyState::Arming: return {Status::Arming, "the vehicle is arming; commands are accepted when it is ready"};
+    case SafetyState::Killed:
+        return {Status::Killed, "the vehicle is killed (" + std::string(kill_source_name()) + "); call ClearKill first"};
+    case SafetyState::PoweredOff: return {Status::PoweredOff, "the vehicle is powered off"};
+    }
+    return {Status::Hardware, "unknown state"};
+}
+
+void Vehicle::handle(const SafetyAction& a) {
+    uint32_t changes = 0;
+    if (a.clear_commands) {
+        requested_.fill(0);
+        applied_.fill(0);
+        limit_ = 0;
+        saturated_ = false;
+        changes |= kChangeMotors | kChangeController;
+    }
+    if (a.zero_outputs)
+        bus_.zero_all();
+    if (a.state_changed) {
+        changes |= kChangeState;
+        lines_.set_kill_output(safety_.kill_output_asserted()); // after the zero orders
+    }
+    if (a.command_stale)
+        log_info("command stream silent for %llu ms: thrusters to zero",
+                 static_cast<unsigned long long>(config_.control.command_timeout_ms));
+    events_.changed(changes);
+}
+
+Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
+    BudgetResult b = apply_budget(wanted, config_.control.budget_policy);
+    if (b.error == BudgetError::OutOfRange)
+        return {Status::OutOfRange, b.message};
+    if (b.error == BudgetError::OverBudget)
+        return {Status::OverBudget, b.message};
+    if (Result r = state_error(); !r.ok())
+        return r;
+    const std::string previous = safety_.commanding_client();
+    SafetyAction a = safety_.accept_command(monotonic_ns(), client);
+    if (!a.ok())
+        return state_error();
+    const int32_t limit = b.running ? b.limit : 0;
+    const bool saturated = b.saturated || mix_saturated;
+    // A stream re-sending the same command changes nothing worth announcing.
+    const bool changed = requested_ != wanted || applied_ != b.motors || limit_ != limit || saturated_ != saturated;
+    // The changed orders go out now, one transaction per loop iteration, not at the next tick;
+    // an unchanged one is already on the wire and refreshed by the tick.
+    bool any_due = false;
+    for (size_t i = 0; i < kMotorCount; ++i)
+        if (applied_[i] != b.motors[i] || bus_.ordered_value(i) != b.motors[i]) {
+            bus_.schedule().mark_order(i);
+            any_due = true;
+        }
+    requested_ = wanted;
+    applied_ = b.motors;
+    limit_ = limit;
+    saturated_ = saturated;
+    if (any_due && loop_)
+        loop_->schedule_work();
+    events_.changed((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
+    return {};
+}
+
+Result Vehicle::set_thrust(std::span<const int32_t> values, std::string_view client) {
+    if (values.size() != kMotorCount)
+        return {Status::InvalidLength, "SetThrust needs exactly 8 motor values, got " + std::to_string(values.size())};
+    MotorValues m{};
+    for (size_t i = 0; i < kMotorCount; ++i) {
+        if (values[i] < -kMotorMax || values[i] > kMotorMax)
+            return {Status::OutOfRange, "motor " + std::to_string(i) + ": " + std::to_string(values[i]) +
+                                            " is outside -8850..8850"};
+        m[i] = values[i];
+    }
+    return accept_motors(m, false, client);
+}
+
+Result Vehicle::set_motion(const AxisDemand& demand, std::string_view client) {
+    MixResult mr = mix(demand, config_.mixing);
+    if (mr.error == MixError::NotFinite)
+        return {Status::InvalidValue, mr.message};
+    if (mr.error != MixError::None)
+        return {Status::OutOfRange, mr.message};
+    return accept_motors(mr.motors, mr.saturated, client);
+}
+
+Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client) {
+    PacketResult pr = decode_packet(words);
+    switch (pr.error) {
+    case PacketError::None: break;
+    case PacketError::WrongLength: return {Status::InvalidLength, pr.message};
+    case PacketError::MotorOutOfRange:
+    case PacketError::ColorOutOfRange: return {Status::OutOfRange, pr.message};
+    case PacketError::BadPowerOffState: return {Status::InvalidValue, pr.message};
+    }
+    const Packet& p = pr.packet;
+    if (safety_.state() == SafetyState::PoweredOff)
+        return state_error();
+    if (p.kill) {
+        // The seed: a non-zero killState stops the motors until a zero is sent.
+        kill(KillSource::Packet, "packet killState=" + std::to_string(p.kill_state));
+        set_leds(p.red, p.green, p.blue);
+        return {};
+    }
+    if (p.power_off)
+        return power_off(kPowerOffConfirmation);
+    if (safety_.state() == SafetyState::Killed) {
+        if (safety_.kill_source() != KillSource::Packet)
+            return state_error();
+        // killState 0 is the packet's "all clear": it clears a packet kill (arming follows).
+        SafetyAction a = safety_.clear_kill(monotonic_ns());
+        if (!a.ok())
+            return {a.error == SafetyError::KillSwitchSet ? Status::KillSwitchSet : Status::Killed, a.message};
+        handle(a);
+        set_leds(p.red, p.green, p.blue);
+        return {};
+    }
+    Result r = accept_motors(p.motors, false, client);
+    if (!r.ok())
+        return r;
+    if (teensy_.leds() != std::array<uint8_t, 3>{p.red, p.green, p.blue})
+        set_leds(p.red, p.green, p.blue);
+    return {};
+}
+
+Result Vehicle::kill(KillSource source, std::string_view reason) {
+    const bool was_killed = safety_.state() == SafetyState::Killed;
+    handle(safety_.kill(source, monotonic_ns(), reason));
+    if (!was_killed && safety_.state() == SafetyState::Killed)
+        log_warning("KILLED by %s%s%s", std::string(kill_source_name()).c_str(), reason.empty() ? "" : ": ",
+                    std::string(reason).c_str());
+    teensy_.stop_motion();
+    teensy_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
+    return {};
+}
+
+Result Vehicle::clear_kill() {
+    SafetyAction a = safety_.clear_kill(monotonic_ns());
+    switch (a.error) {
+    case SafetyError::None: break;
+    case SafetyError::NotKilled: return {Status::NotKilled, a.message};
+    case SafetyError::KillSwitchSet: return {Status::KillSwitchSet, a.message};
+    case SafetyError::PoweredOff: return {Status::PoweredOff, a.message};
+    case SafetyError::NotReady: return {Status::Arming, a.message};
+    }
+    handle(a);
+    log_notice("kill cleared; arming for %u ms", config_.control.arming_delay_ms);
+    return {};
+}
+
+Result Vehicle::power_off(std::string_view confirmation) {
+    if (confirmation != kPowerOffConfirmation)
+        return {Status::ConfirmationRequired,
+                std::string("power-off is irreversible: pass the confirmation string \"") + kPowerOffConfirmation + "\""};
+    SafetyAction a = safety_.power_off(monotonic_ns());
+    if (a.error == SafetyError::PoweredOff)
+        return {Status::PoweredOff, a.message};
+    handle(a);
+    bus_.zero_all(); // thrusters first, whatever handle() decided
+    lines_.assert_power_off();
+    log_warning("POWER-OFF confirmed: thrusters zeroed%s", lines_.has_power_off() ? ", power-off line asserted" : "");
+    teensy_.stop_motion();
+    teensy_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
+    return {};
+}
+
+Result Vehicle::set_leds(int red, int green, int blue) {
+    if (powered_off())
+        return state_error();
+    return teensy_.set_leds(red, green, blue);
+}
+
+void Vehicle::client_left(std::string_view unique_name) {
+    if (unique_name.empty() || unique_name != safety_.commanding_client())
+        return;
+    log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
+    // A command it had accepted reaches the wire before the zero: a one-shot `busctl call`
+    // moves the thrusters for a moment, the same whether or not its disconnect happens to
+    // arrive before the loop sent the orders.
+    for (size_t i = 0; !bus_.recovering() && bus_.schedule().pop_order(i);)
+        bus_.send_order(i, order_value(i));
+    handle(safety_.client_left(unique_name, monotonic_ns())); // announces Controller with the motors
+}
+
+void Vehicle::kill_switch_read(bool set) {
+    if (set == safety_.kill_switch_set())
+        return;
+    const bool was_killed = safety_.state() == SafetyState::Killed;
+    handle(safety_.switch_changed(set, monotonic_ns()));
+    if (set && !was_killed)
+        log_warning("KILLED by the kill switch");
+    else if (!set)
+        log_notice("kill switch released; ClearKill re-arms the vehicle");
+    if (set && !was_killed)
+        teensy_.stop_motion();
+    if (set)
+        teensy_.cancel_turn({Status::Killed, "the kill switch was set during the turn"});
+}
+
+std::string_view Vehicle::state_name() const {
+    // A vehicle that could run but reaches none of its thrusters is in fault, whatever it was asked.
+    const SafetyState s = safety_.state();
+    if ((s == SafetyState::Ready || s == SafetyState::Arming) && bus_.telemetry().state == BusState::Lost)
+        return "fault";
+    return caracara::state_name(s);
+}
+
+std::string_view Vehicle::kill_source_name() const {
+    if (safety_.state() != SafetyState::Killed)
+        return "";
+    return caracara::kill_source_name(safety_.kill_source());
+}
+
+int64_t Vehicle::command_age_ms() const {
+    const uint64_t last = safety_.last_command_at();
+    if (last == 0)
+        return -1;
+    return static_cast<int64_t>((monotonic_ns() - last) / 1'000'000ull);
+}
+
+} // namespace caracara

@@ -1,0 +1,82 @@
+// The vehicle as callers see it: the safety state machine, the commands (thrust, motion,
+// packet, kill, clear, power-off, LEDs), requested/applied values with the budget, and who
+// is commanding. Every safety action is carried out here, on the bus, the safety lines and
+// the Teensy, in the order DESIGN.md's safety semantics give.
+#pragma once
+
+#include "core/budget.hpp"
+#include "core/config.hpp"
+#include "core/mixing.hpp"
+#include "core/safety.hpp"
+#include "core/status.hpp"
+#include "daemon/command_gate.hpp"
+#include "daemon/safety_lines.hpp"
+#include "daemon/teensy_port.hpp"
+#include "daemon/thruster_bus.hpp"
+#include "daemon/vehicle_events.hpp"
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace caracara {
+
+class ControlLoop;
+
+class Vehicle final : public CommandGate, public SafetyLines::Listener {
+public:
+    Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
+            VehicleEvents& events);
+    void set_loop(ControlLoop* loop) { loop_ = loop; }
+
+    Result set_thrust(std::span<const int32_t> values, std::string_view client);
+    Result set_motion(const AxisDemand& demand, std::string_view client);
+    Result apply_packet(std::span<const int32_t> words, std::string_view client);
+    Result kill(KillSource source, std::string_view reason = {});
+    Result clear_kill();
+    Result power_off(std::string_view confirmation);
+    Result set_leds(int red, int green, int blue);
+    void client_left(std::string_view unique_name);
+    // Once per cycle: arming and the command timeout.
+    void tick(uint64_t now_ns) { handle(safety_.tick(now_ns)); }
+
+    void kill_switch_read(bool set) override;
+    Result state_error() const override;
+    bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
+
+    // What thruster i is to be ordered now: its applied value while the vehicle may drive.
+    int32_t order_value(size_t i) const { return safety_.may_drive() ? applied_[i] : 0; }
+    bool may_drive() const { return safety_.may_drive(); }
+    bool kill_output_asserted() const { return safety_.kill_output_asserted(); }
+
+    const SafetyMachine& safety() const { return safety_; }
+    std::string_view state_name() const;
+    std::string_view kill_source_name() const;
+    const MotorValues& motor_values() const { return applied_; }
+    const MotorValues& requested_values() const { return requested_; }
+    int32_t budget_limit() const { return limit_; }
+    bool saturated() const { return saturated_; }
+    int64_t command_age_ms() const;
+    const std::string& controller_client() const { return safety_.commanding_client(); }
+
+private:
+    void handle(const SafetyAction& a);
+    Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);
+
+    const DaemonConfig& config_;
+    ThrusterBus& bus_;
+    SafetyLines& lines_;
+    TeensyPort& teensy_;
+    VehicleEvents& events_;
+    ControlLoop* loop_ = nullptr;
+    SafetyMachine safety_;
+
+    MotorValues requested_{};
+    MotorValues applied_{};
+    int32_t limit_ = 0;
+    bool saturated_ = false;
+};
+
+} // namespace caracara

@@ -1,0 +1,50 @@
+#include "daemon/vehicle_daemon.hpp"
+
+#include "daemon/log.hpp"
+#include "platform/io_error.hpp"
+
+namespace caracara {
+
+VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config)
+    : config_(std::move(config)),
+      bus_(io, config_, events_),
+      lines_(event, gpio, config_.gpio),
+      teensy_(event, io, config_.spi, vehicle_, events_),
+      vehicle_(config_, bus_, lines_, teensy_, events_),
+      loop_(event, config_.control, vehicle_, bus_, teensy_, lines_, events_),
+      recovery_(event, config_, io, gpio, bus_, vehicle_, events_),
+      status_(event, vehicle_, bus_, loop_) {
+    vehicle_.set_loop(&loop_);
+    bus_.set_listener(&recovery_);
+    events_.attach(&status_);
+}
+
+std::string VehicleDaemon::start() {
+    if (int r = bus_.open(); r < 0)
+        return "cannot open I2C bus " + config_.i2c.device + ": " + errno_name(-r);
+    // Zero before anything else: a previous instance may have died with orders standing.
+    bus_.zero_all();
+    if (std::string e = lines_.open(vehicle_.kill_output_asserted(), &vehicle_); !e.empty())
+        return e;
+    if (int r = teensy_.open(); r < 0)
+        log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
+                    errno_name(-r).c_str());
+    if (std::string e = loop_.start(); !e.empty())
+        return e;
+    started_ = true;
+    return {};
+}
+
+void VehicleDaemon::shutdown() {
+    if (!started_)
+        return;
+    started_ = false;
+    loop_.stop();
+    recovery_.stop();
+    lines_.close();
+    bus_.zero_all();
+    teensy_.close();
+    bus_.close();
+}
+
+} // namespace caracara

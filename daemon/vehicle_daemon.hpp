@@ -1,0 +1,56 @@
+// Owns the daemon's objects and brings them up and down in the order safety needs: the I2C
+// bus opened and every thruster zeroed before anything else, then the safety lines, the
+// Teensy, the loop; on the way out the loop stopped and every thruster zeroed again.
+#pragma once
+
+#include "core/config.hpp"
+#include "daemon/bus_recovery.hpp"
+#include "daemon/control_loop.hpp"
+#include "daemon/safety_lines.hpp"
+#include "daemon/service_status.hpp"
+#include "daemon/teensy_port.hpp"
+#include "daemon/thruster_bus.hpp"
+#include "daemon/vehicle.hpp"
+#include "daemon/vehicle_events.hpp"
+#include "platform/device_io.hpp"
+#include "platform/gpio_backend.hpp"
+
+#include <string>
+
+namespace caracara {
+
+class VehicleDaemon {
+public:
+    VehicleDaemon(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config);
+    ~VehicleDaemon() { shutdown(); }
+    VehicleDaemon(const VehicleDaemon&) = delete;
+    VehicleDaemon& operator=(const VehicleDaemon&) = delete;
+
+    // "" or the reason the daemon cannot run (the I2C bus or a configured GPIO line cannot be
+    // had). A missing Teensy is not fatal.
+    std::string start();
+    // Orders zero to every thruster (SIGTERM, fatal errors). Safe to call more than once.
+    void shutdown();
+
+    const DaemonConfig& config() const { return config_; }
+    VehicleEvents& events() { return events_; }
+    Vehicle& vehicle() { return vehicle_; }
+    ThrusterBus& bus() { return bus_; }
+    TeensyPort& teensy() { return teensy_; }
+    ControlLoop& loop() { return loop_; }
+    ServiceStatus& status() { return status_; }
+
+private:
+    DaemonConfig config_;
+    VehicleEvents events_;
+    ThrusterBus bus_;
+    SafetyLines lines_;
+    TeensyPort teensy_;
+    Vehicle vehicle_;
+    ControlLoop loop_;
+    BusRecovery recovery_;
+    ServiceStatus status_;
+    bool started_ = false;
+};
+
+} // namespace caracara

@@ -1,0 +1,14 @@
+#include "daemon/vehicle_events.hpp"
+
+#include "daemon/service_status.hpp"
+
+namespace caracara {
+
+void VehicleEvents::changed(uint32_t changes) {
+    if ((changes & (kChangeState | kChangeBus)) && status_)
+        status_->publish();
+    if (changes && observer_)
+        observer_->vehicle_changed(changes);
+}
+
+} // namespace caracara

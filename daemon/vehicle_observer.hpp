@@ -1,0 +1,30 @@
+// What the daemon's objects tell the presentation layer (dbus/ implements it): which vehicle
+// properties changed, periodic telemetry, and the I2C bus going and coming back.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace caracara {
+
+// Which vehicle properties changed, for PropertiesChanged.
+enum VehicleChange : uint32_t {
+    kChangeState = 1u << 0,      // State, KillSource
+    kChangeMotors = 1u << 1,     // MotorValues, RequestedValues, BudgetLimit, Saturated
+    kChangeLeds = 1u << 2,
+    kChangeController = 1u << 3, // Controller
+    kChangeBus = 1u << 4,        // the Bus object's State and recovery figures
+};
+
+class VehicleObserver {
+public:
+    virtual ~VehicleObserver() = default;
+    virtual void vehicle_changed(uint32_t changes) = 0;
+    // Periodic: thruster, Teensy and bus telemetry, command age, cycles.
+    virtual void telemetry() = 0;
+    // The I2C bus was found locked up / came back after a recovery.
+    virtual void bus_lost(const std::string& reason) = 0;
+    virtual void bus_restored(uint32_t pulses, double milliseconds) = 0;
+};
+
+} // namespace caracara
