@@ -8,7 +8,7 @@
 //   caracara-bench kill2wire  --bus ADDR [--samples N] [--source dbus|switch] [--phase-ms MS]
 //   caracara-bench cycles     --bus ADDR --seconds S
 //   caracara-bench stream     --bus ADDR --hz H --seconds S
-//   caracara-bench wait-ready --bus ADDR [--timeout-ms MS]
+//   caracara-bench wait-ready --bus ADDR [--timeout-ms MS]   (arms a daemon that started killed)
 //
 // Every measuring command prints one JSON object on stdout.
 #include "bench/bench_common.hpp"
@@ -723,6 +723,9 @@ int cmd_stream(const Args& a) {
 
 int cmd_wait_ready(const Args& a) {
     Client c(a.bus);
+    // A fresh daemon comes up killed (source "start"): arm it as a pilot would.
+    if (c.state() == "killed" && c.get_string(kVehicle, kVehiclePath, kVehicle, "KillSource") == "start")
+        c.vehicle_call("ClearKill");
     if (!c.wait_ready(static_cast<uint64_t>(a.timeout_ms * 1e6))) {
         std::fprintf(stderr, "caracara-bench: not ready after %.0f ms (state '%s')\n", a.timeout_ms, c.state().c_str());
         return 1;

@@ -38,6 +38,7 @@ SafetyConfig safety_config(const DaemonConfig& config) {
     SafetyConfig s;
     s.arming_delay_ns = ms_to_ns(config.control.arming_delay_ms);
     s.command_timeout_ns = ms_to_ns(config.control.command_timeout_ms);
+    s.start_killed = !config.control.arm_at_start;
     return s;
 }
 
@@ -436,12 +437,14 @@ void parse_mixing(Checker& c, const toml::table& t, MixMatrix& out) {
 void parse_control(Checker& c, const toml::table& t, ControlSettings& out) {
     const std::string p = "control.";
     c.only_keys(t, p,
-                {"loop_rate_hz", "status_reads_per_tick", "command_timeout_ms", "arming_delay_ms", "budget_policy"});
+                {"loop_rate_hz", "status_reads_per_tick", "command_timeout_ms", "arming_delay_ms", "budget_policy",
+                 "arm_at_start"});
     c.integer(t, p, "loop_rate_hz", 0, 1000, out.loop_rate_hz,
               "between 0 and 1000 (0 = as fast as the bus allows)");
     c.integer(t, p, "status_reads_per_tick", 1, static_cast<int64_t>(kMotorCount), out.status_reads_per_tick);
     c.integer(t, p, "command_timeout_ms", 10, 60000, out.command_timeout_ms);
     c.integer(t, p, "arming_delay_ms", 0, 60000, out.arming_delay_ms);
+    c.boolean(t, p, "arm_at_start", out.arm_at_start);
     std::string policy;
     if (c.string(t, p, "budget_policy", policy)) {
         if (policy == "scale")

@@ -59,6 +59,7 @@ struct ControlSettings {
     uint32_t command_timeout_ms = 500;    // silent command stream -> zero output (not a kill)
     uint32_t arming_delay_ms = 3000;      // zero output after a kill is cleared
     BudgetPolicy budget_policy = BudgetPolicy::Scale;
+    bool arm_at_start = false;            // false: every start comes up killed (source "start")
 };
 
 struct RecoverySettings {

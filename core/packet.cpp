@@ -29,9 +29,7 @@ PacketResult field_error(PacketError e, std::size_t index, int32_t value, std::s
                 "): " + std::string(problem) + ", got " + std::to_string(value);
     return r;
 }
-} // namespace
-
-PacketResult decode_packet(std::span<const int32_t> words) {
+PacketResult decode_fields(std::span<const int32_t> words) {
     if (words.size() != kPacketWords) {
         PacketResult r;
         r.error = PacketError::WrongLength;
@@ -60,6 +58,15 @@ PacketResult decode_packet(std::span<const int32_t> words) {
     }
     PacketResult r;
     r.packet = p;
+    return r;
+}
+
+} // namespace
+
+
+PacketResult decode_packet(std::span<const int32_t> words) {
+    PacketResult r = decode_fields(words);
+    r.kill_requested = words.size() > kPacketKill && words[kPacketKill] != 0;
     return r;
 }
 

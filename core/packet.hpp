@@ -4,7 +4,7 @@
 //   [9]     powerOffState     0 = not powered off, 1 = initiate power off (irreversible)
 //   [10-12] red, green, blue  0..255 each
 // Decoding validates every field; the first bad field is reported by index and name and
-// the decoded packet is left empty, so a bad packet can change nothing.
+// the decoded packet is left empty, so a bad packet can change nothing but a kill it asks for.
 #pragma once
 
 #include "core/mixing.hpp"
@@ -53,6 +53,9 @@ struct PacketResult {
     PacketError error = PacketError::None;
     int field = -1;         // index of the offending word (-1 for WrongLength)
     Packet packet;          // default (all zero) on error
+    // killState != 0 in a packet long enough to carry it, whatever else is wrong with it:
+    // a kill is never lost to a bad field.
+    bool kill_requested = false;
     std::string message;    // names the field index and name and the value
     bool ok() const { return error == PacketError::None; }
 };

@@ -19,6 +19,7 @@ std::string_view kill_source_name(KillSource s) {
     case KillSource::Switch: return "switch";
     case KillSource::Packet: return "packet";
     case KillSource::Fault: return "bus"; // the escalated fault is the I2C bus that could not be recovered
+    case KillSource::Start: return "start";
     }
     return "?";
 }
@@ -60,6 +61,8 @@ SafetyMachine::SafetyMachine(SafetyConfig config, bool kill_switch_set, uint64_t
     : config_(config), switch_set_(kill_switch_set), arming_started_(now) {
     if (kill_switch_set)
         enter_killed(KillSource::Switch, now, "kill switch set at start");
+    else if (config_.start_killed)
+        enter_killed(KillSource::Start, now, "started killed; ClearKill arms the vehicle");
 }
 
 void SafetyMachine::drop_commands() {
@@ -80,8 +83,10 @@ SafetyAction SafetyMachine::kill(KillSource source, uint64_t now, std::string_vi
         source = KillSource::Fault;  // a kill without a named source is still a kill
     if (state_ == SafetyState::PoweredOff)
         return zeroing("powered off", false);
-    if (state_ == SafetyState::Killed)
+    if (state_ == SafetyState::Killed && kill_source_ != KillSource::Start)
         return zeroing("already killed (" + std::string(kill_source_name(kill_source_)) + ")", false);
+    // A start kill is the weakest source: any real kill names itself in its place (a switch
+    // set at start reads "switch", and ClearKill then asks for it to be released).
     enter_killed(source, now, reason);
     return zeroing("killed (" + std::string(kill_source_name(source)) + "): " + kill_reason_, true);
 }

@@ -4,7 +4,7 @@
 // touches hardware itself, so every rule here is unit-tested.
 //
 //   start ──> Arming ──(arming delay, zero output)──> Ready
-//   start with the kill switch set ──> Killed
+//   start with the kill switch set ──> Killed (switch); start_killed ──> Killed (start)
 //   Arming/Ready ──kill (dbus, switch, packet, fault)──> Killed   (latches)
 //   Killed ──clear_kill, switch released──> Arming
 //   any ──power_off──> PoweredOff   (irreversible)
@@ -32,8 +32,9 @@ enum class KillSource {
     Switch,  // the kill switch GPIO
     Packet,  // a legacy packet with killState != 0
     Fault,   // an escalated fault, e.g. the I2C bus could not be recovered
+    Start,   // every start of the daemon, until someone decides to arm it (ClearKill)
 };
-std::string_view kill_source_name(KillSource s);  // "none", "dbus", "switch", "packet", "fault"
+std::string_view kill_source_name(KillSource s);  // "none", "dbus", "switch", "packet", "bus", "start"
 
 enum class SafetyError {
     None,
@@ -47,6 +48,9 @@ std::string_view error_name(SafetyError e);  // "NotKilled", "KillSwitchSet", ..
 struct SafetyConfig {
     uint64_t arming_delay_ns = ms_to_ns(3000);     // as the board firmware did
     uint64_t command_timeout_ns = ms_to_ns(500);
+    // Come up killed (source Start): a restart after a crash, an upgrade or a reboot must not
+    // drive again by itself. The daemon sets it unless control.arm_at_start is true.
+    bool start_killed = false;
 };
 
 // What the owner must do after an event. The flags are idempotent: acting on them twice
@@ -65,11 +69,12 @@ class SafetyMachine {
 public:
     static constexpr uint64_t kNoDeadline = std::numeric_limits<uint64_t>::max();
 
-    // Starts in Arming, or Killed (source Switch) when the kill switch is already set.
+    // Starts in Arming; Killed (source Switch) when the kill switch is already set, else
+    // Killed (source Start) when config.start_killed.
     SafetyMachine(SafetyConfig config, bool kill_switch_set, uint64_t now);
 
     // Always accepted: from Arming/Ready it latches Killed with this source; when already
-    // killed the first source is kept; after power-off it only repeats the zeroing.
+    // killed the first source is kept, except Start, which any other source replaces; after power-off it only repeats the zeroing.
     // KillSource::None is recorded as Fault: a kill is never ignored for a missing source.
     SafetyAction kill(KillSource source, uint64_t now, std::string_view reason = {});
     // Killed -> Arming. Refused with NotKilled, KillSwitchSet or PoweredOff.

@@ -1,7 +1,7 @@
 #include "daemon/bus_recovery.hpp"
 
 #include "core/clock.hpp"
-#include "daemon/line_spec.hpp"
+#include "platform/line_spec.hpp"
 #include "daemon/log.hpp"
 #include "devices/i2c_bus_clear.hpp"
 #include "platform/io_error.hpp"

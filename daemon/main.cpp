@@ -3,6 +3,7 @@
 #include "daemon/vehicle_daemon.hpp"
 #include "platform/hardware.hpp"
 #include "devices/emergency_stop.hpp"
+#include "devices/final_stop.hpp"
 #include "platform/io_error.hpp"
 #include "daemon/log.hpp"
 #include "dbus/bus_input_probe.hpp"
@@ -34,8 +35,21 @@ void usage(FILE* f) {
                "  --user                 serve on the user bus\n"
                "  --bus-address ADDR     serve on the bus at ADDR\n"
                "  --check-config         validate the configuration and exit\n"
+               "  --zero-thrusters       assert the kill output, order zero to every thruster, stop\n"
+               "                         the Teensy's wheels, and exit (systemd's ExecStopPost=)\n"
                "  -h, --help             this text\n",
                f);
+}
+
+// After every end of the daemon (systemd's ExecStopPost=): whatever state the process left
+// the hardware in, the thrusters end at zero. Exit 0 when every thruster took its zero.
+int zero_thrusters(const DaemonConfig& config, Hardware& hw) {
+    const FinalStop::Report r = FinalStop(config, *hw.io, *hw.gpio).run();
+    for (const auto& p : r.problems)
+        log_error("zeroing: %s", p.c_str());
+    log_notice("zeroing after stop: %u of %zu thrusters zeroed%s", r.zeroed, config.thrusters.size(),
+               r.kill_output_asserted ? ", kill output asserted" : "");
+    return r.ok() ? 0 : 1;
 }
 
 int on_signal(sd_event_source* s, const signalfd_siginfo* si, void*) {
@@ -50,6 +64,7 @@ int main(int argc, char** argv) {
     std::string hardware = "linux";
     dbus::BusChoice bus_choice;
     bool check_only = false;
+    bool zero_only = false;
 
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
@@ -70,6 +85,7 @@ int main(int argc, char** argv) {
         else if (a == "--user") bus_choice = {dbus::BusChoice::Kind::User, {}};
         else if (is("--bus-address")) bus_choice = {dbus::BusChoice::Kind::Address, value("--bus-address")};
         else if (a == "--check-config") check_only = true;
+        else if (a == "--zero-thrusters") zero_only = true;
         else if (a == "-h" || a == "--help") { usage(stdout); return 0; }
         else {
             std::fprintf(stderr, "caracarad: unknown option '%s'\n", a.c_str());
@@ -104,6 +120,8 @@ int main(int argc, char** argv) {
         log_error("%s", err.c_str());
         return 1;
     }
+    if (zero_only)
+        return zero_thrusters(*cr.config, hw);
 
     sd_event* ev_raw = nullptr;
     if (int r = sd_event_default(&ev_raw); r < 0) {

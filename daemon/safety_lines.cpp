@@ -1,6 +1,6 @@
 #include "daemon/safety_lines.hpp"
 
-#include "daemon/line_spec.hpp"
+#include "platform/line_spec.hpp"
 #include "daemon/log.hpp"
 #include "platform/io_error.hpp"
 

@@ -4,23 +4,6 @@
 
 namespace caracara {
 
-namespace {
-LockupDetector::Transfer classify(IoError e) {
-    switch (e) {
-    case IoError::None: return LockupDetector::Transfer::Ok;
-    case IoError::BadReply: return LockupDetector::Transfer::BadReply;
-    case IoError::Timeout:
-    case IoError::ClockStretch:
-    case IoError::Arbitration:
-    case IoError::NoDevice: return LockupDetector::Transfer::BusError;
-    case IoError::Nack:
-    case IoError::Unsupported:
-    case IoError::Other: return LockupDetector::Transfer::DeviceError;
-    }
-    return LockupDetector::Transfer::DeviceError;
-}
-} // namespace
-
 std::string_view bus_state_name(BusState s) {
     switch (s) {
     case BusState::Ok: return "ok";
@@ -70,7 +53,7 @@ void ThrusterBus::note(IoError e) {
     ++tm_.transactions;
     if (recovering_)
         return; // the bus is closed on purpose; failures now say nothing new
-    const LockupDetector::Transfer t = classify(e);
+    const LockupDetector::Transfer t = lockup_transfer(e);
     if (t != LockupDetector::Transfer::Ok) {
         ++tm_.errors;
         tm_.last_error = std::string(io_error_name(e));

@@ -4,6 +4,7 @@
 #include "core/packet.hpp"
 #include "daemon/control_loop.hpp"
 #include "daemon/log.hpp"
+#include "platform/io_error.hpp"
 
 namespace caracara {
 
@@ -50,6 +51,36 @@ void Vehicle::handle(const SafetyAction& a) {
         log_info("command stream silent for %llu ms: thrusters to zero",
                  static_cast<unsigned long long>(config_.control.command_timeout_ms));
     events_.changed(changes);
+    arm_deadline();
+}
+
+void Vehicle::arm_deadline() {
+    // The end of arming and the command timeout land on their own timer, at the time the
+    // safety machine names, not at the next tick.
+    const uint64_t at = safety_.next_deadline();
+    if (!deadline_)
+        return;
+    if (at == SafetyMachine::kNoDeadline) {
+        sd_event_source_set_enabled(deadline_.get(), SD_EVENT_OFF);
+        return;
+    }
+    sd_event_source_set_time(deadline_.get(), at / 1000);
+    sd_event_source_set_enabled(deadline_.get(), SD_EVENT_ONESHOT);
+}
+
+std::string Vehicle::start(sd_event* event) {
+    sd_event_source* s = nullptr;
+    // Accuracy 1 us, like the loop's tick: the timeout is measured against its configured value.
+    if (int r = sd_event_add_time(event, &s, CLOCK_MONOTONIC, 0, 1, on_deadline, this); r < 0)
+        return "sd_event_add_time: " + errno_name(-r);
+    deadline_.reset(s);
+    arm_deadline();
+    return {};
+}
+
+int Vehicle::on_deadline(sd_event_source*, uint64_t, void* userdata) {
+    static_cast<Vehicle*>(userdata)->tick(monotonic_ns());
+    return 0;
 }
 
 Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
@@ -64,6 +95,7 @@ Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std
     SafetyAction a = safety_.accept_command(monotonic_ns(), client);
     if (!a.ok())
         return state_error();
+    arm_deadline();
     const int32_t limit = b.running ? b.limit : 0;
     const bool saturated = b.saturated || mix_saturated;
     // A stream re-sending the same command changes nothing worth announcing.
@@ -110,6 +142,10 @@ Result Vehicle::set_motion(const AxisDemand& demand, std::string_view client) {
 
 Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client) {
     PacketResult pr = decode_packet(words);
+    // The packet's author asked for a kill: it happens even when another field is refused,
+    // and the call still returns that field's error with nothing else changed.
+    if (pr.kill_requested && !powered_off())
+        kill(KillSource::Packet, "packet killState=" + std::to_string(words[kPacketKill]));
     switch (pr.error) {
     case PacketError::None: break;
     case PacketError::WrongLength: return {Status::InvalidLength, pr.message};
@@ -117,12 +153,14 @@ Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view cl
     case PacketError::ColorOutOfRange: return {Status::OutOfRange, pr.message};
     case PacketError::BadPowerOffState: return {Status::InvalidValue, pr.message};
     }
-    const Packet& p = pr.packet;
-    if (safety_.state() == SafetyState::PoweredOff)
+    if (powered_off())
         return state_error();
+    const Packet& p = pr.packet;
     if (p.kill) {
-        // The seed: a non-zero killState stops the motors until a zero is sent.
-        kill(KillSource::Packet, "packet killState=" + std::to_string(p.kill_state));
+        // The seed: a non-zero killState stops the motors until a zero is sent. Kill first,
+        // then a power-off the same packet asks for.
+        if (p.power_off)
+            return power_off(kPowerOffConfirmation);
         set_leds(p.red, p.green, p.blue);
         return {};
     }

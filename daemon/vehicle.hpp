@@ -14,6 +14,7 @@
 #include "daemon/teensy_port.hpp"
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle_events.hpp"
+#include "platform/event_loop.hpp"
 
 #include <array>
 #include <cstdint>
@@ -30,6 +31,9 @@ public:
     Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
             VehicleEvents& events);
     void set_loop(ControlLoop* loop) { loop_ = loop; }
+    // Makes the deadline timer (end of arming, command timeout). "" or why it could not.
+    std::string start(sd_event* event);
+    void stop() { deadline_.reset(); }
 
     Result set_thrust(std::span<const int32_t> values, std::string_view client);
     Result set_motion(const AxisDemand& demand, std::string_view client);
@@ -62,6 +66,8 @@ public:
     const std::string& controller_client() const { return safety_.commanding_client(); }
 
 private:
+    static int on_deadline(sd_event_source*, uint64_t usec, void* userdata);
+    void arm_deadline();
     void handle(const SafetyAction& a);
     Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);
 
@@ -72,6 +78,7 @@ private:
     VehicleEvents& events_;
     ControlLoop* loop_ = nullptr;
     SafetyMachine safety_;
+    SourcePtr deadline_;
 
     MotorValues requested_{};
     MotorValues applied_{};

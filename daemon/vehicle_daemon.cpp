@@ -6,7 +6,8 @@
 namespace caracara {
 
 VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config)
-    : config_(std::move(config)),
+    : event_(event),
+      config_(std::move(config)),
       bus_(io, config_, events_),
       lines_(event, gpio, config_.gpio),
       teensy_(event, io, config_.spi, vehicle_, events_),
@@ -29,6 +30,8 @@ std::string VehicleDaemon::start() {
     if (int r = teensy_.open(); r < 0)
         log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
                     errno_name(-r).c_str());
+    if (std::string e = vehicle_.start(event_); !e.empty())
+        return e;
     if (std::string e = loop_.start(); !e.empty())
         return e;
     started_ = true;
@@ -40,6 +43,7 @@ void VehicleDaemon::shutdown() {
         return;
     started_ = false;
     loop_.stop();
+    vehicle_.stop();
     recovery_.stop();
     lines_.close();
     bus_.zero_all();

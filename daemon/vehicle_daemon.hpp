@@ -41,6 +41,7 @@ public:
     ServiceStatus& status() { return status_; }
 
 private:
+    sd_event* event_;
     DaemonConfig config_;
     VehicleEvents events_;
     ThrusterBus bus_;

@@ -3,7 +3,8 @@
 
     mission_square.py [--system | --user | --bus-address ADDR] [--leg-seconds S] ...
 
-Waits until caracarad (org.caracara.Vehicle1) is ready, then four times: drive forward for
+Waits until caracarad (org.caracara.Vehicle1) is ready (every start of the daemon comes up
+killed, kill source "start": --arm clears that kill, and only that one), then four times: drive forward for
 --leg-seconds, and yaw 90 degrees clockwise by thrust while watching the Teensy's heading
 (Orientation). Commands are re-sent faster than the daemon's command timeout, which zeroes the
 thrusters when a command stream goes silent. At the end (or on any error, or Ctrl-C) the
@@ -15,7 +16,7 @@ reason is printed); 2 bad arguments; 3 the daemon is not there.
 Try it against the simulator:
     caracara-sim --socket /tmp/sim.sock --user &
     caracarad --hardware=sim:/tmp/sim.sock --user &
-    ./mission_square.py --user
+    ./mission_square.py --user --arm
 
 Needs python3-dbus (Debian: apt install python3-dbus).
 """
@@ -65,6 +66,12 @@ class Vehicle:
     def state(self):
         return str(self.prop("State"))
 
+    def kill_source(self):
+        return str(self.prop("KillSource"))
+
+    def clear_kill(self):
+        self.vehicle.ClearKill()
+
     def orientation(self):
         """(yaw, pitch, roll) in radians; yaw is clockwise from above."""
         o = self.teensy.Get(TEENSY_IFACE, "Orientation", dbus_interface=PROPS)
@@ -106,6 +113,11 @@ class Mission:
             if state == "ready":
                 self.log("vehicle ready")
                 return
+            if state == "killed" and self.args.arm and self.v.kill_source() == "start":
+                # Every daemon start comes up killed; --arm is the pilot's decision to arm it.
+                self.log("arming the vehicle (ClearKill; it started killed)")
+                self.v.clear_kill()
+                continue
             if state in ("killed", "powered-off", "fault"):
                 raise MissionError("the vehicle is %s; clear it before running a mission" % state)
             if state != shown:
@@ -197,6 +209,9 @@ def main():
     p.add_argument("--turn-degrees", type=float, default=90.0, help="turn per corner (default 90)")
     p.add_argument("--tolerance", type=float, default=0.08, help="heading tolerance in radians (default 0.08)")
     p.add_argument("--turn-timeout", type=float, default=30.0, help="seconds allowed per turn (default 30)")
+    p.add_argument("--arm", action="store_true",
+                   help="arm a vehicle that started killed (kill source \"start\") with ClearKill; "
+                        "any other kill is left for a person to clear")
     p.add_argument("--ready-timeout", type=float, default=30.0, help="seconds to wait for ready (default 30)")
     args = p.parse_args()
     if not (0 < args.speed <= 1 and 0 < args.yaw_demand <= 1 and args.leg_seconds >= 0):

@@ -45,4 +45,19 @@ std::string errno_name(int err) {
     return s;
 }
 
+LockupDetector::Transfer lockup_transfer(IoError e) {
+    switch (e) {
+    case IoError::None: return LockupDetector::Transfer::Ok;
+    case IoError::BadReply: return LockupDetector::Transfer::BadReply;
+    case IoError::Timeout:
+    case IoError::ClockStretch:
+    case IoError::Arbitration:
+    case IoError::NoDevice: return LockupDetector::Transfer::BusError;
+    case IoError::Nack:
+    case IoError::Unsupported:
+    case IoError::Other: return LockupDetector::Transfer::DeviceError;
+    }
+    return LockupDetector::Transfer::DeviceError;
+}
+
 } // namespace caracara

@@ -2,6 +2,8 @@
 // the way the Linux i2c/spi bus drivers report it (see DESIGN.md "Protocol facts").
 #pragma once
 
+#include "core/lockup_detector.hpp"
+
 #include <string>
 #include <string_view>
 
@@ -22,5 +24,8 @@ enum class IoError {
 IoError io_error_from_errno(int err);   // err is positive errno
 std::string_view io_error_name(IoError e);
 std::string errno_name(int err);       // "ETIMEDOUT (Connection timed out)"
+// What a transfer's outcome says about the wire, for lockup detection: timeouts, EIO, lost
+// arbitration and a vanished adapter are the bus's; a NACK is one device's.
+LockupDetector::Transfer lockup_transfer(IoError e);
 
 } // namespace caracara

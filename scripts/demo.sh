@@ -52,8 +52,10 @@ sim_speeds() {
 for _ in $(seq 200); do
   "$build/tools/caracaractl" --bus-address "$bus" status >/dev/null 2>&1 && break; sleep 0.05
 done
-echo; echo "== the daemon is up and arming (zero output for the arming delay)"
+echo; echo "== the daemon is up, killed: every start comes up killed (kill source \"start\")"
 ctl status
+echo; echo "== clear-kill arms it: zero output for the arming delay, then ready"
+ctl clear-kill
 for _ in $(seq 100); do
   busctl --address="$bus" get-property org.caracara.Vehicle1 /org/caracara/Vehicle1 org.caracara.Vehicle1 State | grep -q ready && break
   sleep 0.1

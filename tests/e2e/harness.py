@@ -6,7 +6,7 @@ nothing of what the daemon claims.
 
     rig = Rig(control={"arming_delay_ms": 300})
     rig.start()                      # dbus-daemon, caracara-sim, caracarad; waits for the name
-    rig.wait_state("ready")
+    rig.arm()                        # it starts killed (source "start"): ClearKill, wait for ready
     rig.thrust([1000, 0, 0, 0, 0, 0, 0, 0])
     poll(lambda: rig.sim_speeds()[0] == speed_byte(1000))
     rig.stop_checked()               # SIGTERM, wait, SIGKILL fallback, directory removed;
@@ -518,6 +518,13 @@ class Rig:
     def packet(self, words):
         return self.vcall("ApplyPacket", dbus.Array(words, signature="i"), signature="ai")
 
+    def arm(self, timeout=20.0):
+        """What a pilot does after a start: the daemon comes up killed (source "start");
+        ClearKill arms it, and it is ready after the arming delay."""
+        if self.state() == "killed" and self.vget("KillSource") == "start":
+            self.vcall("ClearKill")
+        self.wait_state("ready", timeout)
+
     def wait_state(self, state, timeout=20.0):
         return poll(lambda: self.state() == state, timeout, message="State never became %r" % state)
 
@@ -663,7 +670,7 @@ class VehicleTestCase(unittest.TestCase):
         cls.addClassCleanup(cls.rig.stop_checked)
         cls.rig.start()
         if cls.WAIT_READY:
-            cls.rig.wait_state("ready")
+            cls.rig.arm()
 
     def assertDBusError(self, expected, fn, *args, **kwargs):
         got = error_name(fn, *args, **kwargs)

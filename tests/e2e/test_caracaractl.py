@@ -214,7 +214,7 @@ class CaracaractlPowerOffTest(unittest.TestCase):
         rig = Rig(control={"arming_delay_ms": 300})
         self.addCleanup(rig.stop_checked)
         rig.start()
-        rig.wait_state("ready")
+        rig.arm()
         r = rig.ctl("power-off", "--yes-power-off")
         self.assertEqual(r.returncode, OK, r.stderr)
         self.assertEqual(rig.state(), "powered-off")
@@ -248,7 +248,7 @@ class CaracaractlUnavailableTest(unittest.TestCase):
         rig = Rig(control={"arming_delay_ms": 300})
         self.addCleanup(rig.stop_checked)
         rig.start()
-        rig.wait_state("ready")
+        rig.arm()
         proc = subprocess.Popen([binary("caracaractl"), "--bus-address", rig.address, "thrust", "800", "0", "0",
                                  "0", "0", "0", "0", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                 stdin=subprocess.DEVNULL, preexec_fn=harness._die_with_parent)

@@ -32,7 +32,7 @@ class MissionTest(unittest.TestCase):
         rig = self.start_rig(control={"arming_delay_ms": 1000})
         yaw0 = rig.sim_yaw()
         pos0 = rig.sim_teensy("Position")
-        proc = run_mission(rig, "--leg-seconds", 0.5, "--yaw-demand", 0.65, "--turn-timeout", 40)
+        proc = run_mission(rig, "--arm", "--leg-seconds", 0.5, "--yaw-demand", 0.65, "--turn-timeout", 40)
         turned = 0.0
         largest = 0.0
         last = yaw0
@@ -67,7 +67,7 @@ class MissionTest(unittest.TestCase):
 
     def test_refuses_a_killed_vehicle(self):
         rig = self.start_rig(control={"arming_delay_ms": 300})
-        rig.wait_state("ready")
+        rig.arm()
         rig.vcall("Kill")
         proc = run_mission(rig)
         out, err = proc.communicate(timeout=60)
@@ -78,7 +78,7 @@ class MissionTest(unittest.TestCase):
 
     def test_sigterm_stops_and_kills(self):
         rig = self.start_rig(control={"arming_delay_ms": 300})
-        rig.wait_state("ready")
+        rig.arm()
         proc = run_mission(rig, "--leg-seconds", 30)
         try:
             poll(lambda: any(s != ZERO for s in rig.sim_speeds()), 30, message="the mission never drove")

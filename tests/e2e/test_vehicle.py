@@ -909,10 +909,14 @@ class DefaultArmingTest(VehicleTestCase):
         self.assertEqual(rig.vget("CommandAgeMs"), -1)
         self.assertEqual(rig.vget("Controller"), "")
         self.assertEqual(rig.vget("ArmingDelayMs"), 3000)
-        # At start: arming, zero output, commands refused.
-        if rig.state() == "arming":
-            self.assertDBusError(ERR + "Arming", rig.thrust, [1000] + [0] * 7)
-            self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+        # At start: killed (source "start"), zero output, commands refused until ClearKill,
+        # then arming for the delay.
+        self.assertEqual(rig.state(), "killed")
+        self.assertEqual(rig.vget("KillSource"), "start")
+        self.assertDBusError(ERR + "Killed", rig.thrust, [1000] + [0] * 7)
+        self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+        rig.vcall("ClearKill")
+        self.assertDBusError(ERR + "Arming", rig.thrust, [1000] + [0] * 7)
         rig.wait_state("ready", 30)
         rig.vcall("Kill")
         rig.vcall("ClearKill")
@@ -936,7 +940,7 @@ class PowerOffTest(unittest.TestCase):
         self.rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
         self.addCleanup(self.rig.stop_checked)
         self.rig.start()
-        self.rig.wait_state("ready")
+        self.rig.arm()
         self.values = [1500, -1500, 0, 0, 3000, 0, 0, 0]
         self.rig.thrust(self.values)
         self.rig.wait_sim_speeds([speed_byte(v) for v in self.values])
@@ -1124,7 +1128,7 @@ class SigtermTest(unittest.TestCase):
         rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
         self.addCleanup(rig.stop_checked)
         rig.start()
-        rig.wait_state("ready")
+        rig.arm()
         values = [0, 3500, 0, 3500, 0, -3500, 0, -3500]
         rig.thrust(values)
         rig.wait_sim_speeds([speed_byte(v) for v in values])
@@ -1139,15 +1143,18 @@ class SigtermTest(unittest.TestCase):
         # The next daemon zeroes them before it takes its name.
         rig.start_daemon()
         self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS, "orders standing when the service appeared")
-        self.assertEqual(rig.state(), "arming")
-        rig.wait_state("ready")
+        # It comes up killed: nothing drives again until someone arms it.
+        self.assertEqual(rig.state(), "killed")
+        self.assertEqual(rig.vget("KillSource"), "start")
+        self.assertTrue(rig.sim_get("KillOutput"))
+        rig.arm()
         self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
 
     def test_sigterm_zeroes_and_exits_0(self):
         rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
         self.addCleanup(rig.stop_checked)
         rig.start()
-        rig.wait_state("ready")
+        rig.arm()
         values = [4000, -4000, 4000, -4000, 0, 0, 0, 0]
         rig.thrust(values)
         rig.wait_sim_speeds([speed_byte(v) for v in values])

@@ -26,7 +26,12 @@ DaemonFixture::DaemonFixture(SimFixture& sim, const std::string& config, bool wa
     });
     if (!up)
         throw std::runtime_error("caracarad did not come up; see " + sim.dir() + "/caracarad.log");
-    if (wait_ready && !wait_for([&] { return vehicle_string("State") == "ready"; }))
+    if (!wait_ready)
+        return;
+    // Every start comes up killed (source "start"); a pilot's ClearKill arms it.
+    if (vehicle_string("State") == "killed" && vehicle_string("KillSource") == "start")
+        call("ClearKill", "");
+    if (!wait_for([&] { return vehicle_string("State") == "ready"; }))
         throw std::runtime_error("caracarad did not become ready");
 }
 

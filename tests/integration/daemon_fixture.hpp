@@ -12,7 +12,8 @@ namespace caracara::test {
 class DaemonFixture {
 public:
     // Writes `config` (TOML) and starts caracarad on the simulator's bus, or on `bus_address`
-    // when given; waits until the name is owned and, if `wait_ready`, until State is "ready".
+    // when given; waits until the name is owned and, if `wait_ready`, arms it (ClearKill of the
+    // start kill) and waits until State is "ready".
     DaemonFixture(SimFixture& sim, const std::string& config, bool wait_ready = true,
                   const std::string& bus_address = {});
     ~DaemonFixture();

@@ -126,3 +126,23 @@ TEST_CASE("encode and decode round-trip") {
     CHECK(packet_field_name(8) == "killState");
     CHECK(packet_field_name(13) == "?");
 }
+
+TEST_CASE("a kill in a packet is seen even when another field is refused") {
+    std::array<int32_t, kPacketWords> w{};
+    w[kPacketKill] = 1;
+    w[0] = 9000; // out of range
+    PacketResult r = decode_packet(w);
+    CHECK(r.error == PacketError::MotorOutOfRange);
+    CHECK(r.kill_requested);
+    w[0] = 0;
+    w[kPacketRed] = 300;
+    CHECK(decode_packet(w).kill_requested);
+    w[kPacketRed] = 0;
+    w[kPacketPowerOff] = 2;
+    CHECK(decode_packet(w).kill_requested);
+    // A short packet that still carries killState.
+    CHECK(decode_packet(std::span<const int32_t>(w.data(), 9)).kill_requested);
+    CHECK_FALSE(decode_packet(std::span<const int32_t>(w.data(), 8)).kill_requested);
+    w[kPacketKill] = 0;
+    CHECK_FALSE(decode_packet(w).kill_requested);
+}

@@ -294,3 +294,45 @@ TEST_CASE("state names") {
     CHECK(state_name(SafetyState::Killed) == "killed");
     CHECK(state_name(SafetyState::PoweredOff) == "powered-off");
 }
+
+TEST_CASE("start killed: source start until ClearKill, and any real kill names itself instead") {
+    SafetyConfig cfg;
+    cfg.start_killed = true;
+    SafetyMachine s(cfg, false, kT0);
+    CHECK(s.state() == SafetyState::Killed);
+    CHECK(s.kill_source() == KillSource::Start);
+    CHECK(kill_source_name(s.kill_source()) == "start");
+    CHECK(s.kill_output_asserted());
+    CHECK_FALSE(s.may_drive());
+    CHECK(s.next_deadline() == SafetyMachine::kNoDeadline); // nothing ends a start kill by itself
+    CHECK(s.tick(kT0 + ms(60000)).state_changed == false);
+    CHECK(s.state() == SafetyState::Killed);
+    CHECK_FALSE(s.accept_command(kT0 + ms(1), "client").ok());
+
+    // The switch set at start: the kill is the switch's now, and ClearKill wants it released.
+    SafetyAction a = s.switch_changed(true, kT0 + ms(2));
+    CHECK(a.zero_outputs);
+    CHECK(s.kill_source() == KillSource::Switch);
+    CHECK(s.clear_kill(kT0 + ms(3)).error == SafetyError::KillSwitchSet);
+    s.switch_changed(false, kT0 + ms(4));
+    CHECK(s.clear_kill(kT0 + ms(5)).ok());
+    CHECK(s.state() == SafetyState::Arming);
+}
+
+TEST_CASE("start killed: ClearKill arms it; a second kill keeps its first real source") {
+    SafetyConfig cfg;
+    cfg.start_killed = true;
+    SafetyMachine s(cfg, false, kT0);
+    REQUIRE(s.clear_kill(kT0 + ms(10)).ok());
+    s.tick(kT0 + ms(10) + cfg.arming_delay_ns);
+    CHECK(s.state() == SafetyState::Ready);
+    s.kill(KillSource::DBus, kT0 + ms(4000));
+    s.kill(KillSource::Packet, kT0 + ms(4001));
+    CHECK(s.kill_source() == KillSource::DBus);
+}
+
+TEST_CASE("the default machine (arm at start) still starts arming") {
+    SafetyMachine s(SafetyConfig{}, false, kT0);
+    CHECK(s.state() == SafetyState::Arming);
+    CHECK(s.kill_source() == KillSource::None);
+}

@@ -1,4 +1,4 @@
-// A configured GPIO line as the GPIO backend asks for it.
+// A configured GPIO line (core/config) as the GPIO backend asks for it.
 #pragma once
 
 #include "core/config.hpp"
