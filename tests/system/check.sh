@@ -106,6 +106,43 @@ journal_grep() {
     }
     END { exit !found }'
 }
+# CLOCK_MONOTONIC now, in microseconds, as journald stamps a marker (the container has no
+# other way to read the clock the simulator's wire log uses; /proc/uptime is BOOTTIME).
+mono_us() {
+  local tag="caracara-mark-$$-$RANDOM" i v
+  echo "$tag" | systemd-cat -t caracara-mark
+  for i in $(seq 50); do
+    v=$(journalctl -t caracara-mark -o export --no-pager 2>/dev/null |
+        awk -v tag="$tag" 'BEGIN { RS = ""; FS = "\n" } index($0, "MESSAGE=" tag) {
+          for (i = 1; i <= NF; i++) if ($i ~ /^__MONOTONIC_TIMESTAMP=/) print substr($i, 23) }')
+    [ -n "$v" ] && { echo "$v"; return 0; }
+    sleep 0.05
+  done
+  return 1
+}
+# The simulator's next wire-log index (entries logged from now on have it or a larger one).
+wire_next() { busctl call $S $SP $S GetWireLog t 9223372036854775808 | awk '{print $2}'; }
+# zero_orders_since INDEX: "addr7 time_ns" for every zero order (SPEED 0x80) on the wire since INDEX.
+zero_orders_since() {
+  busctl call $S $SP $S GetWireLog t "$1" |
+    grep -oE '[0-9]+ [0-9]+ [0-9]+ "i2c" [0-9]+ false 3 128 100 [0-9]+' | awk '{print $5, $2}'
+}
+# every_thruster_zeroed_since INDEX: all eight addresses got a zero order since INDEX.
+every_thruster_zeroed_since() { [ "$(zero_orders_since "$1" | awk '{print $1}' | sort -u | wc -l)" -ge 8 ]; }
+# last_zero_us_since INDEX: the time of the last zero order since INDEX (us, CLOCK_MONOTONIC).
+last_zero_us_since() { zero_orders_since "$1" | awk 'BEGIN { m = 0 } $2 > m { m = $2 } END { printf "%.0f", m / 1000 }'; }
+# hold_all V: caracaractl keeps every thruster at V in the background.
+hold_all() {
+  caracaractl thrust "$1" "$1" "$1" "$1" "$1" "$1" "$1" "$1" --for 120 >>"$out/caracaractl.log" 2>&1 &
+  ctl_pid=$!
+}
+all_at() { local n; for n in 0 1 2 3 4 5 6 7; do speed_is $n "$1" || return 1; done; }
+# arm: every start comes up killed (source "start"); ClearKill, then wait for ready.
+arm() {
+  [ "$(state)" = killed ] && [ "$(prop $V $VP $V KillSource)" = start ] && busctl call $V $VP $V ClearKill
+  wait_until 10 state_is ready
+}
+
 # The cursor of the newest journal entry.
 cursor() { journalctl -n 1 -q -o cat --show-cursor --no-pager 2>/dev/null | sed -n 's/^-- cursor: //p'; }
 
@@ -156,11 +193,13 @@ zero_orders_ok() {
 check "at READY=1 every simulated thruster has received a zero order" zero_orders_ok
 check "caracara-sim.service is active (pulled in by the sim-mode drop-in)" active caracara-sim
 check "caracarad.service is active" active caracarad
+check "it comes up killed, kill source \"start\"" \
+  bash -c '[ "$(busctl get-property "$1" "$2" "$1" KillSource)" = "s \"start\"" ]' _ $V $VP
 status=$(systemctl status --no-pager caracarad 2>&1)
 echo "$status" | sed 's/^/  | /'
 check "systemctl status: active (running)" grep -q 'Active: active (running)' <<<"$status"
 check "systemctl status: a Status: line" grep -q '^ *Status: "' <<<"$status"
-wait_until 10 state_is ready
+check "root: ClearKill arms it, ready after the arming delay" arm
 st=$(state)
 stext=$(unit caracarad StatusText)
 info "State=$st StatusText=$stext"
@@ -228,7 +267,78 @@ check "the restarted daemon is ready with every thruster at zero ($speeds_now)" 
 check "the zero came from the new daemon (thruster 0 got new zero orders)" \
   [ "$(prop $S "$SP/thruster/0" $ST ZeroOrders)" -gt "${z0:-0}" ]
 check "NRestarts counts the restart" [ "$(unit caracarad NRestarts)" -gt "$nr" ]
-wait_until 10 state_is ready
+check "the restarted daemon is killed (source start) until someone arms it" \
+  bash -c '[ "$(busctl get-property "$1" "$2" "$1" KillSource)" = "s \"start\"" ]' _ $V $VP
+arm
+
+# --- 5b. every end of the service zeroes the thrusters (ExecStopPost=caracarad --zero-thrusters) ------
+# The SeaBotix controllers keep their last order forever: after any end of the process, systemd
+# runs the daemon's own zeroing step. Measured from the wire log: the event to the last zero order.
+v=2000
+spd_all=$((0x80 + (v * 102 * 2 + 8850) / (2 * 8850)))
+drive_all() {
+  stop_ctl
+  hold_all $v
+  wait_until 5 all_at $spd_all
+}
+# (a) SIGKILL with Restart= off (as when the start limit has been hit): nothing restarts the
+# daemon, the zeroing step alone stops the thrusters.
+mkdir -p /run/systemd/system/caracarad.service.d
+printf '[Service]\nRestart=no\n' >/run/systemd/system/caracarad.service.d/norestart.conf
+systemctl daemon-reload
+systemctl restart caracarad
+arm
+check "Restart=no: all eight thrusters driven at SPEED $spd_all" drive_all
+idx=$(wire_next)
+pid=$(unit caracarad MainPID)
+kill -KILL "$pid"
+gone() { ! active caracarad; }
+wait_until 15 gone
+check "Restart=no, SIGKILL: zero orders to all eight thrusters arrive" wait_until 10 every_thruster_zeroed_since "$idx"
+died=$(unit caracarad ExecMainExitTimestampMonotonic)
+last=$(last_zero_us_since "$idx")
+info "SIGKILL (Restart=no): process gone at ${died} us, last zero order at ${last} us"
+echo "BOUND: SIGKILL, no restart: $(((last - died) / 1000)) ms from the daemon's death to the last zero order"
+stop_ctl
+sleep 1
+stays_zero_unrestarted() { all_zero && ! active caracarad; }
+check "Restart=no, SIGKILL: the wire stays at zero ($(speeds)) and nothing restarted the daemon" stays_zero_unrestarted
+check "the journal has the zeroing step's report" \
+  bash -c 'journalctl -u caracarad --no-pager -o cat | grep -q "zeroing after stop: 8 of 8 thrusters zeroed"'
+rm -f /run/systemd/system/caracarad.service.d/norestart.conf
+systemctl daemon-reload
+systemctl reset-failed caracarad 2>/dev/null
+timeout 60 systemctl start caracarad
+arm
+# (b) SIGKILL with the restart: the zeroing step runs before systemd starts the next daemon.
+check "SIGKILL: all eight thrusters driven" drive_all
+idx=$(wire_next)
+pid=$(unit caracarad MainPID)
+kill -KILL "$pid"
+check "SIGKILL: zero orders to all eight thrusters arrive" wait_until 10 every_thruster_zeroed_since "$idx"
+died=$(unit caracarad ExecMainExitTimestampMonotonic)
+first_restart_zero() { [ "$(unit caracarad MainPID)" != "$pid" ] && active caracarad; }
+wait_until 15 first_restart_zero
+last=$(zero_orders_since "$idx" | awk 'NR <= 8 { if ($2 > m) m = $2 } END { printf "%.0f", m / 1000 }')
+echo "BOUND: SIGKILL, restarted: $(((last - died) / 1000)) ms from the daemon's death to the zeroing step's last zero order"
+stop_ctl
+arm
+# (c) SIGSTOP past WatchdogSec: systemd's watchdog ends the frozen daemon; the zeroing step follows.
+check "SIGSTOP: all eight thrusters driven" drive_all
+idx=$(wire_next)
+nr=$(unit caracarad NRestarts)
+pid=$(unit caracarad MainPID)
+t_stop=$(mono_us)
+kill -STOP "$pid"
+check "SIGSTOP: the thrusters hold their order while the daemon is frozen" all_at $spd_all
+restarted_after_watchdog() { [ "$(unit caracarad NRestarts)" -gt "$nr" ] && active caracarad; }
+check "SIGSTOP past WatchdogSec=5s: systemd ends and restarts the daemon" wait_until 30 restarted_after_watchdog
+check "SIGSTOP: zero orders to all eight thrusters arrive" every_thruster_zeroed_since "$idx"
+last=$(zero_orders_since "$idx" | awk 'NR <= 8 { if ($2 > m) m = $2 } END { printf "%.0f", m / 1000 }')
+echo "BOUND: SIGSTOP (watchdog): $(((last - t_stop) / 1000)) ms from the SIGSTOP to the zeroing step's last zero order (WatchdogSec=5s)"
+check "the journal names the watchdog" bash -c 'journalctl -u caracarad --no-pager -o cat | grep -qi "watchdog timeout"'
+stop_ctl
+arm
 
 # --- 6. an unprivileged user reads, and is refused every command by the policy ---------------------
 useradd --no-create-home --shell /usr/sbin/nologin tester
@@ -313,7 +423,7 @@ check "a configuration error is not retried (exit status 78, RestartPreventExitS
 cp /root/caracarad.toml.good "$CONF"
 systemctl reset-failed caracarad
 check "with the configuration fixed it starts again" timeout 60 systemctl start caracarad
-check "and is ready" wait_until 10 state_is ready
+check "and is ready once armed" arm
 
 # --- 12. exposure -----------------------------------------------------------------------------------------
 for u in caracarad caracara-sim; do
