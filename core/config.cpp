@@ -438,13 +438,14 @@ void parse_control(Checker& c, const toml::table& t, ControlSettings& out) {
     const std::string p = "control.";
     c.only_keys(t, p,
                 {"loop_rate_hz", "status_reads_per_tick", "command_timeout_ms", "arming_delay_ms", "budget_policy",
-                 "arm_at_start"});
+                 "arm_at_start", "profile"});
     c.integer(t, p, "loop_rate_hz", 0, 1000, out.loop_rate_hz,
               "between 0 and 1000 (0 = as fast as the bus allows)");
     c.integer(t, p, "status_reads_per_tick", 1, static_cast<int64_t>(kMotorCount), out.status_reads_per_tick);
     c.integer(t, p, "command_timeout_ms", 10, 60000, out.command_timeout_ms);
     c.integer(t, p, "arming_delay_ms", 0, 60000, out.arming_delay_ms);
     c.boolean(t, p, "arm_at_start", out.arm_at_start);
+    c.string(t, p, "profile", out.profile);
     std::string policy;
     if (c.string(t, p, "budget_policy", policy)) {
         if (policy == "scale")
@@ -455,6 +456,30 @@ void parse_control(Checker& c, const toml::table& t, ControlSettings& out) {
             c.fail(p + "budget_policy", "must be \"scale\" or \"reject\", got \"" + policy + "\"",
                    t.get("budget_policy"));
     }
+}
+
+void parse_profiles(Checker& c, const toml::table& t, std::vector<ThrustProfile>& out) {
+    std::vector<ThrustProfile> profiles;
+    for (auto&& [k, v] : t) {
+        const std::string key = "profiles." + std::string(k.str());
+        double f = 0.0;
+        if (const auto* iv = v.as_integer())
+            f = static_cast<double>(iv->get());
+        else if (const auto* fv = v.as_floating_point())
+            f = fv->get();
+        else {
+            c.fail(key, "must be a scale factor (a number above 0, at most 1), got " + written(v), &v);
+            continue;
+        }
+        if (!std::isfinite(f) || f <= 0.0 || f > 1.0) {
+            c.fail(key, "must be a scale factor above 0 and at most 1, got " + written(v), &v);
+            continue;
+        }
+        profiles.push_back({std::string(k.str()), f});
+    }
+    if (t.empty())
+        c.fail("profiles", "names no profile; leave the table out for the built-in water = 1.0", &t);
+    out = std::move(profiles);
 }
 
 std::optional<GpioLineSettings> parse_gpio_line(Checker& c, const toml::table& gpio, std::string_view role) {
@@ -551,7 +576,7 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     Checker c;
     DaemonConfig cfg;
     // [sim] belongs to caracara-sim, which reads the same file; it is not checked here.
-    c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "sim"});
+    c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "sim"});
     if (const toml::table* t = c.table(root, "", "i2c"))
         parse_i2c(c, *t, cfg.i2c);
     if (const toml::table* t = c.table(root, "", "spi"))
@@ -565,7 +590,16 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
         parse_gpio(c, *t, cfg.gpio);
     if (const toml::table* t = c.table(root, "", "recovery"))
         parse_recovery(c, *t, cfg.recovery);
+    if (const toml::table* t = c.table(root, "", "profiles"))
+        parse_profiles(c, *t, cfg.profiles);
     c.table(root, "", "sim");
+    if (!cfg.profiles.empty() && !find_profile(cfg, cfg.control.profile)) {
+        std::string known;
+        for (const auto& p : cfg.profiles)
+            known += (known.empty() ? "" : ", ") + p.name;
+        c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + known,
+               root["control"]["profile"].node());
+    }
 
     // Only when neither line is given: one without the other is already reported.
     if (cfg.recovery.enabled && !root["gpio"]["scl"] && !root["gpio"]["sda"])
@@ -578,6 +612,13 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     }
     r.config = std::move(cfg);
     return r;
+}
+
+const ThrustProfile* find_profile(const DaemonConfig& config, std::string_view name) {
+    for (const auto& p : config.profiles)
+        if (p.name == name)
+            return &p;
+    return nullptr;
 }
 
 ConfigResult parse_config_file(const std::string& path) {

@@ -60,6 +60,14 @@ struct ControlSettings {
     uint32_t arming_delay_ms = 3000;      // zero output after a kill is cleared
     BudgetPolicy budget_policy = BudgetPolicy::Scale;
     bool arm_at_start = false;            // false: every start comes up killed (source "start")
+    std::string profile = "water";        // the thrust profile selected at start
+};
+
+// A named scale factor for every motor value, applied after mixing and before the budget:
+// teams test in air at a fraction of the thrust they use in water.
+struct ThrustProfile {
+    std::string name;
+    double factor = 1.0; // 0 < factor <= 1
 };
 
 struct RecoverySettings {
@@ -88,7 +96,11 @@ struct DaemonConfig {
     ControlSettings control;
     GpioSettings gpio;
     RecoverySettings recovery;
+    std::vector<ThrustProfile> profiles{{"water", 1.0}};
 };
+
+// The profile called `name`, or nullptr.
+const ThrustProfile* find_profile(const DaemonConfig& config, std::string_view name);
 
 struct ConfigResult {
     std::optional<DaemonConfig> config;  // set when valid

@@ -19,6 +19,7 @@ std::string_view status_name(Status s) {
     case Status::Timeout: return "Timeout";
     case Status::LinkError: return "LinkError";
     case Status::Hardware: return "Hardware";
+    case Status::UnknownProfile: return "UnknownProfile";
     }
     return "Hardware";
 }

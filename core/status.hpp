@@ -24,6 +24,7 @@ enum class Status {
     Timeout,
     LinkError,
     Hardware,
+    UnknownProfile,
 };
 std::string_view status_name(Status s); // "OutOfRange", ...
 

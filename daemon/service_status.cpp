@@ -7,8 +7,9 @@ namespace caracara {
 void ServiceStatus::publish() const {
     const std::string state(vehicle_.state_name());
     const std::string ks(vehicle_.kill_source_name());
-    sd_notifyf(0, "STATUS=%s%s%s; I2C bus %s; %zu thrusters", state.c_str(), ks.empty() ? "" : " by ", ks.c_str(),
-               std::string(bus_state_name(bus_.telemetry().state)).c_str(), bus_.size());
+    sd_notifyf(0, "STATUS=%s%s%s; profile %s; I2C bus %s; %zu thrusters", state.c_str(), ks.empty() ? "" : " by ",
+               ks.c_str(), vehicle_.profile().name.c_str(), std::string(bus_state_name(bus_.telemetry().state)).c_str(),
+               bus_.size());
 }
 
 void ServiceStatus::start_watchdog() {

@@ -2,6 +2,8 @@
 
 #include "core/clock.hpp"
 #include "core/packet.hpp"
+
+#include <cmath>
 #include "daemon/control_loop.hpp"
 #include "daemon/log.hpp"
 #include "platform/io_error.hpp"
@@ -19,7 +21,8 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       lines_(lines),
       teensy_(teensy),
       events_(events),
-      safety_(safety_config(config), false, monotonic_ns()) {}
+      safety_(safety_config(config), false, monotonic_ns()),
+      profile_(find_profile(config, config.control.profile)) {}
 
 Result Vehicle::state_error() const {
     switch (safety_.state()) {
@@ -83,19 +86,14 @@ int Vehicle::on_deadline(sd_event_source*, uint64_t, void* userdata) {
     return 0;
 }
 
-Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
-    BudgetResult b = apply_budget(wanted, config_.control.budget_policy);
-    if (b.error == BudgetError::OutOfRange)
-        return {Status::OutOfRange, b.message};
-    if (b.error == BudgetError::OverBudget)
-        return {Status::OverBudget, b.message};
-    if (Result r = state_error(); !r.ok())
-        return r;
-    const std::string previous = safety_.commanding_client();
-    SafetyAction a = safety_.accept_command(monotonic_ns(), client);
-    if (!a.ok())
-        return state_error();
-    arm_deadline();
+MotorValues Vehicle::scaled(const MotorValues& wanted) const {
+    MotorValues m{};
+    for (size_t i = 0; i < kMotorCount; ++i)
+        m[i] = static_cast<int32_t>(std::lround(wanted[i] * profile_->factor));
+    return m;
+}
+
+bool Vehicle::apply(const MotorValues& wanted, const BudgetResult& b, bool mix_saturated) {
     const int32_t limit = b.running ? b.limit : 0;
     const bool saturated = b.saturated || mix_saturated;
     // A stream re-sending the same command changes nothing worth announcing.
@@ -112,9 +110,52 @@ Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std
     applied_ = b.motors;
     limit_ = limit;
     saturated_ = saturated;
+    mix_saturated_ = mix_saturated;
     if (any_due && loop_)
         loop_->schedule_work();
+    return changed;
+}
+
+Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
+    // The profile scales before the budget, so the budget holds whatever the profile.
+    BudgetResult b = apply_budget(scaled(wanted), config_.control.budget_policy);
+    if (b.error == BudgetError::OutOfRange)
+        return {Status::OutOfRange, b.message};
+    if (b.error == BudgetError::OverBudget)
+        return {Status::OverBudget, b.message};
+    if (Result r = state_error(); !r.ok())
+        return r;
+    const std::string previous = safety_.commanding_client();
+    SafetyAction a = safety_.accept_command(monotonic_ns(), client);
+    if (!a.ok())
+        return state_error();
+    arm_deadline();
+    const bool changed = apply(wanted, b, mix_saturated);
     events_.changed((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
+    return {};
+}
+
+Result Vehicle::set_profile(std::string_view name) {
+    const ThrustProfile* p = find_profile(config_, name);
+    if (!p) {
+        std::string known;
+        for (const auto& q : config_.profiles)
+            known += (known.empty() ? "" : ", ") + q.name;
+        return {Status::UnknownProfile, "no thrust profile \"" + std::string(name) + "\"; known: " + known};
+    }
+    if (p == profile_)
+        return {};
+    profile_ = p;
+    log_notice("thrust profile %s (factor %g)", p->name.c_str(), p->factor);
+    uint32_t changes = kChangeProfile;
+    // The command standing now goes out under the new factor at once. Under policy "reject" a
+    // command that no longer fits is dropped to zero rather than kept at the old factor.
+    BudgetResult b = apply_budget(scaled(requested_), config_.control.budget_policy);
+    if (!b.ok())
+        b = apply_budget(MotorValues{}, config_.control.budget_policy);
+    if (apply(requested_, b, mix_saturated_))
+        changes |= kChangeMotors;
+    events_.changed(changes);
     return {};
 }
 

@@ -42,6 +42,8 @@ public:
     Result clear_kill();
     Result power_off(std::string_view confirmation);
     Result set_leds(int red, int green, int blue);
+    // Selects a thrust profile by name; the current command goes out again under it at once.
+    Result set_profile(std::string_view name);
     void client_left(std::string_view unique_name);
     // Once per cycle: arming and the command timeout.
     void tick(uint64_t now_ns) { handle(safety_.tick(now_ns)); }
@@ -64,12 +66,17 @@ public:
     bool saturated() const { return saturated_; }
     int64_t command_age_ms() const;
     const std::string& controller_client() const { return safety_.commanding_client(); }
+    const ThrustProfile& profile() const { return *profile_; }
 
 private:
     static int on_deadline(sd_event_source*, uint64_t usec, void* userdata);
     void arm_deadline();
     void handle(const SafetyAction& a);
     Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);
+    // The budget over `wanted` scaled by the profile; applied, limit and saturation updated,
+    // changed orders due. Returns whether anything announced changed.
+    bool apply(const MotorValues& wanted, const BudgetResult& b, bool mix_saturated);
+    MotorValues scaled(const MotorValues& wanted) const;
 
     const DaemonConfig& config_;
     ThrusterBus& bus_;
@@ -84,6 +91,8 @@ private:
     MotorValues applied_{};
     int32_t limit_ = 0;
     bool saturated_ = false;
+    bool mix_saturated_ = false;
+    const ThrustProfile* profile_;
 };
 
 } // namespace caracara

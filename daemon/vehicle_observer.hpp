@@ -14,6 +14,7 @@ enum VehicleChange : uint32_t {
     kChangeLeds = 1u << 2,
     kChangeController = 1u << 3, // Controller
     kChangeBus = 1u << 4,        // the Bus object's State and recovery figures
+    kChangeProfile = 1u << 5,    // Profile, ProfileFactor
 };
 
 class VehicleObserver {

@@ -140,6 +140,11 @@ int cmd_clear_kill(Client& c, const Args&, const Options&) {
     return kExitOk;
 }
 
+int cmd_profile(Client& c, const Args& a, const Options&) {
+    c.call(kRootPath, kVehicleIface, "SetProfile", append_args("s", a[0].c_str()));
+    return kExitOk;
+}
+
 int cmd_leds(Client& c, const Args& a, const Options&) {
     const uint8_t r = parse_byte(a[0], "R"), g = parse_byte(a[1], "G"), b = parse_byte(a[2], "B");
     c.call(kRootPath, kVehicleIface, "SetLeds", append_args("yyy", r, g, b));
@@ -225,7 +230,9 @@ constexpr Command kCommands[] = {
     {"packet", "W0 ... W12", "Hold a 13-word Caracara packet (motors, kill, power-off, RGB)", 13, cmd_packet,
      nullptr, kOptHold},
     {"kill", "", "Zero every thruster at once and latch the kill", 0, cmd_kill},
-    {"clear-kill", "", "Clear the kill (arming, then ready)", 0, cmd_clear_kill},
+    {"clear-kill", "", "Clear the kill, e.g. the one every start comes up with (arming, then ready)", 0,
+     cmd_clear_kill},
+    {"profile", "NAME", "Select a thrust profile (a scale factor, e.g. water, air)", 1, cmd_profile},
     {"leds", "R G B", "Set the LED colour (0..255 each)", 3, cmd_leds},
     {"power-off", "[--yes-power-off]", "Power the vehicle off, irreversibly (asks to confirm)", 0, cmd_power_off,
      nullptr, kOptYesPowerOff},

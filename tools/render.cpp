@@ -85,6 +85,7 @@ void print_vehicle(std::ostream& out, const Props& v) {
              (limit ? strf("limit %lld", static_cast<long long>(limit)) : std::string("no motor running")) + ", " +
                  (prop(v, "Saturated").boolean() ? "saturated" : "not saturated") + ", policy " +
                  or_dash(prop(v, "BudgetPolicy").s));
+    key_line(out, "Profile", or_dash(prop(v, "Profile").s) + strf(" (thrust x %g)", prop(v, "ProfileFactor").number()));
     const Value& leds = prop(v, "Leds");
     key_line(out, "LEDs",
              leds.items.size() == 3 ? strf("red %llu, green %llu, blue %llu",
