@@ -138,39 +138,45 @@ void encode(std::string& out, const T& v) {
 
 // --- Getters from accessors -----------------------------------------------------------------
 
-// The object an accessor reads (its first argument) and what it returns.
+// The object an accessor reads, as its first argument takes it (const or not: the simulator's
+// models hand out their parts through non-const accessors).
 template <auto Get, class = void>
 struct Accessor; // a lambda
 template <class C, class R, R (C::*Get)() const>
 struct Accessor<Get> {
-    using Object = C;
+    using Arg = const C&;
 };
 template <class C, class R, R C::*Get>
     requires(!std::is_function_v<R>)
 struct Accessor<Get> {
-    using Object = C;
+    using Arg = const C&;
 };
 template <auto Get>
     requires requires { &decltype(Get)::operator(); }
 struct Accessor<Get> {
     template <class R, class L, class A>
     static A arg(R (L::*)(A) const);
-    using Object = std::remove_cvref_t<decltype(arg(&decltype(Get)::operator()))>;
+    using Arg = decltype(arg(&decltype(Get)::operator()));
 };
 
 template <auto Get>
-using Object = typename Accessor<Get>::Object;
+using Arg = typename Accessor<Get>::Arg;
 template <auto Get>
-using Value = std::remove_cvref_t<std::invoke_result_t<decltype(Get), const Object<Get>&>>;
+using Value = std::remove_cvref_t<std::invoke_result_t<decltype(Get), Arg<Get>>>;
 
 template <auto Get>
-int get(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
-    return append(reply, std::invoke(Get, *static_cast<const Object<Get>*>(userdata)));
+decltype(auto) read(void* userdata) {
+    return std::invoke(Get, *static_cast<std::remove_reference_t<Arg<Get>>*>(userdata));
 }
 
 template <auto Get>
-void encode_property(const void* userdata, std::string& out) {
-    encode(out, std::invoke(Get, *static_cast<const Object<Get>*>(userdata)));
+int get(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata, sd_bus_error*) {
+    return append(reply, read<Get>(userdata));
+}
+
+template <auto Get>
+void encode_property(void* userdata, std::string& out) {
+    encode(out, read<Get>(userdata));
 }
 
 // --- An object's table ----------------------------------------------------------------------
@@ -179,7 +185,7 @@ void encode_property(const void* userdata, std::string& out) {
 struct Member {
     sd_bus_vtable entry;
     uint32_t announce = 0;
-    void (*encode)(const void* userdata, std::string& out) = nullptr;
+    void (*encode)(void* userdata, std::string& out) = nullptr;
 };
 
 template <auto Get>
