@@ -61,30 +61,23 @@ int m_release_bus(sd_bus_message* m, void* userdata, sd_bus_error*) {
 // SetKillSwitch changed it, which is when caracarad's edge event can fire).
 int m_wire_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint64_t since = 0;
-    int r = sd_bus_message_read(m, "t", &since);
-    if (r < 0)
+    if (int r = sd_bus_message_read(m, "t", &since); r < 0)
         return r;
-    sd_bus_message* reply = nullptr;
-    if ((r = sd_bus_message_new_method_return(m, &reply)) < 0)
-        return r;
-    dbus::MessagePtr guard(reply);
-    auto& log = vehicle(userdata).log();
-    r = sd_bus_message_append(reply, "t", log.next_index());
-    if (r >= 0)
-        r = sd_bus_message_open_container(reply, 'a', "(tttsqbayays)");
-    for (const WireEntry* e : log.since(since)) {
-        if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttsqbayays");
-        if (r >= 0) r = sd_bus_message_append(reply, "tttsqb", e->index, e->time_ns, e->transaction, e->bus.c_str(), e->addr, static_cast<int>(e->read));
-        if (r >= 0) r = sd_bus_message_append_array(reply, 'y', e->data.data(), e->data.size());
-        if (r >= 0) r = sd_bus_message_append_array(reply, 'y', e->miso.data(), e->miso.size());
-        if (r >= 0) r = sd_bus_message_append(reply, "s", e->result.c_str());
-        if (r >= 0) r = sd_bus_message_close_container(reply);
-    }
-    if (r >= 0)
-        r = sd_bus_message_close_container(reply);
-    if (r < 0)
-        return r;
-    return sd_bus_send(nullptr, reply, nullptr);
+    return reply_with(m, [&](sd_bus_message* reply) {
+        auto& log = vehicle(userdata).log();
+        int r = sd_bus_message_append(reply, "t", log.next_index());
+        if (r >= 0)
+            r = sd_bus_message_open_container(reply, 'a', "(tttsqbayays)");
+        for (const WireEntry* e : log.since(since)) {
+            if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttsqbayays");
+            if (r >= 0) r = sd_bus_message_append(reply, "tttsqb", e->index, e->time_ns, e->transaction, e->bus.c_str(), e->addr, static_cast<int>(e->read));
+            if (r >= 0) r = sd_bus_message_append_array(reply, 'y', e->data.data(), e->data.size());
+            if (r >= 0) r = sd_bus_message_append_array(reply, 'y', e->miso.data(), e->miso.size());
+            if (r >= 0) r = sd_bus_message_append(reply, "s", e->result.c_str());
+            if (r >= 0) r = sd_bus_message_close_container(reply);
+        }
+        return r < 0 ? r : sd_bus_message_close_container(reply);
+    });
 }
 
 int m_clear_log(sd_bus_message* m, void* userdata, sd_bus_error*) {

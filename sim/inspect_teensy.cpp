@@ -68,24 +68,17 @@ int m_commands(sd_bus_message* m, void* userdata, sd_bus_error*) {
 
 // GetFrameLog() -> a(tttysayay): seq, start_ns, end_ns, command, outcome, mosi, miso.
 int m_frame_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    sd_bus_message* reply = nullptr;
-    int r = sd_bus_message_new_method_return(m, &reply);
-    if (r < 0)
-        return r;
-    dbus::MessagePtr guard(reply);
-    r = sd_bus_message_open_container(reply, 'a', "(tttysayay)");
-    for (const auto& f : teensy(userdata).frame_log()) {
-        if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttysayay");
-        if (r >= 0) r = sd_bus_message_append(reply, "tttys", f.seq, f.start_ns, f.end_ns, f.command, std::string(to_string(f.outcome)).c_str());
-        if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.mosi.data(), f.mosi.size());
-        if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.miso.data(), f.miso.size());
-        if (r >= 0) r = sd_bus_message_close_container(reply);
-    }
-    if (r >= 0)
-        r = sd_bus_message_close_container(reply);
-    if (r < 0)
-        return r;
-    return sd_bus_send(nullptr, reply, nullptr);
+    return reply_with(m, [&](sd_bus_message* reply) {
+        int r = sd_bus_message_open_container(reply, 'a', "(tttysayay)");
+        for (const auto& f : teensy(userdata).frame_log()) {
+            if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttysayay");
+            if (r >= 0) r = sd_bus_message_append(reply, "tttys", f.seq, f.start_ns, f.end_ns, f.command, std::string(to_string(f.outcome)).c_str());
+            if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.mosi.data(), f.mosi.size());
+            if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.miso.data(), f.miso.size());
+            if (r >= 0) r = sd_bus_message_close_container(reply);
+        }
+        return r < 0 ? r : sd_bus_message_close_container(reply);
+    });
 }
 
 using V = SimVehicle&;
