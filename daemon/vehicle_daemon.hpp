@@ -35,9 +35,13 @@ public:
     const DaemonConfig& config() const { return config_; }
     VehicleEvents& events() { return events_; }
     Vehicle& vehicle() { return vehicle_; }
+    const Vehicle& vehicle() const { return vehicle_; }
     ThrusterBus& bus() { return bus_; }
+    const ThrusterBus& bus() const { return bus_; }
     TeensyPort& teensy() { return teensy_; }
+    const TeensyPort& teensy() const { return teensy_; }
     ControlLoop& loop() { return loop_; }
+    const ControlLoop& loop() const { return loop_; }
     ServiceStatus& status() { return status_; }
 
 private:

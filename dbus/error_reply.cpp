@@ -1,0 +1,20 @@
+#include "dbus/error_reply.hpp"
+
+#include "dbus/vehicle_names.hpp"
+
+namespace caracara::dbus {
+
+std::string error_name(Status s) { return std::string(kErrorPrefix) + std::string(status_name(s)); }
+
+int reply(sd_bus_message* call, const Result& result) {
+    if (result.ok())
+        return sd_bus_reply_method_return(call, "");
+    const std::string name = error_name(result.status);
+    sd_bus_error error = SD_BUS_ERROR_NULL;
+    sd_bus_error_set(&error, name.c_str(), result.message.c_str());
+    const int r = sd_bus_reply_method_error(call, &error);
+    sd_bus_error_free(&error);
+    return r;
+}
+
+} // namespace caracara::dbus

@@ -1,0 +1,120 @@
+#include "dbus/vehicle_object.hpp"
+
+#include "dbus/announcer.hpp"
+#include "dbus/error_reply.hpp"
+#include "dbus/vehicle_names.hpp"
+
+#include <cstring>
+#include <tuple>
+#include <vector>
+
+namespace caracara::dbus {
+
+namespace {
+
+Vehicle& ctl(void* userdata) { return static_cast<VehicleDaemon*>(userdata)->vehicle(); }
+
+std::string sender(sd_bus_message* m) {
+    const char* s = sd_bus_message_get_sender(m);
+    return s ? s : "";
+}
+
+int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
+    const void* p = nullptr;
+    size_t n = 0;
+    int r = sd_bus_message_read_array(m, 'i', &p, &n);
+    if (r < 0)
+        return r;
+    out.resize(n / sizeof(int32_t));
+    if (n)
+        std::memcpy(out.data(), p, n);
+    return 0;
+}
+
+int m_set_thrust(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    std::vector<int32_t> v;
+    if (int r = read_ints(m, v); r < 0)
+        return r;
+    return reply(m, ctl(userdata).set_thrust(v, sender(m)));
+}
+
+int m_set_motion(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    AxisDemand d{};
+    if (int r = sd_bus_message_read(m, "dddddd", &d[0], &d[1], &d[2], &d[3], &d[4], &d[5]); r < 0)
+        return r;
+    return reply(m, ctl(userdata).set_motion(d, sender(m)));
+}
+
+int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    std::vector<int32_t> v;
+    if (int r = read_ints(m, v); r < 0)
+        return r;
+    return reply(m, ctl(userdata).apply_packet(v, sender(m)));
+}
+
+int m_kill(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    return reply(m, ctl(userdata).kill(KillSource::DBus, "Kill() from " + sender(m)));
+}
+
+int m_clear_kill(sd_bus_message* m, void* userdata, sd_bus_error*) { return reply(m, ctl(userdata).clear_kill()); }
+
+int m_power_off(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    const char* confirmation = nullptr;
+    if (int r = sd_bus_message_read(m, "s", &confirmation); r < 0)
+        return r;
+    return reply(m, ctl(userdata).power_off(confirmation));
+}
+
+int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    uint8_t red = 0, green = 0, blue = 0;
+    if (int r = sd_bus_message_read(m, "yyy", &red, &green, &blue); r < 0)
+        return r;
+    return reply(m, ctl(userdata).set_leds(red, green, blue));
+}
+
+using D = const VehicleDaemon&;
+int m_set_profile(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    const char* name = nullptr;
+    if (int r = sd_bus_message_read(m, "s", &name); r < 0)
+        return r;
+    return reply(m, ctl(userdata).set_profile(name));
+}
+
+const ControlSettings& control(D d) { return d.config().control; }
+
+constexpr Member kMembers[] = {
+    member(SD_BUS_METHOD_WITH_ARGS("SetThrust", SD_BUS_ARGS("ai", values), SD_BUS_NO_RESULT, m_set_thrust, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetMotion", SD_BUS_ARGS("d", x, "d", y, "d", z, "d", yaw, "d", pitch, "d", roll),
+                                   SD_BUS_NO_RESULT, m_set_motion, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("ApplyPacket", SD_BUS_ARGS("ai", packet), SD_BUS_NO_RESULT, m_apply_packet, kUnpriv)),
+    member(SD_BUS_METHOD("Kill", "", "", m_kill, kUnpriv)),
+    member(SD_BUS_METHOD("ClearKill", "", "", m_clear_kill, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("PowerOff", SD_BUS_ARGS("s", confirmation), SD_BUS_NO_RESULT, m_power_off, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
+                                   kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetProfile", SD_BUS_ARGS("s", name), SD_BUS_NO_RESULT, m_set_profile, kUnpriv)),
+    property<[](D d) { return d.vehicle().state_name(); }>("State", kChange, kChangeState),
+    property<[](D d) { return d.vehicle().kill_source_name(); }>("KillSource", kChange, kChangeState),
+    property<[](D d) -> const auto& { return d.vehicle().motor_values(); }>("MotorValues", kChange, kChangeMotors),
+    property<[](D d) -> const auto& { return d.vehicle().requested_values(); }>("RequestedValues", kChange, kChangeMotors),
+    property<[](D d) { return d.vehicle().budget_limit(); }>("BudgetLimit", kChange, kChangeMotors),
+    property<[](D d) { return d.vehicle().saturated(); }>("Saturated", kChange, kChangeMotors),
+    property<[](D d) { return policy_name(control(d).budget_policy); }>("BudgetPolicy", kConst),
+    property<[](D d) -> const auto& { return d.vehicle().profile().name; }>("Profile", kChange, kChangeProfile),
+    property<[](D d) { return d.vehicle().profile().factor; }>("ProfileFactor", kChange, kChangeProfile),
+    property<[](D d) { auto l = d.teensy().leds(); return std::tuple{l[0], l[1], l[2]}; }>("Leds", kChange, kChangeLeds),
+    property<[](D d) { return d.vehicle().command_age_ms(); }>("CommandAgeMs", kChange, kTelemetryTick),
+    property<[](D d) -> const auto& { return d.vehicle().controller_client(); }>("Controller", kChange, kChangeController),
+    property<[](D d) { return control(d).command_timeout_ms; }>("CommandTimeoutMs", kConst),
+    property<[](D d) { return control(d).arming_delay_ms; }>("ArmingDelayMs", kConst),
+    property<[](D d) { return double(control(d).loop_rate_hz); }>("LoopRateHz", kConst),
+    property<[](D d) { return d.loop().cycles(); }>("Cycles", kChange, kTelemetryTick),
+};
+constexpr auto kVtable = vtable(kMembers);
+
+} // namespace
+
+VehicleObject::VehicleObject(sd_bus* bus, VehicleDaemon& daemon)
+    : object_(bus, kRootPath, kVehicleIface, kMembers, kVtable, &daemon) {}
+
+} // namespace caracara::dbus

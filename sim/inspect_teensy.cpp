@@ -1,0 +1,127 @@
+#include "sim/inspect_teensy.hpp"
+
+#include "dbus/property.hpp"
+#include "sim/inspect.hpp"
+
+#include <string>
+#include <tuple>
+
+namespace caracara::sim {
+
+namespace {
+
+using dbus::kUnpriv;
+using dbus::member;
+using dbus::property;
+
+TeensyModel& teensy(void* userdata) { return static_cast<SimVehicle*>(userdata)->teensy(); }
+
+int m_inject(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    const char* kind = nullptr;
+    uint32_t frames = 0;
+    if (int r = sd_bus_message_read(m, "su", &kind, &frames); r < 0)
+        return r;
+    const std::string k = kind;
+    if (k == "busy")
+        teensy(userdata).inject_busy(frames);
+    else if (k == "garbage-ack")
+        teensy(userdata).inject_garbage_ack(frames);
+    else if (k == "no-answer")
+        teensy(userdata).inject_no_answer(frames);
+    else
+        return sd_bus_error_setf(err, kInspectInvalid, "fault must be busy, garbage-ack or no-answer, got '%s'", kind);
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_random_busy(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    double p = 0;
+    uint64_t seed = 0;
+    if (int r = sd_bus_message_read(m, "dt", &p, &seed); r < 0)
+        return r;
+    if (!teensy(userdata).set_random_busy(p, seed))
+        return sd_bus_error_setf(err, kInspectInvalid, "probability must be within 0..1");
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_clear(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    teensy(userdata).clear_faults();
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_set_distance(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    uint8_t sensor = 0;
+    uint16_t mm = 0;
+    if (int r = sd_bus_message_read(m, "yq", &sensor, &mm); r < 0)
+        return r;
+    if (!teensy(userdata).set_distance_mm(sensor, mm))
+        return sd_bus_error_setf(err, kInspectInvalid, "no distance sensor %u", sensor);
+    return sd_bus_reply_method_return(m, "");
+}
+
+int m_commands(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    uint8_t cmd = 0;
+    if (int r = sd_bus_message_read(m, "y", &cmd); r < 0)
+        return r;
+    return sd_bus_reply_method_return(m, "tt", static_cast<uint64_t>(teensy(userdata).commands_received(cmd)),
+                                      static_cast<uint64_t>(teensy(userdata).commands_executed(cmd)));
+}
+
+// GetFrameLog() -> a(tttysayay): seq, start_ns, end_ns, command, outcome, mosi, miso.
+int m_frame_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    return reply_with(m, [&](sd_bus_message* reply) {
+        int r = sd_bus_message_open_container(reply, 'a', "(tttysayay)");
+        for (const auto& f : teensy(userdata).frame_log()) {
+            if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttysayay");
+            if (r >= 0) r = sd_bus_message_append(reply, "tttys", f.seq, f.start_ns, f.end_ns, f.command, std::string(to_string(f.outcome)).c_str());
+            if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.mosi.data(), f.mosi.size());
+            if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.miso.data(), f.miso.size());
+            if (r >= 0) r = sd_bus_message_close_container(reply);
+        }
+        return r < 0 ? r : sd_bus_message_close_container(reply);
+    });
+}
+
+using V = SimVehicle&;
+SpiPort& spi(V v) { return v.teensy_port(); }
+
+constexpr dbus::Member kMembers[] = {
+    property<[](V v) { auto o = v.teensy().orientation(); return std::tuple{o.yaw, o.pitch, o.roll}; }>("Orientation"),
+    property<[](V v) { auto p = v.body().position(); return std::tuple{p.x, p.y, p.depth}; }>("Position"),
+    property<[](V v) {
+        auto w = v.teensy().wheels();
+        return std::tuple{w.front_left, w.front_right, w.back_left, w.back_right};
+    }>("Wheels"),
+    property<[](V v) { auto l = v.teensy().leds(); return std::tuple{l[0], l[1], l[2]}; }>("Leds"),
+    property<[](V v) -> const auto& { return v.teensy().servo_degrees(); }>("Servos"),
+    property<[](V v) -> const auto& { return v.teensy().distances_mm(); }>("Distances"),
+    property<[](V v) { return v.teensy().stop_duty(); }>("StopDuty"),
+    property<[](V v) { return to_string(v.teensy().task_state()); }>("Task"),
+    property<[](V v) { return v.teensy().acknowledgements(); }>("Acknowledgements"),
+    property<[](V v) { return v.teensy().frames_total(); }>("Frames"),
+    property<[](V v) { return double(v.teensy().last_turn_rad()); }>("LastTurn"),
+    property<[](V v) { return double(v.teensy().last_turn_to_rad()); }>("LastTurnTo"),
+    property<[](V v) { return v.teensy().heading_offset(); }>("HeadingOffset"),
+    property<[](V v) { return spi(v).mode; }>("SpiMode"),
+    property<[](V v) { return spi(v).bits_per_word; }>("SpiBitsPerWord"),
+    property<[](V v) { return spi(v).max_speed_hz; }>("SpiMaxSpeedHz"),
+    property<[](V v) { return spi(v).mode_mismatches; }>("SpiModeMismatches"),
+    property<[](V v) { return spi(v).last_transfers; }>("SpiLastTransfers"),
+    property<[](V v) { return spi(v).last_speed_hz; }>("SpiLastSpeedHz"),
+    property<[](V v) { return spi(v).last_delay_usecs; }>("SpiLastDelayUsecs"),
+    member(SD_BUS_METHOD_WITH_ARGS("InjectFault", SD_BUS_ARGS("s", fault, "u", frames), SD_BUS_NO_RESULT, m_inject, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetRandomBusy", SD_BUS_ARGS("d", probability, "t", seed), SD_BUS_NO_RESULT, m_random_busy,
+                                   kUnpriv)),
+    member(SD_BUS_METHOD("ClearFaults", "", "", m_clear, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetDistance", SD_BUS_ARGS("y", sensor, "q", millimeters), SD_BUS_NO_RESULT, m_set_distance,
+                                   kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("CommandCount", SD_BUS_ARGS("y", command), SD_BUS_RESULT("t", received, "t", executed),
+                                   m_commands, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("GetFrameLog", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(tttysayay)", frames), m_frame_log, kUnpriv)),
+};
+constexpr auto kVtable = dbus::vtable(kMembers);
+
+} // namespace
+
+const sd_bus_vtable* teensy_inspection() { return kVtable.data(); }
+
+} // namespace caracara::sim
