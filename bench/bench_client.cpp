@@ -195,11 +195,15 @@ public:
     }
     uint64_t wire_next() { return wire_log(UINT64_MAX, nullptr); }
 
+    // Also arms a daemon that started killed (kill source "start"), as a pilot would.
     bool wait_ready(uint64_t timeout_ns) {
         const uint64_t end = mono_ns() + timeout_ns;
         while (mono_ns() < end) {
-            if (state() == "ready")
+            const std::string s = state();
+            if (s == "ready")
                 return true;
+            if (s == "killed" && get_string(kVehicle, kVehiclePath, kVehicle, "KillSource") == "start")
+                vehicle_call("ClearKill");
             sleep_ns(1'000'000);
         }
         return false;
@@ -723,9 +727,6 @@ int cmd_stream(const Args& a) {
 
 int cmd_wait_ready(const Args& a) {
     Client c(a.bus);
-    // A fresh daemon comes up killed (source "start"): arm it as a pilot would.
-    if (c.state() == "killed" && c.get_string(kVehicle, kVehiclePath, kVehicle, "KillSource") == "start")
-        c.vehicle_call("ClearKill");
     if (!c.wait_ready(static_cast<uint64_t>(a.timeout_ms * 1e6))) {
         std::fprintf(stderr, "caracara-bench: not ready after %.0f ms (state '%s')\n", a.timeout_ms, c.state().c_str());
         return 1;

@@ -44,11 +44,17 @@ void Vehicle::handle(const SafetyAction& a) {
         saturated_ = false;
         changes |= kChangeMotors | kChangeController;
     }
+    // A kill reaches the kill output first: it is one GPIO write, and the zero orders behind it
+    // are bus transfers that a hung device can delay. Releasing it (arming) waits for the zeros.
+    const bool assert_first = a.state_changed && safety_.kill_output_asserted();
+    if (assert_first)
+        lines_.set_kill_output(true);
     if (a.zero_outputs)
         bus_.zero_all();
     if (a.state_changed) {
         changes |= kChangeState;
-        lines_.set_kill_output(safety_.kill_output_asserted()); // after the zero orders
+        if (!assert_first)
+            lines_.set_kill_output(safety_.kill_output_asserted());
     }
     if (a.command_stale)
         log_info("command stream silent for %llu ms: thrusters to zero",
