@@ -65,10 +65,12 @@ void Vehicle::handle(const SafetyAction& a) {
 
 void Vehicle::arm_deadline() {
     // The end of arming and the command timeout land on their own timer, at the time the
-    // safety machine names, not at the next tick.
+    // safety machine names, not at the next tick. Re-armed only when that time moves: this runs
+    // on every cycle.
     const uint64_t at = safety_.next_deadline();
-    if (!deadline_)
+    if (!deadline_ || at == deadline_at_)
         return;
+    deadline_at_ = at;
     if (at == SafetyMachine::kNoDeadline) {
         sd_event_source_set_enabled(deadline_.get(), SD_EVENT_OFF);
         return;
@@ -83,12 +85,15 @@ std::string Vehicle::start(sd_event* event) {
     if (int r = sd_event_add_time(event, &s, CLOCK_MONOTONIC, 0, 1, on_deadline, this); r < 0)
         return "sd_event_add_time: " + errno_name(-r);
     deadline_.reset(s);
+    sd_event_source_set_enabled(s, SD_EVENT_OFF);
     arm_deadline();
     return {};
 }
 
 int Vehicle::on_deadline(sd_event_source*, uint64_t, void* userdata) {
-    static_cast<Vehicle*>(userdata)->tick(monotonic_ns());
+    auto* self = static_cast<Vehicle*>(userdata);
+    self->deadline_at_ = SafetyMachine::kNoDeadline; // a one-shot source is off once it fired
+    self->tick(monotonic_ns());
     return 0;
 }
 

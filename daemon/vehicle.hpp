@@ -86,6 +86,7 @@ private:
     ControlLoop* loop_ = nullptr;
     SafetyMachine safety_;
     SourcePtr deadline_;
+    uint64_t deadline_at_ = SafetyMachine::kNoDeadline; // what deadline_ is armed for
 
     MotorValues requested_{};
     MotorValues applied_{};
