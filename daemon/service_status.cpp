@@ -7,9 +7,15 @@ namespace caracara {
 void ServiceStatus::publish() const {
     const std::string state(vehicle_.state_name());
     const std::string ks(vehicle_.kill_source_name());
-    sd_notifyf(0, "STATUS=%s%s%s; profile %s; I2C bus %s; %zu thrusters", state.c_str(), ks.empty() ? "" : " by ",
+    // The faults someone must act on show on `systemctl status`'s Status: line.
+    std::string faults;
+    for (size_t i = 0; i < bus_.size(); ++i)
+        for (Fault f : {Fault::WaterDetect, Fault::Overtemp})
+            if (bus_.faults(i).has(f))
+                faults += "; thruster " + std::to_string(i) + " " + std::string(fault_name(f));
+    sd_notifyf(0, "STATUS=%s%s%s; profile %s; I2C bus %s; %zu thrusters%s", state.c_str(), ks.empty() ? "" : " by ",
                ks.c_str(), vehicle_.profile().name.c_str(), std::string(bus_state_name(bus_.telemetry().state)).c_str(),
-               bus_.size());
+               bus_.size(), faults.c_str());
 }
 
 void ServiceStatus::start_watchdog() {

@@ -1,5 +1,7 @@
 #include "daemon/thruster_bus.hpp"
 
+#include "daemon/log.hpp"
+
 #include <algorithm>
 
 namespace caracara {
@@ -18,6 +20,7 @@ ThrusterBus::ThrusterBus(DeviceIo& io, const DaemonConfig& config, VehicleEvents
       device_(config.i2c.device),
       i2c_(io, config.i2c.device),
       ordered_(config.thrusters.size(), 0),
+      faults_(config.thrusters.size()),
       schedule_(config.thrusters.size()),
       lockup_(static_cast<uint32_t>(kMotorCount)) {
     for (const auto& tc : config.thrusters)
@@ -35,7 +38,24 @@ void ThrusterBus::zero_all() {
         send_order(i, 0);
 }
 
-void ThrusterBus::read_status(std::size_t i) { note(thrusters_[i]->read_status()); }
+void ThrusterBus::read_status(std::size_t i) {
+    const IoError e = thrusters_[i]->read_status();
+    note(e);
+    if (e == IoError::None)
+        report_faults(i);
+}
+
+void ThrusterBus::report_faults(std::size_t i) {
+    const auto& st = thrusters_[i]->last_status();
+    const FaultSet now = st ? st->faults : FaultSet{};
+    if (now == faults_[i])
+        return;
+    for (Fault f : kAllFaults)
+        if (now.has(f) != faults_[i].has(f))
+            log_thruster_fault(i, fault_name(f), now.has(f));
+    faults_[i] = now;
+    events_.changed(kChangeFaults);
+}
 
 void ThrusterBus::set_recovering(bool r) {
     recovering_ = r;

@@ -66,12 +66,15 @@ public:
     std::size_t size() const { return thrusters_.size(); }
     const ThrusterDriver& thruster(std::size_t i) const { return *thrusters_[i]; }
     int32_t ordered_value(std::size_t i) const { return ordered_[i]; }
+    // The fault bits last reported for thruster i (logged once per change).
+    FaultSet faults(std::size_t i) const { return faults_[i]; }
     BusTelemetry& telemetry() { return tm_; }
     const BusTelemetry& telemetry() const { return tm_; }
     const std::string& device() const { return device_; }
 
 private:
     void note(IoError e);
+    void report_faults(std::size_t i);
 
     VehicleEvents& events_;
     std::string device_;
@@ -79,6 +82,7 @@ private:
     MuxTracker mux_;
     std::vector<std::unique_ptr<ThrusterDriver>> thrusters_;
     std::vector<int32_t> ordered_;
+    std::vector<FaultSet> faults_;
     OrderSchedule schedule_;
     LockupDetector lockup_;
     BusTelemetry tm_;

@@ -5,7 +5,7 @@
 namespace caracara {
 
 void VehicleEvents::changed(uint32_t changes) {
-    if ((changes & (kChangeState | kChangeBus | kChangeProfile)) && status_)
+    if ((changes & (kChangeState | kChangeBus | kChangeProfile | kChangeFaults)) && status_)
         status_->publish();
     if (changes && observer_)
         observer_->vehicle_changed(changes);

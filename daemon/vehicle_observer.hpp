@@ -15,6 +15,7 @@ enum VehicleChange : uint32_t {
     kChangeController = 1u << 3, // Controller
     kChangeBus = 1u << 4,        // the Bus object's State and recovery figures
     kChangeProfile = 1u << 5,    // Profile, ProfileFactor
+    kChangeFaults = 1u << 6,     // a thruster's fault bits (its Faults property goes with telemetry)
 };
 
 class VehicleObserver {

@@ -122,6 +122,11 @@ void print_thrusters(std::ostream& out, const std::vector<const Props*>& list) {
                         or_dash(prop(*t, "LastError").s)});
     }
     print_table(out, rows);
+    // The faults someone must act on, said in words under the table.
+    for (const Props* t : list)
+        for (const Value& f : prop(*t, "Faults").items)
+            if (f.s == "water-detect" || f.s == "overtemp")
+                out << "Warning: thruster " << render(prop(*t, "Index")) << ": " << f.s << '\n';
 }
 
 void print_teensy(std::ostream& out, const Props& t) {

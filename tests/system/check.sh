@@ -388,6 +388,20 @@ check "the status line says killed" wait_until 2 status_says_killed
 check "root: ClearKill" busctl call $V $VP $V ClearKill
 check "ready again after the arming delay" wait_until 10 state_is ready
 
+# --- 9b. a thruster fault is told: STATUS= and the journal's THRUSTER=/FAULT= fields, once ---------
+busctl call $S "$SP/thruster/2" $ST SetFault sb water-detect true
+status_has_water() { unit caracarad StatusText | grep -q "thruster 2 water-detect"; }
+check "water detect on thruster 2 shows on the Status: line ($(unit caracarad StatusText))" wait_until 10 status_has_water
+sleep 1
+busctl call $S "$SP/thruster/2" $ST SetFault sb water-detect false
+status_clear() { ! status_has_water; }
+check "and leaves it when the fault clears" wait_until 10 status_clear
+nraised=$(journalctl --no-pager -o cat THRUSTER=2 FAULT=water-detect FAULT_STATE=on | wc -l)
+ncleared=$(journalctl --no-pager -o cat THRUSTER=2 FAULT=water-detect FAULT_STATE=off | wc -l)
+once_each_way() { [ "$nraised" = 1 ] && [ "$ncleared" = 1 ]; }
+check "the journal has it once each way with THRUSTER=2 FAULT=water-detect (raised $nraised, cleared $ncleared)" \
+  once_each_way
+
 # --- 10. systemctl stop leaves the thrusters at zero ----------------------------------------------------
 hold 1000
 check "before stop: thruster 0 held at SPEED $spd" wait_until 5 speed_is 0 $spd
