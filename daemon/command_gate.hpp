@@ -1,8 +1,10 @@
-// Whether the vehicle's state allows a command: asked by the objects that move something
-// (the Teensy's wheels and turns) without their knowing the safety machine.
+// Whether the vehicle's state allows a command, and taking one: asked by the objects that move
+// something (the Teensy's wheels and turns) without their knowing the safety machine.
 #pragma once
 
 #include "core/status.hpp"
+
+#include <string_view>
 
 namespace caracara {
 
@@ -12,6 +14,9 @@ public:
     // Ok when the vehicle is ready to move; else the error a caller gets (Killed, Arming, ...).
     virtual Result state_error() const = 0;
     virtual bool powered_off() const = 0;
+    // A command that moves something, from `client`: accepted only when ready, it restarts the
+    // command timeout and makes `client` the commanding client, as SetThrust does.
+    virtual Result accept_command(std::string_view client) = 0;
 };
 
 } // namespace caracara

@@ -41,7 +41,7 @@ Result teensy_result(teensy::TeensyError e, std::string_view what) {
 
 } // namespace
 
-TeensyPort::TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, const CommandGate& gate,
+TeensyPort::TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate,
                        VehicleEvents& events)
     : event_(event), gate_(gate), events_(events), spi_(io, settings.device, settings.spi), link_(spi_, settings.teensy) {
     tm_.distances.assign(static_cast<size_t>(settings.teensy.limits.distance_sensor_count), 0);
@@ -83,10 +83,18 @@ void TeensyPort::poll() {
 }
 
 void TeensyPort::stop_motion() {
+    wheels_moving_ = false;
     if (!spi_.is_open())
         return;
     if (auto e = link_.stop(0); e != teensy::TeensyError::None)
-        log_error("Teensy Stop on kill failed: %s", std::string(teensy::teensy_error_name(e)).c_str());
+        log_error("Teensy Stop failed: %s", std::string(teensy::teensy_error_name(e)).c_str());
+}
+
+void TeensyPort::stop_if_moving() {
+    if (!wheels_moving_ && !turn_done_)
+        return;
+    stop_motion();
+    cancel_turn({Status::Timeout, "the turn was stopped: its command stream ended"});
 }
 
 void TeensyPort::cancel_turn(const Result& r) {
@@ -107,11 +115,23 @@ Result TeensyPort::set_leds(int red, int green, int blue) {
     return {};
 }
 
-Result TeensyPort::set_speed(int left, int right) {
-    // Drive motors are motors: only a ready vehicle moves them (stopping is always allowed).
-    if (Result r = gate_.state_error(); !r.ok() && (left != 0 || right != 0))
-        return r;
-    return teensy_result(link_.set_speed(left, right), "Set Speed");
+Result TeensyPort::set_speed(int left, int right, std::string_view client) {
+    // Drive motors are motors: only a ready vehicle moves them, as a command from the commanding
+    // client under the command timeout (stopping is always allowed).
+    const bool moving = left != 0 || right != 0;
+    if (moving) {
+        if (Result r = gate_.state_error(); !r.ok())
+            return r;
+        // Range first: a refused command changes nothing, not even who commands.
+        if (auto e = teensy::encode_set_speed(left, right).error; e != teensy::TeensyError::None)
+            return teensy_result(e, "Set Speed");
+        if (Result r = gate_.accept_command(client); !r.ok())
+            return r;
+    }
+    Result r = teensy_result(link_.set_speed(left, right), "Set Speed");
+    if (r.ok())
+        wheels_moving_ = moving;
+    return r;
 }
 
 Result TeensyPort::stop(int duty) { return teensy_result(link_.stop(duty), "Stop"); }
@@ -135,13 +155,16 @@ Result TeensyPort::distance(int sensor, uint16_t& mm) {
     return {};
 }
 
-Result TeensyPort::turn(double radians, bool absolute, std::function<void(const Result&)> done) {
+Result TeensyPort::turn(double radians, bool absolute, std::string_view client,
+                        std::function<void(const Result&)> done) {
     if (Result r = gate_.state_error(); !r.ok())
         return r;
     if (turn_done_)
         return {Status::Busy, "a turn is already running"};
     if (!std::isfinite(radians))
         return {Status::InvalidValue, "the angle must be a finite number of radians"};
+    if (Result r = gate_.accept_command(client); !r.ok())
+        return r;
     auto e = absolute ? link_.turn_to(radians) : link_.turn(radians);
     if (Result r = teensy_result(e, absolute ? "Turn to" : "Turn"); !r.ok())
         return r;

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <string_view>
 #include <vector>
 
 namespace caracara {
@@ -30,8 +31,7 @@ struct TeensyTelemetry {
 
 class TeensyPort {
 public:
-    TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, const CommandGate& gate,
-               VehicleEvents& events);
+    TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate, VehicleEvents& events);
     ~TeensyPort() { close(); }
 
     int open(); // 0 or -errno; a missing Teensy is not fatal to the daemon
@@ -40,19 +40,22 @@ public:
 
     // One frame: the three orientation axes, then one distance sensor, in turn.
     void poll();
-    // Kill and power-off: Stop halts the wheels and ends a running turn.
+    // Kill, power-off, start and exit: Stop halts the wheels and ends a running turn.
     void stop_motion();
+    // The command timeout or the commanding client gone: Stop, if the wheels or a turn move.
+    void stop_if_moving();
     // Ends a running turn with `r` (kill, power-off, shutdown).
     void cancel_turn(const Result& r);
 
     Result set_leds(int red, int green, int blue);
-    Result set_speed(int left, int right);
+    // Wheels and turns are motors: a command from `client`, under the command timeout.
+    Result set_speed(int left, int right, std::string_view client);
     Result stop(int duty);
     Result servo(int id, int degrees);
     Result distance(int sensor, uint16_t& mm);
     // Starts a Turn (relative) or Turn to (absolute); `done` runs when the Teensy confirms
     // completion, or on failure. Returns an error at once if it cannot start.
-    Result turn(double radians, bool absolute, std::function<void(const Result&)> done);
+    Result turn(double radians, bool absolute, std::string_view client, std::function<void(const Result&)> done);
 
     const TeensyTelemetry& telemetry() const { return tm_; }
     const TeensyLinkCounters& counters() const { return link_.counters(); }
@@ -64,12 +67,13 @@ private:
     void finish_turn(const Result& r);
 
     sd_event* event_;
-    const CommandGate& gate_;
+    CommandGate& gate_;
     VehicleEvents& events_;
     SpiDev spi_;
     TeensyLink link_;
     TeensyTelemetry tm_;
     std::array<uint8_t, 3> leds_{};
+    bool wheels_moving_ = false;
     unsigned poll_index_ = 0;
     teensy::ConfirmHandshake handshake_;
     std::function<void(const Result&)> turn_done_;

@@ -49,8 +49,13 @@ void Vehicle::handle(const SafetyAction& a) {
     const bool assert_first = a.state_changed && safety_.kill_output_asserted();
     if (assert_first)
         lines_.set_kill_output(true);
-    if (a.zero_outputs)
+    if (a.zero_outputs) {
         bus_.zero_all();
+        // The wheels are motors too. A kill or power-off stops them itself, and tells a
+        // running turn why.
+        if (!safety_.kill_output_asserted())
+            teensy_.stop_if_moving();
+    }
     if (a.state_changed) {
         changes |= kChangeState;
         if (!assert_first)
@@ -143,6 +148,18 @@ Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std
     arm_deadline();
     const bool changed = apply(wanted, b, mix_saturated);
     events_.changed((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
+    return {};
+}
+
+Result Vehicle::accept_command(std::string_view client) {
+    if (Result r = state_error(); !r.ok())
+        return r;
+    const std::string previous = safety_.commanding_client();
+    if (!safety_.accept_command(monotonic_ns(), client).ok())
+        return state_error();
+    arm_deadline();
+    if (previous != safety_.commanding_client())
+        events_.changed(kChangeController);
     return {};
 }
 

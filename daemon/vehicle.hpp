@@ -51,6 +51,7 @@ public:
     void kill_switch_read(bool set) override;
     Result state_error() const override;
     bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
+    Result accept_command(std::string_view client) override;
 
     // What thruster i is to be ordered now: its applied value while the vehicle may drive.
     int32_t order_value(size_t i) const { return safety_.may_drive() ? applied_[i] : 0; }

@@ -30,6 +30,7 @@ std::string VehicleDaemon::start() {
     if (int r = teensy_.open(); r < 0)
         log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
                     errno_name(-r).c_str());
+    teensy_.stop_motion(); // the wheels too may have been left running by an earlier instance
     if (std::string e = vehicle_.start(event_); !e.empty())
         return e;
     if (std::string e = loop_.start(); !e.empty())
@@ -47,6 +48,7 @@ void VehicleDaemon::shutdown() {
     recovery_.stop();
     lines_.close();
     bus_.zero_all();
+    teensy_.stop_motion();
     teensy_.close();
     bus_.close();
 }

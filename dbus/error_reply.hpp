@@ -9,6 +9,12 @@
 
 namespace caracara::dbus {
 
+// The caller's unique bus name: who commands the vehicle, for the command timeout and client loss.
+inline std::string sender(sd_bus_message* m) {
+    const char* s = sd_bus_message_get_sender(m);
+    return s ? s : "";
+}
+
 std::string error_name(Status s);
 // Replies to `call` (now, or later for a deferred reply): an empty return, or the error.
 int reply(sd_bus_message* call, const Result& result);

@@ -17,7 +17,7 @@ int m_set_speed(sd_bus_message* m, void* userdata, sd_bus_error*) {
     int32_t left = 0, right = 0;
     if (int r = sd_bus_message_read(m, "ii", &left, &right); r < 0)
         return r;
-    return reply(m, ctl(userdata).set_speed(left, right));
+    return reply(m, ctl(userdata).set_speed(left, right, sender(m)));
 }
 
 int m_stop(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -50,7 +50,7 @@ int turn(sd_bus_message* m, void* userdata, bool absolute) {
         return r;
     // Replied to when the Teensy confirms; other calls are served meanwhile.
     auto call = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
-    Result res = ctl(userdata).turn(radians, absolute, [call](const Result& done) { reply(call.get(), done); });
+    Result res = ctl(userdata).turn(radians, absolute, sender(m), [call](const Result& done) { reply(call.get(), done); });
     return res.ok() ? 1 : reply(m, res);
 }
 

@@ -14,11 +14,6 @@ namespace {
 
 Vehicle& ctl(void* userdata) { return static_cast<VehicleDaemon*>(userdata)->vehicle(); }
 
-std::string sender(sd_bus_message* m) {
-    const char* s = sd_bus_message_get_sender(m);
-    return s ? s : "";
-}
-
 int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
     const void* p = nullptr;
     size_t n = 0;

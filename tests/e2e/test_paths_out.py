@@ -10,6 +10,8 @@ import unittest
 
 import os
 
+import dbus
+
 import harness
 from harness import (ERR, MOTORS, ZERO, DEFAULT_MT, Rig, VehicleTestCase, binary, error_name, poll, speed_byte)
 
@@ -128,6 +130,79 @@ class FaultsToldTest(VehicleTestCase):
         print("\nlog lines: raised %d, cleared %d" % (raised, cleared))
         self.assertEqual((raised, cleared), (1, 1), log[-2000:])
         self.assertNotIn("Warning: thruster 3", rig.ctl("status").stdout)
+
+
+def front_wheels(rig):
+    w = rig.sim_teensy("Wheels")
+    return (float(w[0]), float(w[1]))
+
+
+def stop_frames(rig):
+    return int(rig.sim_teensy_call("CommandCount", dbus.Byte(0x05), signature="y")[1])
+
+
+class WheelsAreMotorsTest(VehicleTestCase):
+    """The Teensy's SetSpeed is a command like SetThrust: the command timeout and the commanding
+    client leaving stop the wheels."""
+    CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 400}
+
+    def setUp(self):
+        self.rig.reset()
+
+    def set_speed(self, left, right):
+        return self.rig.vcall("SetSpeed", left, right, signature="ii", path=harness.TEENSY_PATH,
+                              iface=harness.TEENSY_IFACE)
+
+    def test_command_timeout_stops_the_wheels(self):
+        self.set_speed(60, 60)
+        self.assertEqual(front_wheels(self.rig), (60.0, 60.0))
+        self.assertNotEqual(self.rig.vget("Controller"), "")
+        t0 = time.monotonic()
+        poll(lambda: front_wheels(self.rig) == (0.0, 0.0), 5, message="the wheels kept turning")
+        took = time.monotonic() - t0
+        print("\nwheels stopped %.0f ms after SetSpeed (command timeout 400 ms)" % (took * 1000))
+        self.assertGreater(took, 0.3)
+
+    def test_client_leaving_stops_the_wheels(self):
+        # A client process commands the wheels itself, then leaves.
+        script = (
+            "import sys, dbus\n"
+            "bus = dbus.bus.BusConnection(sys.argv[1])\n"
+            "t = bus.get_object('org.caracara.Vehicle1', '/org/caracara/Vehicle1/teensy', introspect=False)\n"
+            "t.SetSpeed(dbus.Int32(40), dbus.Int32(-40), dbus_interface='org.caracara.Vehicle1.Teensy')\n"
+            "print(bus.get_unique_name(), flush=True)\n"
+            "sys.stdin.read()\n")
+        c = subprocess.Popen([harness.PYTHON, "-c", script, self.rig.address], stdin=subprocess.PIPE,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        who = c.stdout.readline().strip()
+        self.assertTrue(who, c.stderr.read() if c.poll() is not None else "")
+        poll(lambda: front_wheels(self.rig) == (40.0, -40.0), 5)
+        self.assertEqual(self.rig.vget("Controller"), who)
+        c.stdin.close()
+        c.wait(10)
+        poll(lambda: front_wheels(self.rig) == (0.0, 0.0), 5, message="the wheels kept turning after the client left")
+
+    def test_a_refused_speed_changes_nothing(self):
+        time.sleep(0.15)
+        self.assertEqual(error_name(self.set_speed, 500, 0), ERR + "OutOfRange")
+        # Not taken as a command: the age of the last one kept growing.
+        self.assertGreaterEqual(int(self.rig.vget("CommandAgeMs")), 150)
+
+
+class WheelsStopAtStartAndExitTest(unittest.TestCase):
+
+    def test_start_and_sigterm_send_stop(self):
+        rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
+        self.addCleanup(rig.stop_checked)
+        rig.start(daemon=False)
+        before = stop_frames(rig)
+        rig.start_daemon()
+        self.assertGreater(stop_frames(rig), before, "no Stop to the Teensy at start")
+        rig.arm()
+        rig.vcall("SetSpeed", 30, 30, signature="ii", path=harness.TEENSY_PATH, iface=harness.TEENSY_IFACE)
+        self.assertEqual(front_wheels(rig), (30.0, 30.0))
+        self.assertEqual(rig.stop_daemon(), 0)
+        self.assertEqual(front_wheels(rig), (0.0, 0.0), "SIGTERM left the wheels turning")
 
 
 class KillAndPowerOffPacketTest(unittest.TestCase):
