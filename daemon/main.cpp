@@ -159,7 +159,7 @@ int main(int argc, char** argv) {
         std::string perr;
         if (!make_hardware(hardware, panic_hw, perr))
             log_warning("emergency stop not armed: %s", perr.c_str());
-        else if (std::string e = estop.arm(std::move(panic_hw.io), cr.config->i2c.device, cr.config->thrusters); !e.empty())
+        else if (std::string e = estop.arm(std::move(panic_hw.io), cr.config->i2c.device, cr.config->thrusters, cr.config->spi); !e.empty())
             log_warning("emergency stop not armed: %s", e.c_str());
         else
             EmergencyStop::install_fatal_handlers(&estop);

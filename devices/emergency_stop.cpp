@@ -11,7 +11,7 @@
 namespace caracara {
 
 std::string EmergencyStop::arm(std::unique_ptr<DeviceIo> io, const std::string& i2c_path,
-                               std::span<const ThrusterConfig> thrusters) {
+                               std::span<const ThrusterConfig> thrusters, const SpiSettings& spi) {
     if (thrusters.size() > prepared_.size())
         return "too many thrusters";
     int fd = io->open(i2c_path.c_str(), O_RDWR);
@@ -36,6 +36,13 @@ std::string EmergencyStop::arm(std::unique_ptr<DeviceIo> io, const std::string& 
     count_ = thrusters.size();
     io_ = std::move(io);
     fd_ = fd;
+    if (auto stop = teensy::encode_stop(0); stop.ok()) {
+        auto dev = std::make_unique<SpiDev>(*io_, spi.device, spi.spi);
+        if (dev->open() == 0) {
+            stop_frame_ = stop.value;
+            spi_ = std::move(dev);
+        }
+    }
     return {};
 }
 
@@ -54,6 +61,8 @@ void EmergencyStop::fire() noexcept {
         io_->ioctl(fd_, I2C_RDWR, &d);
     }
     // Other muxes may still have a channel on; the next daemon instance sorts that out.
+    if (spi_) // SpiDev::transfer allocates nothing; one try, no busy retries
+        spi_->transfer(stop_frame_.span(), std::span<uint8_t>(stop_reply_.data(), stop_frame_.size));
 }
 
 namespace {

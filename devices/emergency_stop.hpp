@@ -1,10 +1,14 @@
 // Zero orders for every thruster, prepared in advance on a device connection of their own, so
 // a fatal signal handler can send them without allocating, locking or touching state the
-// crash may have left half-written. Only async-signal-safe calls happen in fire().
+// crash may have left half-written. Only async-signal-safe calls happen in fire(). The
+// Teensy's wheels are motors too: a prepared Stop frame goes out after the zero orders.
 #pragma once
 
 #include "platform/device_io.hpp"
+#include "core/config.hpp"
 #include "devices/thruster_driver.hpp"
+#include "platform/spi_dev.hpp"
+#include "protocol/teensy_codec.hpp"
 
 #include <array>
 #include <csignal>
@@ -18,8 +22,10 @@ namespace caracara {
 class EmergencyStop {
 public:
     // Opens `i2c_path` on `io` (its own connection / file description) and encodes a zero order
-    // per thruster, with its mux select. Returns "" or why it could not.
-    std::string arm(std::unique_ptr<DeviceIo> io, const std::string& i2c_path, std::span<const ThrusterConfig> thrusters);
+    // per thruster, with its mux select; and, when the Teensy's SPI device opens, a Stop for
+    // its wheels (a missing Teensy is not an error). Returns "" or why it could not.
+    std::string arm(std::unique_ptr<DeviceIo> io, const std::string& i2c_path, std::span<const ThrusterConfig> thrusters,
+                    const SpiSettings& spi);
     // Sends the zero orders. Async-signal-safe; errors are ignored (there is no one to tell).
     void fire() noexcept;
     bool armed() const { return fd_ >= 0; }
@@ -45,6 +51,9 @@ private:
         bool has_mux = false;
     };
     std::unique_ptr<DeviceIo> io_;
+    std::unique_ptr<SpiDev> spi_;
+    teensy::Frame stop_frame_;
+    std::array<uint8_t, teensy::kMaxFrame> stop_reply_{};
     int fd_ = -1;
     std::array<Prepared, 8> prepared_{};
     size_t count_ = 0;

@@ -9,6 +9,7 @@ import time
 import unittest
 
 import os
+import signal
 
 import dbus
 
@@ -203,6 +204,21 @@ class WheelsStopAtStartAndExitTest(unittest.TestCase):
         self.assertEqual(front_wheels(rig), (30.0, 30.0))
         self.assertEqual(rig.stop_daemon(), 0)
         self.assertEqual(front_wheels(rig), (0.0, 0.0), "SIGTERM left the wheels turning")
+
+    def test_a_crash_sends_stop(self):
+        rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
+        self.addCleanup(rig.stop_checked)
+        rig.start()
+        rig.arm()
+        rig.thrust([1500] * MOTORS)
+        rig.vcall("SetSpeed", 30, -30, signature="ii", path=harness.TEENSY_PATH, iface=harness.TEENSY_IFACE)
+        rig.wait_sim_speeds([speed_byte(1500)] * MOTORS)
+        proc = rig.procs["caracarad"]
+        proc.send_signal(signal.SIGSEGV)
+        proc.wait(30)
+        self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+        self.assertEqual(front_wheels(rig), (0.0, 0.0), "a crash left the wheels turning")
+        rig.start_daemon()  # as systemd would; stop_checked wants a clean exit at the end
 
 
 class KillAndPowerOffPacketTest(unittest.TestCase):
