@@ -20,6 +20,7 @@ std::string_view status_name(Status s) {
     case Status::LinkError: return "LinkError";
     case Status::Hardware: return "Hardware";
     case Status::UnknownProfile: return "UnknownProfile";
+    case Status::BusLost: return "BusLost";
     }
     return "Hardware";
 }

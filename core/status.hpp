@@ -25,6 +25,7 @@ enum class Status {
     LinkError,
     Hardware,
     UnknownProfile,
+    BusLost,
 };
 std::string_view status_name(Status s); // "OutOfRange", ...
 

@@ -31,11 +31,9 @@ void BusRecovery::bus_locked_up(const std::string& reason) {
         return;
     if (!config_.recovery.enabled) {
         // Nothing to clear the bus with: report it and keep trying the transfers each tick.
-        tm.state = BusState::Lost;
-        tm.last_recovery_error = reason;
         log_error("I2C bus %s lost (%s); recovery is not configured", bus_.device().c_str(), reason.c_str());
         events_.bus_lost(reason);
-        events_.changed(kChangeState | kChangeBus);
+        declare_lost(reason);
         return;
     }
     bus_.set_recovering(true);
@@ -47,6 +45,35 @@ void BusRecovery::bus_locked_up(const std::string& reason) {
     events_.changed(kChangeBus);
     // From the event loop, not from inside the transfer that noticed it.
     schedule(0);
+    // Commands behave as before during a short recovery; one that outlasts the command timeout
+    // has left the thrusters unreachable for longer than any command may stand.
+    const uint64_t at_us = (monotonic_ns() + ms_to_ns(config_.control.command_timeout_ms)) / 1000;
+    if (!lost_timer_) {
+        sd_event_source* s = nullptr;
+        if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, at_us, 1, on_lost_timer, this) < 0)
+            return;
+        lost_timer_.reset(s);
+    }
+    sd_event_source_set_time(lost_timer_.get(), at_us);
+    sd_event_source_set_enabled(lost_timer_.get(), SD_EVENT_ONESHOT);
+}
+
+int BusRecovery::on_lost_timer(sd_event_source*, uint64_t, void* userdata) {
+    auto* self = static_cast<BusRecovery*>(userdata);
+    if (self->bus_.recovering())
+        self->declare_lost("locked up for longer than the command timeout (" +
+                           std::to_string(self->config_.control.command_timeout_ms) + " ms)");
+    return 0;
+}
+
+void BusRecovery::declare_lost(const std::string& why) {
+    BusTelemetry& tm = bus_.telemetry();
+    if (tm.state == BusState::Lost)
+        return;
+    tm.state = BusState::Lost;
+    tm.last_recovery_error = why;
+    vehicle_.kill(KillSource::Fault, "I2C bus lost: " + why);
+    events_.changed(kChangeState | kChangeBus);
 }
 
 void BusRecovery::schedule(uint64_t delay_ns) {
@@ -130,6 +157,8 @@ void BusRecovery::finish() {
         return;
     }
     bus_.set_recovering(false);
+    if (lost_timer_)
+        sd_event_source_set_enabled(lost_timer_.get(), SD_EVENT_OFF);
     BusTelemetry& tm = bus_.telemetry();
     const bool was_lost = tm.state == BusState::Lost;
     tm.state = BusState::Ok;
@@ -149,11 +178,8 @@ void BusRecovery::failed(const std::string& why) {
     phase_ = Phase::Backoff;
     log_error("I2C bus recovery attempt %u failed: %s", policy_.attempt(), why.c_str());
     const RecoveryPolicy::Failure f = policy_.failed();
-    if (f.lost) {
-        tm.state = BusState::Lost;
-        vehicle_.kill(KillSource::Fault, "I2C bus recovery failed: " + why);
-        events_.changed(kChangeState);
-    }
+    if (f.lost)
+        declare_lost("recovery failed: " + why);
     events_.changed(kChangeBus);
     schedule(f.retry_in_ns);
 }

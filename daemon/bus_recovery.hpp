@@ -1,8 +1,9 @@
 // Recovering a locked I2C bus (DESIGN.md, NXP UM10204 "bus clear"): close the adapter, unbind
 // its platform driver, clock SCL through the GPIO lines until SDA is released and send a STOP,
 // rebind, wait for the device node, re-send the current orders (a pending kill first). Bounded
-// attempts with backoff (RecoveryPolicy); when they are used up the vehicle is killed and the
-// bus reported lost, and slow retries go on in the background. Owns its timer.
+// attempts with backoff (RecoveryPolicy); when they are used up, or the lockup outlasts the
+// command timeout, the bus is reported lost and the vehicle killed (source bus), and slow
+// retries go on in the background. Owns its timers.
 #pragma once
 
 #include "core/config.hpp"
@@ -25,7 +26,10 @@ public:
                 Vehicle& vehicle, VehicleEvents& events);
 
     void bus_locked_up(const std::string& reason) override;
-    void stop() { timer_.reset(); }
+    void stop() {
+        timer_.reset();
+        lost_timer_.reset();
+    }
 
 private:
     enum class Phase { Idle, WaitingNode, Backoff };
@@ -35,6 +39,9 @@ private:
     void wait_node();
     void finish();
     void failed(const std::string& why);
+    // The thrusters cannot be reached: the vehicle is killed (source bus) and stays so.
+    void declare_lost(const std::string& why);
+    static int on_lost_timer(sd_event_source*, uint64_t usec, void* userdata);
 
     sd_event* event_;
     const DaemonConfig& config_;
@@ -48,6 +55,7 @@ private:
     uint64_t node_deadline_ns_ = 0;
     uint32_t last_pulses_ = 0;
     SourcePtr timer_;
+    SourcePtr lost_timer_; // a lockup longer than the command timeout is a lost bus
 };
 
 } // namespace caracara

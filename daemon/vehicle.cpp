@@ -25,6 +25,11 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       profile_(find_profile(config, config.control.profile)) {}
 
 Result Vehicle::state_error() const {
+    // Nothing moves while the thrusters cannot be reached: no order could get there, and each
+    // thruster keeps whatever it was last told. Killed too, but this is what to fix first.
+    if (bus_.telemetry().state == BusState::Lost && safety_.state() != SafetyState::PoweredOff)
+        return {Status::BusLost, "the I2C bus to the thrusters is lost (" + bus_.telemetry().last_recovery_error +
+                                     "); the vehicle stays killed until it is back and ClearKill is called"};
     switch (safety_.state()) {
     case SafetyState::Ready: return {};
     case SafetyState::Arming: return {Status::Arming, "the vehicle is arming; commands are accepted when it is ready"};
@@ -266,6 +271,8 @@ Result Vehicle::kill(KillSource source, std::string_view reason) {
 }
 
 Result Vehicle::clear_kill() {
+    if (bus_.telemetry().state == BusState::Lost && safety_.state() == SafetyState::Killed)
+        return {Status::BusLost, "the I2C bus to the thrusters is not back yet; the kill stays"};
     SafetyAction a = safety_.clear_kill(monotonic_ns());
     switch (a.error) {
     case SafetyError::None: break;
