@@ -191,32 +191,21 @@ int TeensyPort::on_turn_step(sd_event_source*, uint64_t, void* userdata) {
 void TeensyPort::turn_step() {
     // Drive the handshake without blocking: send what it asks for, then sleep until it
     // wants the next poll.
-    for (;;) {
-        auto step = handshake_.next(monotonic_ns());
-        switch (step.action) {
-        case teensy::ConfirmHandshake::Action::Send: {
-            auto reply = link_.execute(step.frame);
-            teensy::TeensyResult<uint8_t> res;
-            if (!reply.ok())
-                res.error = reply.error;
-            else
-                res = teensy::decode_confirm(reply.value);
-            handshake_.on_result(res, monotonic_ns());
-            continue;
-        }
-        case teensy::ConfirmHandshake::Action::Wait:
-            sd_event_source_set_time(turn_source_.get(), step.at_ns / 1000);
-            sd_event_source_set_enabled(turn_source_.get(), SD_EVENT_ONESHOT);
-            return;
-        case teensy::ConfirmHandshake::Action::Done:
-            finish_turn({});
-            return;
-        case teensy::ConfirmHandshake::Action::Failed:
-        case teensy::ConfirmHandshake::Action::Idle:
-            finish_turn(teensy_result(step.error == teensy::TeensyError::None ? teensy::TeensyError::LinkError : step.error,
-                                      "turn confirmation"));
-            return;
-        }
+    const auto step = link_.advance(handshake_);
+    switch (step.action) {
+    case teensy::ConfirmHandshake::Action::Wait:
+        sd_event_source_set_time(turn_source_.get(), step.at_ns / 1000);
+        sd_event_source_set_enabled(turn_source_.get(), SD_EVENT_ONESHOT);
+        return;
+    case teensy::ConfirmHandshake::Action::Done:
+        finish_turn({});
+        return;
+    case teensy::ConfirmHandshake::Action::Send: // advance() never stops on a Send
+    case teensy::ConfirmHandshake::Action::Failed:
+    case teensy::ConfirmHandshake::Action::Idle:
+        finish_turn(teensy_result(step.error == teensy::TeensyError::None ? teensy::TeensyError::LinkError : step.error,
+                                  "turn confirmation"));
+        return;
     }
 }
 

@@ -1,5 +1,7 @@
 #include "devices/teensy_link.hpp"
 
+#include "core/clock.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -110,6 +112,21 @@ TeensyResult<uint8_t> TeensyLink::confirm(uint8_t value) {
     if (!r.ok())
         return {r.error, 0};
     return decode_confirm(r.value);
+}
+
+teensy::ConfirmHandshake::Step TeensyLink::advance(teensy::ConfirmHandshake& handshake) {
+    for (;;) {
+        auto step = handshake.next(monotonic_ns());
+        if (step.action != teensy::ConfirmHandshake::Action::Send)
+            return step;
+        auto reply = execute(step.frame);
+        teensy::TeensyResult<uint8_t> res;
+        if (!reply.ok())
+            res.error = reply.error;
+        else
+            res = teensy::decode_confirm(reply.value);
+        handshake.on_result(res, monotonic_ns());
+    }
 }
 
 } // namespace caracara

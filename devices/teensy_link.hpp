@@ -4,6 +4,8 @@
 #pragma once
 
 #include "platform/spi_dev.hpp"
+#include "protocol/confirm_handshake.hpp"
+#include "protocol/retry_tracker.hpp"
 #include "protocol/teensy_codec.hpp"
 
 #include <cstdint>
@@ -26,6 +28,10 @@ public:
 
     // Sends `frame` until it is acked, busy retries run out, or a link/IO error ends it.
     // On success `value` is the decoded reply (status Ok, answer bytes filled in).
+    // Drives a Confirm handshake: sends the frames it asks for, feeding each answer back,
+    // until it asks to wait, is done or failed; returns that step. One home for the loop the
+    // daemon's Turn and the tests share.
+    teensy::ConfirmHandshake::Step advance(teensy::ConfirmHandshake& handshake);
     teensy::TeensyResult<teensy::Reply> execute(const teensy::Frame& frame);
 
     // Each validates its arguments (TeensyLimits from the config) before anything is sent.

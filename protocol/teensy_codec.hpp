@@ -1,7 +1,8 @@
 // The Raspberry Pi <-> Teensy SPI protocol (seeds/raspi-teensy-spi-protocol.md, with the byte
 // order, busy/retry policy and the 0x09 extension defined in docs/teensy-protocol.md).
 // Pure logic: frame encoding with input validation, reply classification and decoding, the
-// busy/link-error retry decision, and the Confirm handshake. No system calls, no clock.
+// (the busy/link-error retry decision and the Confirm handshake are in retry_tracker.hpp and
+// confirm_handshake.hpp). No system calls, no clock.
 #pragma once
 
 #include "core/link_config.hpp"
@@ -154,78 +155,5 @@ void put_u16_le(uint8_t* out, uint16_t v);
 void put_f32_le(uint8_t* out, float v);
 uint16_t get_u16_le(const uint8_t* in);
 float get_f32_le(const uint8_t* in);
-
-// What the frame engine does after each reply, kept here so it can be tested without SPI.
-enum class RetryAction : uint8_t {
-    Done,             // Ok: decode the answer
-    ResendAfterDelay, // wait busy_delay_us, then send the very same frame again
-    Fail,             // give up with `error`
-};
-
-struct RetryDecision {
-    RetryAction action = RetryAction::Fail;
-    TeensyError error = TeensyError::None;
-};
-
-// One instance per execute(): counts the busy and link-error resends of one frame.
-class RetryTracker {
-public:
-    RetryTracker(const RetryPolicy& policy, const CommandInfo& command)
-        : policy_(policy), command_(command) {}
-    RetryDecision on_reply(FrameStatus status);
-    unsigned busy_retries() const { return busy_retries_; }
-    unsigned link_retries() const { return link_retries_; }
-
-private:
-    RetryPolicy policy_;
-    CommandInfo command_;
-    unsigned busy_retries_ = 0;
-    unsigned link_retries_ = 0;
-};
-
-// After Turn / Turn to was accepted: poll Confirm(0) until the answer is 0xFF, then send
-// Confirm(1) once as acknowledgement. Non-blocking: next() says which frame to send and when;
-// the owner sends it (TeensyLink::execute) and reports the outcome with on_result().
-class ConfirmHandshake {
-public:
-    enum class State : uint8_t { Idle, Polling, Acknowledging, Done, Failed };
-    enum class Action : uint8_t {
-        Idle,   // start() not called
-        Send,   // send `frame` now, then call on_result()
-        Wait,   // nothing to send before `at_ns`
-        Done,   // task finished and acknowledged
-        Failed, // see `error`
-    };
-    struct Step {
-        Action action = Action::Idle;
-        Frame frame{};
-        uint64_t at_ns = 0;
-        TeensyError error = TeensyError::None;
-    };
-
-    explicit ConfirmHandshake(ConfirmHandshakeConfig config = {}) : config_(config) {}
-
-    void start(uint64_t now_ns);
-    Step next(uint64_t now_ns);
-    // The outcome of the frame last returned with Action::Send: the Confirm answer byte, or
-    // the link error. Ignored when no Send is outstanding.
-    void on_result(const TeensyResult<uint8_t>& result, uint64_t now_ns);
-
-    State state() const { return state_; }
-    TeensyError error() const { return error_; }
-    TeensyError last_link_error() const { return last_link_error_; }
-    unsigned polls() const { return polls_; }
-
-private:
-    ConfirmHandshakeConfig config_;
-    State state_ = State::Idle;
-    TeensyError error_ = TeensyError::None;
-    TeensyError last_link_error_ = TeensyError::None;
-    uint64_t deadline_ns_ = 0;
-    uint64_t next_send_ns_ = 0;
-    unsigned polls_ = 0;
-    unsigned acks_sent_ = 0;
-    bool awaiting_ = false;
-};
 
 } // namespace caracara::teensy
