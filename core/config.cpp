@@ -1,6 +1,7 @@
 #include "core/config.hpp"
 
 #include "core/hex.hpp"
+#include "core/toml_checker.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -43,174 +44,6 @@ SafetyConfig safety_config(const DaemonConfig& config) {
 }
 
 namespace {
-
-// What the user wrote, for "got ..." in messages.
-std::string written(const toml::node& n) {
-    if (auto s = n.as_string())
-        return "\"" + s->get() + "\"";
-    if (auto i = n.as_integer())
-        return std::to_string(i->get());
-    if (auto f = n.as_floating_point()) {
-        std::ostringstream os;
-        os << f->get();
-        return os.str();
-    }
-    if (auto b = n.as_boolean())
-        return b->get() ? "true" : "false";
-    if (n.is_table())
-        return "a table";
-    if (n.is_array())
-        return "an array";
-    return "a date/time";
-}
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-    std::vector<std::size_t> row(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j)
-        row[j] = j;
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        std::size_t diag = row[0];
-        row[0] = i;
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            const std::size_t up = row[j];
-            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0u : 1u)});
-            diag = up;
-        }
-    }
-    return row[b.size()];
-}
-
-using Keys = std::initializer_list<std::string_view>;
-
-// Collects every problem instead of stopping at the first, so one run of the daemon shows
-// the user everything to fix.
-class Checker {
-public:
-    std::vector<std::string> errors;
-
-    void fail(const std::string& key, const std::string& problem, const toml::node* at = nullptr) {
-        std::string m = key + ": " + problem;
-        if (at && at->source().begin.line > 0)
-            m += " (line " + std::to_string(at->source().begin.line) + ")";
-        errors.push_back(std::move(m));
-    }
-
-    // Unknown keys are errors: a misspelt key would otherwise silently keep its default.
-    void only_keys(const toml::table& t, const std::string& prefix, Keys allowed) {
-        for (auto&& [k, v] : t) {
-            const std::string_view name = k.str();
-            if (std::find(allowed.begin(), allowed.end(), name) != allowed.end())
-                continue;
-            std::string hint;
-            for (std::string_view a : allowed)
-                if (edit_distance(name, a) <= 2) {
-                    hint = "; did you mean '" + prefix + std::string(a) + "'?";
-                    break;
-                }
-            if (hint.empty()) {
-                hint = "; known keys: ";
-                bool first = true;
-                for (std::string_view a : allowed) {
-                    hint += (first ? "" : ", ") + std::string(a);
-                    first = false;
-                }
-            }
-            std::string m = "unknown key '" + prefix + std::string(name) + "'" + hint;
-            if (v.source().begin.line > 0)
-                m += " (line " + std::to_string(v.source().begin.line) + ")";
-            errors.push_back(std::move(m));
-        }
-    }
-
-    const toml::table* table(const toml::table& parent, const std::string& prefix, std::string_view key) {
-        const toml::node* n = parent.get(key);
-        if (!n)
-            return nullptr;
-        if (!n->is_table()) {
-            fail(prefix + std::string(key), "must be a table, got " + written(*n), n);
-            return nullptr;
-        }
-        return n->as_table();
-    }
-
-    // Integer in lo..hi; `range` replaces the default "between lo and hi" wording.
-    template <typename T>
-    bool integer(const toml::table& t, const std::string& prefix, std::string_view key, int64_t lo, int64_t hi,
-                 T& out, const std::string& range = {}) {
-        const toml::node* n = t.get(key);
-        if (!n)
-            return false;
-        const std::string full = prefix + std::string(key);
-        const auto* iv = n->as_integer();
-        if (!iv) {
-            fail(full, "must be an integer, got " + written(*n), n);
-            return false;
-        }
-        const int64_t v = iv->get();
-        if (v < lo || v > hi) {
-            fail(full,
-                 "must be " + (range.empty() ? "between " + std::to_string(lo) + " and " + std::to_string(hi) : range) +
-                     ", got " + std::to_string(v),
-                 n);
-            return false;
-        }
-        out = static_cast<T>(v);
-        return true;
-    }
-
-    template <typename T>
-    bool integer(const toml::table& t, const std::string& prefix, std::string_view key, int64_t lo, int64_t hi,
-                 std::optional<T>& out, const std::string& range = {}) {
-        T v{};
-        if (!integer(t, prefix, key, lo, hi, v, range))
-            return false;
-        out = v;
-        return true;
-    }
-
-    bool boolean(const toml::table& t, const std::string& prefix, std::string_view key, bool& out) {
-        const toml::node* n = t.get(key);
-        if (!n)
-            return false;
-        const auto* b = n->as_boolean();
-        if (!b) {
-            fail(prefix + std::string(key), "must be true or false, got " + written(*n), n);
-            return false;
-        }
-        out = b->get();
-        return true;
-    }
-
-    bool string(const toml::table& t, const std::string& prefix, std::string_view key, std::string& out,
-                bool allow_empty = false) {
-        const toml::node* n = t.get(key);
-        if (!n)
-            return false;
-        const auto* s = n->as_string();
-        if (!s) {
-            fail(prefix + std::string(key), "must be a string, got " + written(*n), n);
-            return false;
-        }
-        if (!allow_empty && s->get().empty()) {
-            fail(prefix + std::string(key), "must not be empty", n);
-            return false;
-        }
-        out = s->get();
-        return true;
-    }
-
-    bool path(const toml::table& t, const std::string& prefix, std::string_view key, std::string& out) {
-        std::string v;
-        if (!string(t, prefix, key, v))
-            return false;
-        if (v.front() != '/') {
-            fail(prefix + std::string(key), "must be an absolute path, got \"" + v + "\"", t.get(key));
-            return false;
-        }
-        out = v;
-        return true;
-    }
-};
 
 void parse_i2c(Checker& c, const toml::table& t, I2cSettings& out) {
     const std::string p = "i2c.";
@@ -312,34 +145,23 @@ bool parse_thruster(Checker& c, const toml::table& t, std::size_t i, ThrusterCon
 void check_thruster_set(Checker& c, const std::array<ThrusterConfig, kMotorCount>& set,
                         const std::array<bool, kMotorCount>& valid) {
     auto name = [](std::size_t i) { return "thruster[" + std::to_string(i) + "]"; };
-    for (std::size_t i = 0; i < kMotorCount; ++i) {
-        if (!valid[i])
+    for (const ThrusterConflict& k : thruster_conflicts(set, valid)) {
+        const ThrusterConfig& t = set[k.thruster];
+        if (k.kind == ThrusterConflict::Kind::MuxAddress) {
+            c.fail(name(k.thruster) + ".address", hex(t.mt) + " (7-bit " + hex(mt_addr7(t.mt)) +
+                                                      ") is the address of the multiplexer used by " + name(k.other));
             continue;
-        const ThrusterConfig& a = set[i];
-        const uint16_t a7 = mt_addr7(a.mt);
-        for (std::size_t m = 0; m < kMotorCount; ++m) {
-            if (valid[m] && set[m].mux && set[m].mux->addr7 == a7) {
-                c.fail(name(i) + ".address",
-                       hex(a.mt) + " (7-bit " + hex(a7) + ") is the address of the multiplexer used by " + name(m));
-                break;
-            }
         }
-        for (std::size_t j = i + 1; j < kMotorCount; ++j) {
-            if (!valid[j] || mt_addr7(set[j].mt) != a7)
-                continue;
-            const ThrusterConfig& b = set[j];
-            if (a.mux && b.mux && (a.mux->addr7 != b.mux->addr7 || a.mux->channel != b.mux->channel))
-                continue;  // separate segments: the driver enables one channel at a time
-            std::string why;
-            if (!a.mux && !b.mux)
-                why = "both are on the main bus";
-            else if (a.mux && b.mux)
-                why = "both are " + segment_name(a);
-            else
-                why = name(a.mux ? j : i) + " is on the main bus, which an enabled mux channel joins to " +
-                      name(a.mux ? i : j) + "'s segment";
-            c.fail(name(j) + ".address", hex(b.mt) + " is also the address of " + name(i) + "; " + why);
-        }
+        const ThrusterConfig& o = set[k.other];
+        std::string why;
+        if (!o.mux && !t.mux)
+            why = "both are on the main bus";
+        else if (o.mux && t.mux)
+            why = "both are " + segment_name(o);
+        else
+            why = name(o.mux ? k.thruster : k.other) + " is on the main bus, which an enabled mux channel joins to " +
+                  name(o.mux ? k.other : k.thruster) + "'s segment";
+        c.fail(name(k.thruster) + ".address", hex(t.mt) + " is also the address of " + name(k.other) + "; " + why);
     }
 }
 
@@ -370,14 +192,7 @@ void parse_thrusters(Checker& c, const toml::table& root, std::array<ThrusterCon
     }
     if (arr->size() != kMotorCount)
         return;
-    const std::size_t before = c.errors.size();
     check_thruster_set(c, set, valid);
-    if (c.errors.size() == before && std::all_of(valid.begin(), valid.end(), [](bool v) { return v; })) {
-        // The driver's own rules; these checks mirror them, this catches any drift.
-        const std::string err = validate_thruster_set(set);
-        if (!err.empty())
-            c.fail("thruster", err, n);
-    }
     out = set;
 }
 

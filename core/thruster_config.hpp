@@ -9,6 +9,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace caracara {
 
@@ -52,6 +53,19 @@ struct ThrusterConfig {
     std::optional<MuxRoute> mux;                 // when the thruster sits behind a PCA9544A
     bool reversed = false;                       // negate motor values (mounting direction)
 };
+
+// A set-level conflict between two thrusters (the one rule set for the drivers and the
+// configuration checker, which words them with keys and lines).
+struct ThrusterConflict {
+    enum class Kind {
+        MuxAddress,    // `thruster`'s address is the address of the mux `other` sits behind
+        SharedAddress, // `thruster` and `other` (other < thruster) answer at one address on one segment
+    } kind;
+    std::size_t thruster;
+    std::size_t other;
+};
+// Every conflict in `set`, skipping the thrusters marked invalid in `valid` (empty: all valid).
+std::vector<ThrusterConflict> thruster_conflicts(std::span<const ThrusterConfig> set, std::span<const bool> valid = {});
 
 // "" when valid, else a message naming the bad field.
 std::string validate_thruster_config(const ThrusterConfig& cfg);
