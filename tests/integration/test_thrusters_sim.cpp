@@ -2,12 +2,14 @@
 // checked on the simulator's side of the wire.
 #include "platform/i2c_dev.hpp"
 #include "protocol/seabotix.hpp"
+#include "platform/linux/linux_device_io.hpp"
 #include "platform/sim/sim_device_io.hpp"
 #include "tests/integration/sim_fixture.hpp"
 #include "devices/thruster_driver.hpp"
 
 #include <catch2/catch.hpp>
 #include <memory>
+#include <stdexcept>
 #include <thread>
 
 using namespace caracara;
@@ -66,6 +68,15 @@ std::vector<ThrusterConfig> default_configs() {
     return v;
 }
 } // namespace
+
+TEST_CASE("a thruster driver refuses a configuration the rules refuse, before any transfer") {
+    LinuxDeviceIo io;
+    I2cDev bus(io, "/dev/null"); // never opened: the constructor refuses first
+    MuxTracker mux;
+    ThrusterConfig read_address;
+    read_address.mt = 0x53; // odd: a read address byte
+    CHECK_THROWS_AS(ThrusterDriver(bus, mux, read_address), std::invalid_argument);
+}
 
 TEST_CASE("all eight thrusters receive exactly the order bytes the IDS prescribes") {
     SimFixture f;
