@@ -43,7 +43,7 @@ enum class MixError {
     NotFinite,   // a demand (or, with a bad custom matrix, a result) is NaN or infinite
     OutOfRange,  // a demand is outside -1..1
 };
-std::string_view error_name(MixError e);  // "NotFinite", "OutOfRange" (D-Bus error suffix)
+std::string_view error_name(MixError e);  // "NotFinite", "OutOfRange" (for logs and tests)
 
 struct MixResult {
     MixError error = MixError::None;

@@ -43,7 +43,7 @@ enum class SafetyError {
     PoweredOff,     // anything that needs power after power-off
     NotReady,       // a thrust command while arming or killed
 };
-std::string_view error_name(SafetyError e);  // "NotKilled", "KillSwitchSet", ... (D-Bus error suffix)
+std::string_view error_name(SafetyError e);  // "NotKilled", "KillSwitchSet", ... (for logs and tests)
 
 struct SafetyConfig {
     uint64_t arming_delay_ns = ms_to_ns(3000);     // as the board firmware did
@@ -57,7 +57,7 @@ struct SafetyConfig {
 // is harmless, missing one is not.
 struct SafetyAction {
     SafetyError error = SafetyError::None;
-    std::string message;          // the reason, for logs and D-Bus error text
+    std::string message;          // the reason, for logs and the caller
     bool state_changed = false;
     bool zero_outputs = false;    // order zero to every thruster now, not at the next tick
     bool clear_commands = false;  // drop stored commands so nothing resumes by itself
@@ -85,7 +85,7 @@ public:
     SafetyAction power_off(uint64_t now);
     // Ends the arming delay and runs the command watchdog; call at least at next_deadline().
     SafetyAction tick(uint64_t now);
-    // A thrust/motion command from `client` (e.g. a D-Bus unique name). Accepted only in
+    // A thrust/motion command from `client` (its unique name on the bus). Accepted only in
     // Ready (NotReady while arming or killed, PoweredOff after power-off); it (re)starts
     // the watchdog and makes `client` the commanding client.
     SafetyAction accept_command(uint64_t now, std::string_view client = {});

@@ -1,9 +1,12 @@
-// Serves the device protocol (drivers/sim_protocol.hpp) on a Unix SOCK_SEQPACKET socket:
-// the simulator's stand-in for the kernel's i2c-dev and spidev.
+// Serves the device protocol (protocol/sim_protocol.hpp) on a Unix SOCK_SEQPACKET socket:
+// the simulator's stand-in for the kernel's i2c-dev and spidev. The socket, its clients and
+// the reply timing live here; what each request does is DeviceOps'.
 #pragma once
 
 #include "dbus/sdbus.hpp"
 #include "protocol/sim_protocol.hpp"
+#include "sim/device_ops.hpp"
+#include "sim/device_session.hpp"
 #include "sim/vehicle.hpp"
 
 #include <array>
@@ -20,23 +23,16 @@ public:
     DeviceServer(sd_event* event, SimVehicle& vehicle);
     ~DeviceServer();
     int listen(const std::string& path); // -errno
-    uint64_t bad_requests() const { return bad_requests_; }
+    uint64_t bad_requests() const { return ops_.bad_requests(); }
     size_t clients() const { return clients_.size(); }
 
 private:
-    struct Handle {
-        SimVehicle::NodeKind kind;
-        std::string path;
-    };
     struct Client {
         DeviceServer* server = nullptr;
         int fd = -1;
         dbus::SourcePtr io;
         dbus::SourcePtr reply_timer;
-        std::map<int, Handle> handles;
-        std::map<int, int> gpio_lines; // handle -> line index in the GPIO model
-        int watched_line = -1;         // a GpioWatch connection: pushes edges of this line
-        int next_handle = 3;
+        DeviceSession session;
         // One reply buffer per client, reused for every request (the hot path of the seam).
         std::array<uint8_t, simproto::kMaxMessage> reply{};
         size_t reply_len = 0;
@@ -46,8 +42,6 @@ private:
     static int on_client(sd_event_source*, int fd, uint32_t revents, void* userdata);
     static int on_reply_due(sd_event_source*, uint64_t, void* userdata);
     void drop(Client* c);
-    // Builds the reply into c.reply; returns the wire time the request occupied.
-    uint64_t handle(Client& c, std::span<const uint8_t> req);
     void send_reply(Client& c);
     void push_gpio_event(int line, int value, uint64_t when_ns);
 
@@ -56,8 +50,8 @@ private:
     int listen_fd_ = -1;
     std::string path_;
     dbus::SourcePtr accept_source_;
+    DeviceOps ops_;
     std::map<Client*, std::unique_ptr<Client>> clients_;
-    uint64_t bad_requests_ = 0;
 };
 
 } // namespace caracara::sim

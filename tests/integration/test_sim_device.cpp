@@ -178,6 +178,33 @@ TEST_CASE("malformed requests get an error reply and the simulator keeps serving
     CHECK(f.sim.running());
 }
 
+TEST_CASE("a reply longer than the protocol allows is an error, not a silent truncation") {
+    SimFixture f;
+    int s = raw_connect(f.socket());
+    std::vector<uint8_t> buf(512);
+    simproto::Writer open(buf);
+    open.header(simproto::Op::Open, 1);
+    open.str("/dev/i2c-1");
+    open.i32(O_RDWR);
+    REQUIRE(send(s, buf.data(), open.size(), 0) > 0);
+    const int32_t handle = reply_result(s);
+    REQUIRE(handle >= 0);
+    // Nine read messages of 8192 bytes: 72 KiB of read data, more than one reply can carry.
+    simproto::Writer w(buf);
+    w.header(simproto::Op::I2cRdwr, 2);
+    w.i32(handle);
+    w.u32(9);
+    for (int i = 0; i < 9; ++i) {
+        w.u16(0x29);
+        w.u16(I2C_M_RD);
+        w.u16(8192);
+    }
+    REQUIRE(send(s, buf.data(), w.size(), 0) > 0);
+    CHECK(reply_result(s) == -EMSGSIZE);
+    close(s);
+    CHECK(f.sim.running());
+}
+
 namespace {
 // A request of the corpus below, built with the protocol's own writer.
 template <typename Fill> std::vector<uint8_t> request(simproto::Op op, uint32_t seq, Fill fill) {

@@ -1,0 +1,23 @@
+// What one client of the device socket has open: its device handles and GPIO lines, as a
+// process's file descriptors are to the kernel.
+#pragma once
+
+#include "sim/vehicle.hpp"
+
+#include <map>
+#include <string>
+
+namespace caracara::sim {
+
+struct DeviceSession {
+    struct Handle {
+        SimVehicle::NodeKind kind;
+        std::string path;
+    };
+    std::map<int, Handle> handles;
+    std::map<int, int> gpio_lines; // handle -> line index in the GPIO model
+    int watched_line = -1;         // a GpioWatch connection: pushes edges of this line
+    int next_handle = 3;
+};
+
+} // namespace caracara::sim
