@@ -2,7 +2,8 @@
 // them, wire time at the configured clock, and the wire log. One call = one I2C_RDWR.
 #pragma once
 
-#include "sim/slave.hpp"
+#include "sim/i2c_slave.hpp"
+#include "sim/pca9544.hpp"
 #include "sim/wire_log.hpp"
 
 #include <cstdint>
@@ -17,19 +18,6 @@ struct I2cMessage {
     uint16_t addr = 0;
     uint16_t flags = 0;         // I2C_M_RD etc.
     std::vector<uint8_t> data;  // write payload, or the read buffer (sized to len)
-};
-
-// PCA9544A: one control byte, bit 2 enables, bits 0-1 pick the downstream channel.
-class Pca9544 final : public I2cSlave {
-public:
-    bool ack_address(bool) override { return true; }
-    void on_write(std::span<const uint8_t> data, uint64_t) override;
-    void on_read(std::span<uint8_t> out, uint64_t) override;
-    std::optional<uint8_t> selected() const;
-    uint8_t control() const { return control_; }
-
-private:
-    uint8_t control_ = 0; // power-on: no channel selected
 };
 
 class I2cBusModel {

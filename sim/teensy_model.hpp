@@ -40,7 +40,8 @@
 // Not thread-safe: the simulator drives all models from one thread.
 #pragma once
 
-#include "sim/slave.hpp"
+#include "sim/spi_slave.hpp"
+#include "sim/stepped.hpp"
 #include "sim/vehicle_body.hpp"
 
 #include <array>

@@ -2,7 +2,8 @@
 // the spec independently of the daemon's codec so that each checks the other.
 #pragma once
 
-#include "sim/slave.hpp"
+#include "sim/i2c_slave.hpp"
+#include "sim/stepped.hpp"
 
 #include <array>
 #include <cstdint>

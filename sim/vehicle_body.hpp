@@ -6,7 +6,7 @@
 // system; pitch and roll also feel a restoring moment because the vehicle is bottom-heavy.
 #pragma once
 
-#include "sim/slave.hpp"
+#include "sim/stepped.hpp"
 
 #include <array>
 #include <cstdint>
