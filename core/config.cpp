@@ -409,10 +409,7 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
         parse_profiles(c, *t, cfg.profiles);
     c.table(root, "", "sim");
     if (!cfg.profiles.empty() && !find_profile(cfg, cfg.control.profile)) {
-        std::string known;
-        for (const auto& p : cfg.profiles)
-            known += (known.empty() ? "" : ", ") + p.name;
-        c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + known,
+        c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + profile_names(cfg),
                root["control"]["profile"].node());
     }
 
@@ -434,6 +431,13 @@ const ThrustProfile* find_profile(const DaemonConfig& config, std::string_view n
         if (p.name == name)
             return &p;
     return nullptr;
+}
+
+std::string profile_names(const DaemonConfig& config) {
+    std::string known;
+    for (const auto& p : config.profiles)
+        known += (known.empty() ? "" : ", ") + p.name;
+    return known;
 }
 
 ConfigResult parse_config_file(const std::string& path) {

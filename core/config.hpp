@@ -101,6 +101,8 @@ struct DaemonConfig {
 
 // The profile called `name`, or nullptr.
 const ThrustProfile* find_profile(const DaemonConfig& config, std::string_view name);
+// "air, water": the configured profile names, for messages.
+std::string profile_names(const DaemonConfig& config);
 
 struct ConfigResult {
     std::optional<DaemonConfig> config;  // set when valid

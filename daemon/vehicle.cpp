@@ -3,7 +3,6 @@
 #include "core/clock.hpp"
 #include "core/packet.hpp"
 
-#include <cmath>
 #include "daemon/control_loop.hpp"
 #include "daemon/log.hpp"
 #include "platform/io_error.hpp"
@@ -22,7 +21,7 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       teensy_(teensy),
       events_(events),
       safety_(safety_config(config), false, monotonic_ns()),
-      profile_(find_profile(config, config.control.profile)) {}
+      demand_(config.control.budget_policy, *find_profile(config, config.control.profile)) {}
 
 Result Vehicle::state_error() const {
     // Nothing moves while the thrusters cannot be reached: no order could get there, and each
@@ -43,10 +42,7 @@ Result Vehicle::state_error() const {
 void Vehicle::handle(const SafetyAction& a) {
     uint32_t changes = 0;
     if (a.clear_commands) {
-        requested_.fill(0);
-        applied_.fill(0);
-        limit_ = 0;
-        saturated_ = false;
+        demand_.clear();
         changes |= kChangeMotors | kChangeController;
     }
     // A kill reaches the kill output first: it is one GPIO write, and the zero orders behind it
@@ -107,39 +103,21 @@ int Vehicle::on_deadline(sd_event_source*, uint64_t, void* userdata) {
     return 0;
 }
 
-MotorValues Vehicle::scaled(const MotorValues& wanted) const {
-    MotorValues m{};
-    for (size_t i = 0; i < kMotorCount; ++i)
-        m[i] = static_cast<int32_t>(std::lround(wanted[i] * profile_->factor));
-    return m;
-}
-
-bool Vehicle::apply(const MotorValues& wanted, const BudgetResult& b, bool mix_saturated) {
-    const int32_t limit = b.running ? b.limit : 0;
-    const bool saturated = b.saturated || mix_saturated;
-    // A stream re-sending the same command changes nothing worth announcing.
-    const bool changed = requested_ != wanted || applied_ != b.motors || limit_ != limit || saturated_ != saturated;
+void Vehicle::orders_due(const MotorValues& before, const MotorValues& next) {
     // The changed orders go out now, one transaction per loop iteration, not at the next tick;
     // an unchanged one is already on the wire and refreshed by the tick.
     bool any_due = false;
     for (size_t i = 0; i < kMotorCount; ++i)
-        if (applied_[i] != b.motors[i] || bus_.ordered_value(i) != b.motors[i]) {
+        if (before[i] != next[i] || bus_.ordered_value(i) != next[i]) {
             bus_.schedule().mark_order(i);
             any_due = true;
         }
-    requested_ = wanted;
-    applied_ = b.motors;
-    limit_ = limit;
-    saturated_ = saturated;
-    mix_saturated_ = mix_saturated;
     if (any_due && loop_)
         loop_->schedule_work();
-    return changed;
 }
 
 Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
-    // The profile scales before the budget, so the budget holds whatever the profile.
-    BudgetResult b = apply_budget(scaled(wanted), config_.control.budget_policy);
+    const BudgetResult b = demand_.evaluate(wanted);
     if (b.error == BudgetError::OutOfRange)
         return {Status::OutOfRange, b.message};
     if (b.error == BudgetError::OverBudget)
@@ -151,7 +129,10 @@ Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std
     if (!a.ok())
         return state_error();
     arm_deadline();
-    const bool changed = apply(wanted, b, mix_saturated);
+    const MotorValues before = demand_.applied();
+    // A stream re-sending the same command changes nothing worth announcing.
+    const bool changed = demand_.take(wanted, b, mix_saturated);
+    orders_due(before, demand_.applied());
     events_.changed((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
     return {};
 }
@@ -170,25 +151,17 @@ Result Vehicle::accept_command(std::string_view client) {
 
 Result Vehicle::set_profile(std::string_view name) {
     const ThrustProfile* p = find_profile(config_, name);
-    if (!p) {
-        std::string known;
-        for (const auto& q : config_.profiles)
-            known += (known.empty() ? "" : ", ") + q.name;
-        return {Status::UnknownProfile, "no thrust profile \"" + std::string(name) + "\"; known: " + known};
-    }
-    if (p == profile_)
+    if (!p)
+        return {Status::UnknownProfile,
+                "no thrust profile \"" + std::string(name) + "\"; known: " + profile_names(config_)};
+    if (p == &demand_.profile())
         return {};
-    profile_ = p;
     log_notice("thrust profile %s (factor %g)", p->name.c_str(), p->factor);
-    uint32_t changes = kChangeProfile;
-    // The command standing now goes out under the new factor at once. Under policy "reject" a
-    // command that no longer fits is dropped to zero rather than kept at the old factor.
-    BudgetResult b = apply_budget(scaled(requested_), config_.control.budget_policy);
-    if (!b.ok())
-        b = apply_budget(MotorValues{}, config_.control.budget_policy);
-    if (apply(requested_, b, mix_saturated_))
-        changes |= kChangeMotors;
-    events_.changed(changes);
+    // The command standing now goes out under the new factor at once.
+    const MotorValues before = demand_.applied();
+    const bool changed = demand_.set_profile(*p);
+    orders_due(before, demand_.applied());
+    events_.changed(kChangeProfile | (changed ? kChangeMotors : 0u));
     return {};
 }
 

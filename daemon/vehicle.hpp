@@ -7,6 +7,7 @@
 #include "core/budget.hpp"
 #include "core/config.hpp"
 #include "core/mixing.hpp"
+#include "core/motor_demand.hpp"
 #include "core/safety.hpp"
 #include "core/status.hpp"
 #include "daemon/command_gate.hpp"
@@ -54,30 +55,28 @@ public:
     Result accept_command(std::string_view client) override;
 
     // What thruster i is to be ordered now: its applied value while the vehicle may drive.
-    int32_t order_value(size_t i) const { return safety_.may_drive() ? applied_[i] : 0; }
+    int32_t order_value(size_t i) const { return safety_.may_drive() ? demand_.applied()[i] : 0; }
     bool may_drive() const { return safety_.may_drive(); }
     bool kill_output_asserted() const { return safety_.kill_output_asserted(); }
 
     const SafetyMachine& safety() const { return safety_; }
     std::string_view state_name() const;
     std::string_view kill_source_name() const;
-    const MotorValues& motor_values() const { return applied_; }
-    const MotorValues& requested_values() const { return requested_; }
-    int32_t budget_limit() const { return limit_; }
-    bool saturated() const { return saturated_; }
+    const MotorValues& motor_values() const { return demand_.applied(); }
+    const MotorValues& requested_values() const { return demand_.requested(); }
+    int32_t budget_limit() const { return demand_.limit(); }
+    bool saturated() const { return demand_.saturated(); }
     int64_t command_age_ms() const;
     const std::string& controller_client() const { return safety_.commanding_client(); }
-    const ThrustProfile& profile() const { return *profile_; }
+    const ThrustProfile& profile() const { return demand_.profile(); }
 
 private:
     static int on_deadline(sd_event_source*, uint64_t usec, void* userdata);
     void arm_deadline();
     void handle(const SafetyAction& a);
     Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);
-    // The budget over `wanted` scaled by the profile; applied, limit and saturation updated,
-    // changed orders due. Returns whether anything announced changed.
-    bool apply(const MotorValues& wanted, const BudgetResult& b, bool mix_saturated);
-    MotorValues scaled(const MotorValues& wanted) const;
+    // Marks due at once the orders whose value changed from `before` or is not on the wire.
+    void orders_due(const MotorValues& before, const MotorValues& next);
 
     const DaemonConfig& config_;
     ThrusterBus& bus_;
@@ -89,12 +88,7 @@ private:
     SourcePtr deadline_;
     uint64_t deadline_at_ = SafetyMachine::kNoDeadline; // what deadline_ is armed for
 
-    MotorValues requested_{};
-    MotorValues applied_{};
-    int32_t limit_ = 0;
-    bool saturated_ = false;
-    bool mix_saturated_ = false;
-    const ThrustProfile* profile_;
+    MotorDemand demand_;
 };
 
 } // namespace caracara

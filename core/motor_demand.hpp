@@ -1,0 +1,48 @@
+// What the thrusters are asked for: the last accepted command (requested), scaled by the thrust
+// profile and held to the current budget (applied), with the budget's limit and whether
+// anything saturated. Pure: the Vehicle decides when a command is accepted, this decides what
+// it becomes.
+#pragma once
+
+#include "core/budget.hpp"
+#include "core/config.hpp"
+#include "core/motor.hpp"
+
+#include <cstdint>
+
+namespace caracara {
+
+class MotorDemand {
+public:
+    MotorDemand(BudgetPolicy policy, const ThrustProfile& profile) : policy_(policy), profile_(&profile) {}
+
+    // The budget over `wanted` under the current profile, without taking it: the caller checks
+    // the result (range, OverBudget) before it accepts the command.
+    BudgetResult evaluate(const MotorValues& wanted) const { return apply_budget(scaled(wanted), policy_); }
+    // Takes a command evaluated above; true when what is announced (values, limit, saturation)
+    // changed.
+    bool take(const MotorValues& wanted, const BudgetResult& b, bool mix_saturated);
+    // A new profile: the standing command under it (zero if it no longer fits a "reject" budget).
+    bool set_profile(const ThrustProfile& profile);
+    // Kill, timeout, client gone: nothing stored resumes by itself.
+    void clear();
+
+    const MotorValues& requested() const { return requested_; }
+    const MotorValues& applied() const { return applied_; }
+    int32_t limit() const { return limit_; }
+    bool saturated() const { return saturated_; }
+    const ThrustProfile& profile() const { return *profile_; }
+
+private:
+    MotorValues scaled(const MotorValues& wanted) const;
+
+    BudgetPolicy policy_;
+    const ThrustProfile* profile_;
+    MotorValues requested_{};
+    MotorValues applied_{};
+    int32_t limit_ = 0;
+    bool saturated_ = false;
+    bool mix_saturated_ = false;
+};
+
+} // namespace caracara
