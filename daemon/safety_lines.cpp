@@ -8,6 +8,10 @@
 
 namespace caracara {
 
+namespace {
+constexpr uint64_t kReopenUs = 1'000'000;
+} // namespace
+
 std::string SafetyLines::open(bool kill_asserted, Listener* listener) {
     listener_ = listener;
     std::string err;
@@ -22,28 +26,42 @@ std::string SafetyLines::open(bool kill_asserted, Listener* listener) {
             return "gpio.power_off_output: " + err;
     }
     if (settings_.kill_switch) {
-        kill_switch_ = gpio_.request(line_spec(*settings_.kill_switch), GpioMode::InputEdges, 0, err);
-        if (!kill_switch_)
-            return "gpio.kill_switch: " + err;
-        // Above D-Bus and the bus work: the switch is the operator's hand on the vehicle.
-        if (int fd = kill_switch_->event_fd(); fd >= 0) {
-            sd_event_source* s = nullptr;
-            if (int r = sd_event_add_io(event_, &s, fd, EPOLLIN, on_kill_switch, this); r < 0)
-                return "gpio.kill_switch: cannot watch edges: " + errno_name(-r);
-            kill_switch_source_.reset(s);
-            sd_event_source_set_priority(s, SD_EVENT_PRIORITY_IMPORTANT);
-        }
+        if (std::string e = open_switch(); !e.empty())
+            return e;
         poll();
     }
     return {};
 }
 
-void SafetyLines::close() { kill_switch_source_.reset(); }
+std::string SafetyLines::open_switch() {
+    std::string err;
+    kill_switch_ = gpio_.request(line_spec(*settings_.kill_switch), GpioMode::InputEdges, 0, err);
+    if (!kill_switch_)
+        return "gpio.kill_switch: " + err;
+    // Above D-Bus and the bus work: the switch is the operator's hand on the vehicle.
+    if (int fd = kill_switch_->event_fd(); fd >= 0) {
+        sd_event_source* s = nullptr;
+        if (int r = sd_event_add_io(event_, &s, fd, EPOLLIN, on_kill_switch, this); r < 0) {
+            kill_switch_.reset();
+            return "gpio.kill_switch: cannot watch edges: " + errno_name(-r);
+        }
+        kill_switch_source_.reset(s);
+        sd_event_source_set_priority(s, SD_EVENT_PRIORITY_IMPORTANT);
+    }
+    return {};
+}
 
-int SafetyLines::on_kill_switch(sd_event_source*, int, uint32_t, void* userdata) {
+void SafetyLines::close() {
+    kill_switch_source_.reset();
+    reopen_timer_.reset();
+}
+
+int SafetyLines::on_kill_switch(sd_event_source*, int, uint32_t revents, void* userdata) {
     auto* self = static_cast<SafetyLines*>(userdata);
-    if (self->kill_switch_->drain_events() < 0)
-        log_error("kill switch events: the line went away");
+    if ((revents & (EPOLLHUP | EPOLLERR)) || self->kill_switch_->drain_events() < 0) {
+        self->switch_lost("the line went away");
+        return 0;
+    }
     self->poll();
     return 0;
 }
@@ -52,9 +70,44 @@ void SafetyLines::poll() {
     if (!kill_switch_ || !listener_)
         return;
     const int v = kill_switch_->get();
-    if (v < 0)
+    if (v < 0) {
+        switch_lost(errno_name(-v));
         return;
+    }
     listener_->kill_switch_read(v == 1);
+}
+
+void SafetyLines::switch_lost(const std::string& why) {
+    kill_switch_source_.reset();
+    kill_switch_.reset();
+    log_error("kill switch %s cannot be read (%s): treated as set; asking for it again once a second",
+              line_spec(*settings_.kill_switch).describe().c_str(), why.c_str());
+    if (listener_)
+        listener_->kill_switch_read(true);
+    sd_event_source* s = nullptr;
+    uint64_t now_us = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
+    if (!reopen_timer_) {
+        if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us + kReopenUs, 1000, on_reopen, this) < 0)
+            return;
+        reopen_timer_.reset(s);
+    } else {
+        sd_event_source_set_time(reopen_timer_.get(), now_us + kReopenUs);
+    }
+    sd_event_source_set_enabled(reopen_timer_.get(), SD_EVENT_ONESHOT);
+}
+
+int SafetyLines::on_reopen(sd_event_source* s, uint64_t usec, void* userdata) {
+    auto* self = static_cast<SafetyLines*>(userdata);
+    if (std::string e = self->open_switch(); !e.empty()) {
+        // Still gone: quietly again in a second (one log line when it went, one when it is back).
+        sd_event_source_set_time(s, usec + kReopenUs);
+        sd_event_source_set_enabled(s, SD_EVENT_ONESHOT);
+        return 0;
+    }
+    log_notice("kill switch %s is back; its level decides", line_spec(*self->settings_.kill_switch).describe().c_str());
+    self->poll();
+    return 0;
 }
 
 void SafetyLines::set_kill_output(bool asserted) {

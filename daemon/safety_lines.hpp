@@ -1,6 +1,7 @@
 // The vehicle's safety lines, in the manner of logind's button: the kill switch (an input
 // whose edges wake the loop above D-Bus and the bus work), the kill output and the power-off
-// output. It reads and drives lines; what a switch change means is the Vehicle's business.
+// output. It reads and drives lines; what a switch change means is the Vehicle's business. A
+// switch that cannot be read is a pressed one until it can be again.
 #pragma once
 
 #include "core/config.hpp"
@@ -39,6 +40,12 @@ public:
 
 private:
     static int on_kill_switch(sd_event_source*, int fd, uint32_t revents, void* userdata);
+    static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
+    // Requests the switch and watches its edges; "" or why not.
+    std::string open_switch();
+    // The switch cannot be read (its chip or the simulator went away): its source goes (no busy
+    // loop), it counts as set (a kill), and it is asked for again once a second.
+    void switch_lost(const std::string& why);
 
     sd_event* event_;
     GpioBackend& gpio_;
@@ -48,6 +55,7 @@ private:
     std::unique_ptr<GpioLine> kill_out_;
     std::unique_ptr<GpioLine> power_off_;
     SourcePtr kill_switch_source_;
+    SourcePtr reopen_timer_;
 };
 
 } // namespace caracara

@@ -312,6 +312,44 @@ class LongLockupKillsTest(VehicleTestCase):
         self.assertEqual(rig.state(), "killed")
 
 
+def cpu_seconds(pid):
+    with open("/proc/%d/stat" % pid) as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+class VanishedLinesTest(unittest.TestCase):
+    """The simulator (the hardware, with its GPIO chip) goes away under a running daemon: the
+    kill switch that can no longer be read is a pressed one, its event source is dropped instead
+    of firing in a loop, and the daemon stays quiet and answers D-Bus."""
+
+    def test_no_busy_loop_and_killed_when_the_switch_vanishes(self):
+        rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
+        self.addCleanup(rig.stop_checked)
+        rig.start()
+        rig.arm()
+        rig.thrust([800] * MOTORS)
+        rig.wait_sim_speeds([speed_byte(800)] * MOTORS)
+        sim = rig.procs.pop("caracara-sim")  # ended on purpose: not a failure of the rig
+        sim.kill()
+        sim.wait(10)
+        pid = rig.procs["caracarad"].pid
+        poll(lambda: rig.state() == "killed", 10, message="a kill switch that cannot be read did not kill")
+        log_before = rig.log().count("\n")
+        cpu0, t0 = cpu_seconds(pid), time.monotonic()
+        time.sleep(5)
+        cpu = (cpu_seconds(pid) - cpu0) / (time.monotonic() - t0) * 100
+        lines = rig.log().count("\n") - log_before
+        print("\nsimulator gone: daemon CPU %.2f %% of a core over 5 s, %d log lines, KillSource %s"
+              % (cpu, lines, rig.vget("KillSource")))
+        self.assertIn(rig.vget("KillSource"), ("switch", "bus"))
+        self.assertIn("kill switch", rig.log())
+        self.assertLess(cpu, 10.0)  # the target is 2 %; loosely here: a shared machine
+        self.assertLess(lines, 60)
+        # Still serving D-Bus.
+        self.assertEqual(error_name(rig.thrust, [100] * MOTORS)[:len(ERR)], ERR)
+
+
 class KillAndPowerOffPacketTest(unittest.TestCase):
 
     def test_kill_first_then_power_off(self):
