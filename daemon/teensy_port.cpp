@@ -10,33 +10,10 @@ namespace caracara {
 
 namespace {
 
-Status teensy_status(teensy::TeensyError e) {
-    using E = teensy::TeensyError;
-    switch (e) {
-    case E::None: return Status::Ok;
-    case E::SpeedOutOfRange:
-    case E::DutyOutOfRange:
-    case E::ServoIdOutOfRange:
-    case E::ServoAngleOutOfRange:
-    case E::SensorIdOutOfRange:
-    case E::AxisOutOfRange:
-    case E::LedValueOutOfRange: return Status::OutOfRange;
-    case E::AngleNotFinite: return Status::InvalidValue;
-    case E::Busy:
-    case E::BusyExhausted: return Status::Busy;
-    case E::ConfirmTimeout: return Status::Timeout;
-    case E::LinkError:
-    case E::BadAnswer:
-    case E::Io:
-    case E::ConfirmAckFailed: return Status::LinkError;
-    }
-    return Status::LinkError;
-}
-
 Result teensy_result(teensy::TeensyError e, std::string_view what) {
     if (e == teensy::TeensyError::None)
         return {};
-    return {teensy_status(e), std::string(what) + ": " + std::string(teensy::teensy_error_name(e))};
+    return {teensy::status_of(e), std::string(what) + ": " + std::string(teensy::teensy_error_name(e))};
 }
 
 } // namespace

@@ -2,6 +2,7 @@
 
 #include "core/clock.hpp"
 #include "core/packet.hpp"
+#include "core/status_of.hpp"
 
 #include "daemon/control_loop.hpp"
 #include "daemon/log.hpp"
@@ -118,10 +119,8 @@ void Vehicle::orders_due(const MotorValues& before, const MotorValues& next) {
 
 Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
     const BudgetResult b = demand_.evaluate(wanted);
-    if (b.error == BudgetError::OutOfRange)
-        return {Status::OutOfRange, b.message};
-    if (b.error == BudgetError::OverBudget)
-        return {Status::OverBudget, b.message};
+    if (!b.ok())
+        return {status_of(b.error), b.message};
     if (Result r = state_error(); !r.ok())
         return r;
     const std::string previous = safety_.commanding_client();
@@ -180,10 +179,8 @@ Result Vehicle::set_thrust(std::span<const int32_t> values, std::string_view cli
 
 Result Vehicle::set_motion(const AxisDemand& demand, std::string_view client) {
     MixResult mr = mix(demand, config_.mixing);
-    if (mr.error == MixError::NotFinite)
-        return {Status::InvalidValue, mr.message};
     if (mr.error != MixError::None)
-        return {Status::OutOfRange, mr.message};
+        return {status_of(mr.error), mr.message};
     return accept_motors(mr.motors, mr.saturated, client);
 }
 
@@ -193,13 +190,8 @@ Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view cl
     // and the call still returns that field's error with nothing else changed.
     if (pr.kill_requested && !powered_off())
         kill(KillSource::Packet, "packet killState=" + std::to_string(words[kPacketKill]));
-    switch (pr.error) {
-    case PacketError::None: break;
-    case PacketError::WrongLength: return {Status::InvalidLength, pr.message};
-    case PacketError::MotorOutOfRange:
-    case PacketError::ColorOutOfRange: return {Status::OutOfRange, pr.message};
-    case PacketError::BadPowerOffState: return {Status::InvalidValue, pr.message};
-    }
+    if (!pr.ok())
+        return {status_of(pr.error), pr.message};
     if (powered_off())
         return state_error();
     const Packet& p = pr.packet;
@@ -247,13 +239,8 @@ Result Vehicle::clear_kill() {
     if (bus_.telemetry().state == BusState::Lost && safety_.state() == SafetyState::Killed)
         return {Status::BusLost, "the I2C bus to the thrusters is not back yet; the kill stays"};
     SafetyAction a = safety_.clear_kill(monotonic_ns());
-    switch (a.error) {
-    case SafetyError::None: break;
-    case SafetyError::NotKilled: return {Status::NotKilled, a.message};
-    case SafetyError::KillSwitchSet: return {Status::KillSwitchSet, a.message};
-    case SafetyError::PoweredOff: return {Status::PoweredOff, a.message};
-    case SafetyError::NotReady: return {Status::Arming, a.message};
-    }
+    if (!a.ok())
+        return {status_of(a.error), a.message};
     handle(a);
     log_notice("kill cleared; arming for %u ms", config_.control.arming_delay_ms);
     return {};

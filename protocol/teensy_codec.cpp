@@ -214,4 +214,27 @@ TeensyError decode_ack(const Reply& r) {
     return TeensyError::LinkError;
 }
 
+Status status_of(TeensyError e) {
+    using E = TeensyError;
+    switch (e) {
+    case E::None: return Status::Ok;
+    case E::SpeedOutOfRange:
+    case E::DutyOutOfRange:
+    case E::ServoIdOutOfRange:
+    case E::ServoAngleOutOfRange:
+    case E::SensorIdOutOfRange:
+    case E::AxisOutOfRange:
+    case E::LedValueOutOfRange: return Status::OutOfRange;
+    case E::AngleNotFinite: return Status::InvalidValue;
+    case E::Busy:
+    case E::BusyExhausted: return Status::Busy;
+    case E::ConfirmTimeout: return Status::Timeout;
+    case E::LinkError:
+    case E::BadAnswer:
+    case E::Io:
+    case E::ConfirmAckFailed: return Status::LinkError;
+    }
+    return Status::LinkError;
+}
+
 } // namespace caracara::teensy

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "core/link_config.hpp"
+#include "core/status.hpp"
 
 #include <array>
 #include <cstddef>
@@ -87,6 +88,8 @@ enum class TeensyError : uint8_t {
 };
 
 std::string_view teensy_error_name(TeensyError e);
+// The Status a caller gets for it (core/status.cpp names it).
+Status status_of(TeensyError e);
 
 // A value or the reason there is none. (std::expected is C++23.)
 template <typename T>
