@@ -18,7 +18,7 @@ std::string_view bus_state_name(BusState s) {
 ThrusterBus::ThrusterBus(DeviceIo& io, const DaemonConfig& config, VehicleEvents& events)
     : events_(events),
       device_(config.i2c.device),
-      i2c_(io, config.i2c.device),
+      i2c_(io, config.i2c.device, {config.i2c.timeout_ms, config.i2c.retries}),
       ordered_(config.thrusters.size(), 0),
       faults_(config.thrusters.size()),
       schedule_(config.thrusters.size()),

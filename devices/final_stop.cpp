@@ -36,7 +36,7 @@ void FinalStop::assert_kill_output(Report& r) {
 }
 
 void FinalStop::zero_thrusters(Report& r) {
-    I2cDev i2c(io_, config_.i2c.device);
+    I2cDev i2c(io_, config_.i2c.device, {config_.i2c.timeout_ms, config_.i2c.retries});
     if (int e = i2c.open(); e < 0) {
         r.problems.push_back("I2C bus " + config_.i2c.device + ": " + errno_name(-e) + "; no thruster zeroed");
         return;

@@ -17,6 +17,17 @@ int I2cDev::open() {
         io_.close(fd);
         return r < 0 ? r : -EOPNOTSUPP;
     }
+    // Value ioctls: the argument is the value itself. I2C_TIMEOUT counts in units of 10 ms.
+    if (limits_.timeout_ms && (r = io_.ioctl(fd, I2C_TIMEOUT, reinterpret_cast<void*>(
+                                                                    static_cast<uintptr_t>((*limits_.timeout_ms + 9) / 10)))) < 0) {
+        io_.close(fd);
+        return r;
+    }
+    if (limits_.retries &&
+        (r = io_.ioctl(fd, I2C_RETRIES, reinterpret_cast<void*>(static_cast<uintptr_t>(*limits_.retries)))) < 0) {
+        io_.close(fd);
+        return r;
+    }
     fd_ = fd;
     return 0;
 }

@@ -6,6 +6,7 @@
 #include "platform/io_error.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <linux/i2c.h>
 #include <span>
 #include <string>
@@ -14,7 +15,13 @@ namespace caracara {
 
 class I2cDev {
 public:
-    I2cDev(DeviceIo& io, std::string path) : io_(io), path_(std::move(path)) {}
+    // The adapter's transfer timeout and retries (I2C_TIMEOUT, I2C_RETRIES), applied at every
+    // open; unset: the kernel's defaults (i2c-bcm2835 waits one second).
+    struct Limits {
+        std::optional<uint32_t> timeout_ms;
+        std::optional<uint32_t> retries;
+    };
+    I2cDev(DeviceIo& io, std::string path, Limits limits = {}) : io_(io), path_(std::move(path)), limits_(limits) {}
     ~I2cDev() { close(); }
     I2cDev(const I2cDev&) = delete;
     I2cDev& operator=(const I2cDev&) = delete;
@@ -36,6 +43,7 @@ public:
 private:
     DeviceIo& io_;
     std::string path_;
+    Limits limits_;
     int fd_ = -1;
     int last_errno_ = 0;
 };

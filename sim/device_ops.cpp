@@ -209,8 +209,8 @@ uint64_t DeviceOps::ioctl(Request& q) {
     } else if (it->second.kind == SimVehicle::NodeKind::I2c) {
         switch (request) {
         case I2C_FUNCS: out = kI2cFuncs; break;
-        case I2C_TIMEOUT:
-        case I2C_RETRIES:
+        case I2C_TIMEOUT: vehicle_.i2c_timeout = static_cast<int64_t>(value); break;
+        case I2C_RETRIES: vehicle_.i2c_retries = static_cast<int64_t>(value); break;
         case I2C_SLAVE:
         case I2C_SLAVE_FORCE: break;
         default: result = -ENOTTY;

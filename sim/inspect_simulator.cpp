@@ -128,6 +128,8 @@ constexpr dbus::Member kMembers[] = {
     property<[](I i) { return gpio(i).level(GpioModel::kScl); }>("Scl"),
     property<[](I i) { return gpio(i).level(GpioModel::kSda); }>("Sda"),
     property<[](I i) { return i2c(i).i2c_function(); }>("I2cFunction"),
+    property<[](I i) { return i.vehicle().i2c_timeout; }>("I2cTimeout"),
+    property<[](I i) { return i.vehicle().i2c_retries; }>("I2cRetries"),
     property<[](I i) { return i.vehicle().driver_bound(); }>("DriverBound"),
     property<[](I i) { return i.vehicle().unbinds(); }>("Unbinds"),
     property<[](I i) { return i.vehicle().binds(); }>("Binds"),

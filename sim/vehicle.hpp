@@ -74,6 +74,10 @@ public:
     void add_stepped(Stepped* s) { stepped_.push_back(s); }
     void step(double dt_s, uint64_t now_ns);
 
+    // What the daemon set with I2C_TIMEOUT (10 ms units) and I2C_RETRIES; -1: never set.
+    int64_t i2c_timeout = -1;
+    int64_t i2c_retries = -1;
+
     bool realistic_timing() const { return realistic_; }
     void set_realistic_timing(bool on) { realistic_ = on; }
     // Real-time mode: the wire is busy until this time; the next transaction starts after it.

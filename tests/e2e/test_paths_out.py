@@ -350,6 +350,25 @@ class VanishedLinesTest(unittest.TestCase):
         self.assertEqual(error_name(rig.thrust, [100] * MOTORS)[:len(ERR)], ERR)
 
 
+class AdapterLimitsTest(unittest.TestCase):
+    """i2c.timeout_ms and i2c.retries reach the adapter as I2C_TIMEOUT and I2C_RETRIES (the
+    keys were read but never applied before)."""
+
+    def test_configured_limits_reach_the_adapter(self):
+        rig = Rig(control={"arming_delay_ms": 300}, extra_config={"i2c": {"timeout_ms": 25, "retries": 2}})
+        self.addCleanup(rig.stop_checked)
+        rig.start()
+        self.assertEqual(int(rig.sim_get("I2cTimeout")), 3)  # 10 ms units, rounded up
+        self.assertEqual(int(rig.sim_get("I2cRetries")), 2)
+
+    def test_unset_limits_leave_the_kernel_defaults(self):
+        rig = Rig(control={"arming_delay_ms": 300})
+        self.addCleanup(rig.stop_checked)
+        rig.start()
+        self.assertEqual(int(rig.sim_get("I2cTimeout")), -1)
+        self.assertEqual(int(rig.sim_get("I2cRetries")), -1)
+
+
 class KillAndPowerOffPacketTest(unittest.TestCase):
 
     def test_kill_first_then_power_off(self):
