@@ -36,6 +36,13 @@ struct DeviceOps::Request {
         begin(err);
         return 0;
     }
+    // The open device handle `hnd` for a transfer on a `kind` node: nullptr with `err` set as the
+    // kernel would answer (EBADF: not open; ENOTTY: the wrong kind of device for the ioctl).
+    const DeviceSession::Handle* device(int32_t hnd, SimVehicle::NodeKind kind, int& err) {
+        auto it = session.handles.find(hnd);
+        err = it == session.handles.end() ? -EBADF : it->second.kind != kind ? -ENOTTY : 0;
+        return err ? nullptr : &it->second;
+    }
 };
 
 const DeviceOps::Entry DeviceOps::kTable[] = {
@@ -115,11 +122,9 @@ uint64_t DeviceOps::i2c_rdwr(Request& q) {
     uint32_t n = q.r.u32();
     if (!q.r.ok())
         return q.bad(-EBADMSG);
-    auto it = q.session.handles.find(hnd);
-    if (it == q.session.handles.end())
-        return q.bad(-EBADF);
-    if (it->second.kind != SimVehicle::NodeKind::I2c)
-        return q.bad(-ENOTTY);
+    int err = 0;
+    if (!q.device(hnd, SimVehicle::NodeKind::I2c, err))
+        return q.bad(err);
     if (n == 0 || n > I2C_RDWR_IOCTL_MAX_MSGS)
         return q.bad(-EINVAL);
     if (!vehicle_.i2c_present(monotonic_ns()))
@@ -155,11 +160,10 @@ uint64_t DeviceOps::spi_message(Request& q) {
     uint32_t n = q.r.u32();
     if (!q.r.ok())
         return q.bad(-EBADMSG);
-    auto it = q.session.handles.find(hnd);
-    if (it == q.session.handles.end())
-        return q.bad(-EBADF);
-    if (it->second.kind != SimVehicle::NodeKind::Spi)
-        return q.bad(-ENOTTY);
+    int err = 0;
+    const DeviceSession::Handle* dev = q.device(hnd, SimVehicle::NodeKind::Spi, err);
+    if (!dev)
+        return q.bad(err);
     if (n > 512)
         return q.bad(-EINVAL);
     std::vector<SpiMessageXfer> xfers(n);
@@ -182,7 +186,7 @@ uint64_t DeviceOps::spi_message(Request& q) {
     }
     if (!q.r.ok() || !q.r.at_end())
         return q.bad(-EBADMSG);
-    SpiPort* port = vehicle_.spi_port(it->second.path);
+    SpiPort* port = vehicle_.spi_port(dev->path);
     const uint64_t start = vehicle_.wire_start(monotonic_ns());
     uint64_t wire = 0;
     int res = vehicle_.spi_message(*port, xfers, start, wire);
