@@ -8,10 +8,10 @@ if ! /sbin/insmod "$WORK/module/caracara_bridge.ko"; then
   echo "FAIL module: insmod" > "$OUT/results.txt"; exit 1
 fi
 ls -l /dev/caracara-bridge /dev/i2c-* /dev/spidev* /dev/gpiochip* 2>&1
-mkdir -p /run/tmp
+grep -E " (/proc|/sys|/dev|/run) " /proc/mounts; echo "self: $$ $(readlink /proc/self)"; ls /proc | head -5; mkdir -p /run/tmp
 export TMPDIR=/run/tmp HOME=/run/tmp
 export GCOV_PREFIX="$OUT/gcov" GCOV_PREFIX_STRIP=0
 export CARACARA_BUILD_DIR="$COV" PYTHONDONTWRITEBYTECODE=1
 cd "$TOP/tests/kernel"
-timeout 500 /usr/bin/python3 scenarios.py "$OUT/results.txt"
+timeout 300 /usr/bin/python3 scenarios.py "$OUT/results.txt" ${SCENARIOS:-}
 echo "guest: scenarios exited $?"

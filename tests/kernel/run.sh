@@ -6,6 +6,7 @@
 # the scenarios (tests/kernel/scenarios.py) judge it from the simulator's wire log.
 #
 #   tests/kernel/run.sh [WORK_DIR]     (default: build-kernel in the source tree)
+#   CARACARA_KERNEL_SCENARIOS='start kill' tests/kernel/run.sh    only those scenarios
 #
 # Fetches the kernel, headers and kbuild .debs with apt-get download into
 # /var/cache/caracara-kernel/VERSION (unpacked there, never installed), builds the module
@@ -27,7 +28,7 @@ fi
 step() { echo "== kernel: $* ($(( $(date +%s) - t0 )) s)"; }
 
 # --- tools ---------------------------------------------------------------------------------
-pkgs=(qemu-system-x86 busybox-static i2c-tools python3-dbus python3-gi dbus make gcc-12 libelf-dev)
+pkgs=(qemu-system-x86 busybox-static i2c-tools python3-dbus python3-gi dbus make gcc-12 kmod cpio)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -51,7 +52,7 @@ if [ ! -f "$kdir/.ok" ]; then
   rm -rf "$kdir" && mkdir -p "$kdir/debs"
   kbuild=$(apt-cache depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-kbuild-.*\)$/\1/p' | head -1)
   common=$(apt-cache depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-headers-.*-common\)$/\1/p' | head -1)
-  (cd "$kdir/debs" && apt-get download "linux-image-$kver" "linux-headers-$kver" "$common" "$kbuild" 2>&1 | grep -v '^W: Download is performed unsandboxed' || true)
+  (cd "$kdir/debs" && apt-get download -qq "linux-image-$kver" "linux-headers-$kver" "$common" "$kbuild" 2>&1 | grep -v '^W: Download is performed unsandboxed' || true)
   for d in "$kdir"/debs/*.deb; do dpkg-deb -x "$d" "$kdir/root"; done
   # The headers' Makefile includes the common tree by its installed path; point it here.
   sed -i "s#^include /usr/src/#include $kdir/root/usr/src/#" "$kdir/root/usr/src/linux-headers-$kver/Makefile"
@@ -59,6 +60,8 @@ if [ ! -f "$kdir/.ok" ]; then
 fi
 kroot=$kdir/root
 modroot=$kroot/lib/modules/$kver
+# The package's postinst would run depmod; unpacked, it is run here on the tree.
+[ -f "$modroot/modules.dep" ] || /sbin/depmod -b "$kroot" "$kver"
 
 # --- the test module -----------------------------------------------------------------------
 step "building caracara_bridge.ko for $kver"
@@ -107,6 +110,7 @@ TOP='$top'
 WORK='$work'
 OUT='$out'
 COV='$cov'
+SCENARIOS='${CARACARA_KERNEL_SCENARIOS:-}'
 EOF
 cp "$top/tests/kernel/guest-init.sh" "$ird/init"
 chmod +x "$ird/init"
@@ -120,7 +124,7 @@ timeout 600 nice -n 10 qemu-system-x86_64 -machine q35 -accel tcg -cpu max -m 76
   -kernel "$kroot/boot/vmlinuz-$kver" -initrd "$work/initramfs.gz" \
   -append "console=ttyS0 panic=-1 quiet loglevel=4" \
   -nographic -no-reboot -nic none \
-  -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on \
+  -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
   -virtfs "local,path=$out,mount_tag=results,security_model=none" \
   > "$work/console.log" 2>&1
 qemu_rc=$?

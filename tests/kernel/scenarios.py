@@ -373,6 +373,33 @@ def sc_i2ctransfer(rig):
     check(zeros, "the daemon's zero order for thruster 1 differs")
 
 
+def diagnose(rig):
+    """Where caracarad and caracara-sim are stuck, as the kernel sees them."""
+    for name in ("caracarad", "caracara-sim"):
+        p = rig.procs.get(name)
+        if p is None or p.poll() is not None:
+            continue
+        for what in ("wchan", "stack"):
+            try:
+                with open("/proc/%d/%s" % (p.pid, what)) as f:
+                    print("--- %s %s:\n%s" % (name, what, f.read()))
+            except OSError as e:
+                print("--- %s %s: %s" % (name, what, e))
+    holders = []
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            for fd in os.listdir("/proc/%s/fd" % pid):
+                target = os.readlink("/proc/%s/fd/%s" % (pid, fd))
+                if target.startswith(I2C_DEV) or target == BRIDGE:
+                    holders.append("%s(%s) fd %s -> %s" % (pid, open("/proc/%s/comm" % pid).read().strip(), fd, target))
+        except OSError:
+            pass
+    print("--- open %s / %s: %s" % (I2C_DEV, BRIDGE, holders))
+    print("--- caracarad log (end)\n" + rig.log("caracarad")[-2000:])
+
+
 SCENARIOS = [
     ("start", sc_start),
     ("set_thrust_through_muxes", sc_set_thrust),
@@ -407,12 +434,15 @@ def main():
             continue
         t = time.monotonic()
         try:
+            if name not in ("start",) and rig.state() != "ready":
+                rig.reset(60)
             fn(rig)
             line = "PASS %s (%.1f s)" % (name, time.monotonic() - t)
         except Exception as e:
             failed += 1
             line = "FAIL %s (%.1f s): %s" % (name, time.monotonic() - t, str(e).splitlines()[0] if str(e) else repr(e))
             traceback.print_exc()
+            diagnose(rig)
         print(line, flush=True)
         out.write(line + "\n")
         out.flush()
