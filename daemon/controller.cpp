@@ -398,6 +398,8 @@ void Controller::recovery_attempt() {
     i2c_.close(); // before unbinding: the driver cannot go while the node is open
     mux_.invalidate();
     const bool rebind = !rc.driver_id.empty();
+    if (rebind && release_node_holders_)
+        release_node_holders_(); // nor while anyone else has it open: unbind would never return
     if (rebind) {
         if (int r = sysfs_write(io_, rc.unbind_path, rc.driver_id); r < 0 && r != -ENODEV)
             log_warning("unbinding %s via %s: %s", rc.driver_id.c_str(), rc.unbind_path.c_str(), errno_name(-r).c_str());
@@ -422,6 +424,8 @@ void Controller::recovery_attempt() {
 void Controller::recovery_wait_node() {
     int r = i2c_.open();
     if (r == 0) {
+        if (reopen_node_holders_)
+            reopen_node_holders_();
         recovery_finish();
         return;
     }

@@ -100,6 +100,12 @@ public:
     void shutdown();
     void set_observer(ControllerObserver* o) { observer_ = o; }
     void set_input_probe(const InputProbe* p) { input_ = p; }
+    // Other holders of the I2C node (the emergency stop's connection) that must let go of it
+    // while the recovery unbinds the adapter's driver, and may take it again once it is back.
+    void set_node_holders(std::function<void()> release, std::function<void()> reopen) {
+        release_node_holders_ = std::move(release);
+        reopen_node_holders_ = std::move(reopen);
+    }
 
     Result set_thrust(std::span<const int32_t> values, std::string_view client);
     Result set_motion(const AxisDemand& demand, std::string_view client);
@@ -196,6 +202,8 @@ private:
     SafetyMachine safety_;
     ControllerObserver* observer_ = nullptr;
     const InputProbe* input_ = nullptr;
+    std::function<void()> release_node_holders_;
+    std::function<void()> reopen_node_holders_;
 
     MotorValues requested_{};
     MotorValues applied_{};
