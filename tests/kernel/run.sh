@@ -75,7 +75,7 @@ nice -n 10 make -s -C "$kroot/usr/src/linux-headers-$kver" M="$mod" -j2 modules 
 step "building caracarad and caracara-sim with --coverage"
 cov=$work/cov
 nice -n 10 cmake -S "$top" -B "$cov" -DCMAKE_BUILD_TYPE=Debug -DCARACARA_WERROR=ON -DCMAKE_CXX_FLAGS=--coverage >/dev/null
-nice -n 10 cmake --build "$cov" -j2 --target caracarad caracara-sim caracaractl >/dev/null
+nice -n 10 cmake --build "$cov" -j2 --target caracarad caracara-sim >/dev/null
 find "$cov" -name '*.gcda' -delete
 
 # --- initramfs: busybox, the 9p modules, /init ----------------------------------------------

@@ -319,6 +319,16 @@ def sc_scl_low(rig):
 
 
 def sc_power_off(rig):
+    if rig._died("caracarad") or "caracarad" not in rig.procs:
+        left = rig.sim_speeds()
+        since = rig.wire_next()
+        rig.start_daemon()
+        # Zero orders to every thruster went out before the name appeared.
+        check(rig.sim_speeds() == [ZERO] * MOTORS, "orders standing when the service appeared: %s (before: %s)"
+              % (rig.sim_speeds(), left))
+        zeros = {i for i, d, _ in rig.orders(since) if d[0] == ZERO}
+        check(zeros == set(range(MOTORS)), "start zeroed only %s" % sorted(zeros))
+        rig.wait_state("ready", 60)
     check(error_name(rig.vcall, "PowerOff", "yes", signature="s") == ERR + "ConfirmationRequired",
           "PowerOff without confirmation")
     check(not rig.sim_get("PowerOffOutput"), "power-off asserted early")
@@ -410,10 +420,14 @@ SCENARIOS = [
     ("teensy_busy_and_turn", sc_teensy),
     ("bus_hang_recovered_with_rebind", sc_bus_hang),
     ("scl_held_low_bus_kill", sc_scl_low),
-    ("power_off_output", sc_power_off),
     ("sigterm", sc_sigterm),
+    # With no daemon: i2c-tools alone on the adapter; it leaves thruster 1 running.
     ("i2ctransfer_reference", sc_i2ctransfer),
+    # A new daemon zeroes what was left running before it takes its name, then powers off.
+    ("restart_zeroes_then_power_off", sc_power_off),
 ]
+# These start without a ready daemon (they stop or start it themselves).
+NO_READY_CHECK = {"start", "i2ctransfer_reference", "restart_zeroes_then_power_off"}
 
 
 def main():
@@ -434,7 +448,7 @@ def main():
             continue
         t = time.monotonic()
         try:
-            if name not in ("start",) and rig.state() != "ready":
+            if name not in NO_READY_CHECK and rig.state() != "ready":
                 rig.reset(60)
             fn(rig)
             line = "PASS %s (%.1f s)" % (name, time.monotonic() - t)
@@ -446,13 +460,12 @@ def main():
         print(line, flush=True)
         out.write(line + "\n")
         out.flush()
-        if rig._died("caracarad") and name not in ("sigterm",):
-            if name != "i2ctransfer_reference":
-                print("--- caracarad died:\n" + rig.log("caracarad")[-3000:])
-                try:
-                    rig.start_daemon()
-                except Exception as e:
-                    print("cannot restart caracarad: %s" % e)
+        if rig._died("caracarad") and name not in ("sigterm", "i2ctransfer_reference"):
+            print("--- caracarad died:\n" + rig.log("caracarad")[-3000:])
+            try:
+                rig.start_daemon()
+            except Exception as e:
+                print("cannot restart caracarad: %s" % e)
     print("--- caracarad log (end)\n" + rig.log("caracarad")[-6000:])
     print("--- caracara-sim log (end)\n" + rig.log("caracara-sim")[-3000:])
     rig.stop(remove_dir=True)
