@@ -133,19 +133,24 @@ def sc_start(rig):
 
 
 def mux_selected_before(rig, since, idx):
-    """The order to muxed thruster idx is preceded, in its transaction or earlier, by a write
-    of the channel's control byte to the mux."""
-    _, entries = rig.wire_log(since)
+    """Every non-zero order to muxed thruster idx logged since `since` went out with the mux
+    on the thruster's channel: the last control byte written to the mux before it (possibly
+    before `since`: the tracker does not select a channel that is already on) selects it."""
+    _, entries = rig.wire_log(0)
     want = 0x04 | MUXED[idx]
     sel = None
+    orders = 0
     for e in entries:
         if e.bus != "i2c" or e.result != "ack":
             continue
         if e.addr == MUX and not e.read and e.data:
             sel = e.data[-1]
-        if e.addr << 1 == DEFAULT_MT[idx] and not e.read and len(e.data) == 3 and e.data[0] != ZERO:
-            return sel == want
-    return False
+        if e.addr << 1 == DEFAULT_MT[idx] and not e.read and len(e.data) == 3 and e.data[0] != ZERO \
+                and e.index >= since:
+            orders += 1
+            if sel != want:
+                return False
+    return orders > 0
 
 
 def sc_set_thrust(rig):
