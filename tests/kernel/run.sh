@@ -17,7 +17,6 @@
 # Exit: 0 all scenarios passed, 1 a failure, 77 skipped (not root).
 set -euo pipefail
 top=$(cd "$(dirname "$0")/../.." && pwd)
-work=$(mkdir -p "${1:-$top/build-kernel}" && cd "${1:-$top/build-kernel}" && pwd)
 cache=/var/cache/caracara-kernel
 t0=$(date +%s)
 
@@ -25,6 +24,7 @@ if [ "$(id -u)" -ne 0 ]; then
   echo "kernel: needs root (apt-get download into $cache, packages for QEMU); skipped"
   exit 77
 fi
+work=$(mkdir -p "${1:-$top/build-kernel}" && cd "${1:-$top/build-kernel}" && pwd)
 step() { echo "== kernel: $* ($(( $(date +%s) - t0 )) s)"; }
 
 # --- tools ---------------------------------------------------------------------------------

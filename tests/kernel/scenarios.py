@@ -388,6 +388,59 @@ def sc_i2ctransfer(rig):
     check(zeros, "the daemon's zero order for thruster 1 differs")
 
 
+def restart_with(rig, **sections):
+    """Stops caracarad and starts it again with some config sections replaced."""
+    rig.terminate("caracarad")
+    cfg = dict(rig.extra_config)
+    cfg.update(sections)
+    rig.extra_config = cfg
+    with open(rig.config_path, "w") as f:
+        f.write(rig.config_text())
+    rig.start_daemon()
+    rig.wait_state("ready", 60)
+
+
+def sc_unwired_line(rig):
+    """A line the kernel refuses (the bridge wires no GPIO5): the daemon names it and exits."""
+    rig.terminate("caracarad")
+    gpio = dict(GPIO, kill_output={"chip": "gpiochip0", "line": "GPIO5"})
+    path = os.path.join(rig.dir, "unwired.toml")
+    cfg = dict(rig.extra_config, gpio=gpio)
+    with open(path, "w") as f:
+        f.write(harness.toml_dumps(dict({"control": rig.control}, **cfg)) + "\n" + rig.extra_toml)
+    r = subprocess.run([binary("caracarad"), "--bus-address", rig.address, "--config", path],
+                       capture_output=True, text=True, timeout=60)
+    out = r.stdout + r.stderr
+    check(r.returncode != 0, "caracarad started with an unwired kill output")
+    check("GPIO5" in out and "kill_output" in out, "the error does not name the line: %r" % out[-400:])
+
+
+def sc_per_byte_spi_active_low(rig):
+    """Per-byte SPI transfers (one spi_ioc_transfer per byte with a delay) through spidev, and
+    an active-low kill output inverted by gpiolib: the wire shows the physical levels."""
+    gpio = dict(GPIO, kill_output={"chip": "gpiochip0", "line": "GPIO27", "active_low": True})
+    restart_with(rig, gpio=gpio, spi={"per_byte_delay_us": 20})
+    tget = lambda n: rig.vget(n, TEENSY_PATH, TEENSY_IFACE)  # noqa: E731
+    poll(lambda: bool(tget("Online")), 15, message="Teensy not online in per-byte mode")
+    f0 = int(tget("Frames"))
+    poll(lambda: int(tget("Frames")) > f0 + 2, 15, message="no frames in per-byte mode")
+    n = int(rig.sim_teensy("SpiLastTransfers"))
+    check(n > 1, "SpiLastTransfers %d: not one transfer per byte" % n)
+    since = rig.wire_next()
+    spi = wait_wire(rig, since, lambda e: e.bus == "spi", 10, "no SPI frames")
+    check(all(e.result == "ok" for e in spi), "SPI results %s" % {e.result for e in spi})
+    # Deasserted active-low output: high on the wire. Kill: low.
+    since = rig.wire_next()
+    rig.vcall("Kill")
+    wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [0], 5,
+              "the active-low kill output did not go low on the wire")
+    since = rig.wire_next()
+    rig.vcall("ClearKill")
+    rig.wait_state("ready", 20)
+    wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5,
+              "the active-low kill output did not go back high")
+
+
 def diagnose(rig):
     """Where caracarad and caracara-sim are stuck, as the kernel sees them."""
     for name in ("caracarad", "caracara-sim"):
@@ -425,6 +478,8 @@ SCENARIOS = [
     ("teensy_busy_and_turn", sc_teensy),
     ("bus_hang_recovered_with_rebind", sc_bus_hang),
     ("scl_held_low_bus_kill", sc_scl_low),
+    ("per_byte_spi_and_active_low_output", sc_per_byte_spi_active_low),
+    ("unwired_gpio_line_refused", sc_unwired_line),
     ("sigterm", sc_sigterm),
     # With no daemon: i2c-tools alone on the adapter; it leaves thruster 1 running.
     ("i2ctransfer_reference", sc_i2ctransfer),
@@ -432,7 +487,7 @@ SCENARIOS = [
     ("restart_zeroes_then_power_off", sc_power_off),
 ]
 # These start without a ready daemon (they stop or start it themselves).
-NO_READY_CHECK = {"start", "i2ctransfer_reference", "restart_zeroes_then_power_off"}
+NO_READY_CHECK = {"start", "i2ctransfer_reference", "restart_zeroes_then_power_off", "sigterm"}
 
 
 def main():
