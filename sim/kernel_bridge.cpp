@@ -59,6 +59,8 @@ KernelBridge::KernelBridge(sd_event* event, SimVehicle& vehicle, const SimConfig
 }
 
 KernelBridge::~KernelBridge() {
+    if (hooked_)
+        vehicle_.gpio().on_change = previous_on_change_;
     io_.reset();
     if (fd_ >= 0)
         ::close(fd_);
@@ -76,12 +78,13 @@ int KernelBridge::open(const std::string& device) {
     // Every level change of the model's lines goes to the kernel, which fires edge interrupts
     // from it; whoever else watches the model (the device server) is still told.
     auto& gpio = vehicle_.gpio();
-    auto previous = gpio.on_change;
-    gpio.on_change = [this, previous](int line, int value, uint64_t when_ns) {
-        if (previous)
-            previous(line, value, when_ns);
-        push_level(vehicle_.gpio().lines()[static_cast<size_t>(line)].offset,
-                   vehicle_.gpio().level(vehicle_.gpio().lines()[static_cast<size_t>(line)].offset));
+    previous_on_change_ = gpio.on_change;
+    hooked_ = true;
+    gpio.on_change = [this](int line, int value, uint64_t when_ns) {
+        if (previous_on_change_)
+            previous_on_change_(line, value, when_ns);
+        const uint32_t offset = vehicle_.gpio().lines()[static_cast<size_t>(line)].offset;
+        push_level(offset, vehicle_.gpio().level(offset)); // physical, whatever the model's active-low
     };
     // The kernel starts with every line low: tell it the levels as they are now.
     for (const auto& l : gpio.lines())

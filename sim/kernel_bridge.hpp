@@ -11,6 +11,7 @@
 #include "sim/vehicle.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <span>
 #include <string>
@@ -49,6 +50,9 @@ private:
     std::vector<uint8_t> payload_;
     // Model line index -> the mode the kernel put it in (it is requested in the model).
     std::map<int, GpioMode> modes_;
+    // The GPIO model's change callback before open() chained onto it; restored on destruction.
+    std::function<void(int, int, uint64_t)> previous_on_change_;
+    bool hooked_ = false;
     uint64_t requests_ = 0;
     uint64_t bad_requests_ = 0;
 };

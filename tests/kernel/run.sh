@@ -40,6 +40,8 @@ if ((${#missing[@]})); then
 fi
 
 # --- kernel, headers -----------------------------------------------------------------------
+# Nothing cached yet: fresh package lists, so the version asked for can still be downloaded.
+ls "$cache"/*/.ok >/dev/null 2>&1 || apt-get update -qq
 kver=$(apt-cache depends linux-image-amd64 2>/dev/null | sed -n 's/.*Depends: linux-image-\(.*-amd64\)$/\1/p' | head -1)
 if [ -z "$kver" ] || { [ ! -f "$cache/$kver/.ok" ] && ! apt-cache show "linux-image-$kver" >/dev/null 2>&1; }; then
   # No package lists: whatever was cached last.
@@ -52,7 +54,10 @@ if [ ! -f "$kdir/.ok" ]; then
   rm -rf "$kdir" && mkdir -p "$kdir/debs"
   kbuild=$(apt-cache depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-kbuild-.*\)$/\1/p' | head -1)
   common=$(apt-cache depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-headers-.*-common\)$/\1/p' | head -1)
-  (cd "$kdir/debs" && apt-get download -qq "linux-image-$kver" "linux-headers-$kver" "$common" "$kbuild" 2>&1 | grep -v '^W: Download is performed unsandboxed' || true)
+  if ! (cd "$kdir/debs" && apt-get download -qq "linux-image-$kver" "linux-headers-$kver" "$common" "$kbuild" 2>/dev/null); then
+    echo "kernel: apt-get download of linux-image-$kver and its headers failed"
+    exit 1
+  fi
   for d in "$kdir"/debs/*.deb; do dpkg-deb -x "$d" "$kdir/root"; done
   # The headers' Makefile includes the common tree by its installed path; point it here.
   sed -i "s#^include /usr/src/#include $kdir/root/usr/src/#" "$kdir/root/usr/src/linux-headers-$kver/Makefile"
