@@ -26,11 +26,9 @@ def main():
         for src in sources:
             rel = os.path.relpath(src, top)
             name = os.path.basename(src)
-            # CMake's object for platform/linux/x.cpp: <build>/platform/CMakeFiles/<t>.dir/linux/x.cpp.gcno
-            cands = [g for g in glob.glob(os.path.join(build, "**", name + ".gcno"), recursive=True)
-                     if g.replace(os.sep + "CMakeFiles" + os.sep, os.sep).find("") >= 0 and
-                     os.path.dirname(rel).split(os.sep)[0] in g and
-                     g.endswith(os.path.join(*(rel.split(os.sep)[1:])) + ".gcno")]
+            # CMake's object of platform/linux/x.cpp: <build>/platform/CMakeFiles/<target>.dir/linux/x.cpp.gcno
+            top_dir, rest = rel.split(os.sep, 1)
+            cands = [g for g in glob.glob(os.path.join(build, top_dir, "CMakeFiles", "*.dir", rest + ".gcno"))]
             if not cands:
                 print("%-34s no .gcno" % rel)
                 continue
