@@ -106,6 +106,8 @@ void BusRecovery::attempt() {
     bus_.close(); // before unbinding: the driver cannot go while the node is open
     bus_.mux().invalidate();
     const bool rebind = !rc.driver_id.empty();
+    if (rebind && release_node_holders_)
+        release_node_holders_(); // nor while anyone else has it open (found on a real kernel)
     if (rebind) {
         if (int r = sysfs_write(io_, rc.unbind_path, rc.driver_id); r < 0 && r != -ENODEV)
             log_warning("unbinding %s via %s: %s", rc.driver_id.c_str(), rc.unbind_path.c_str(), errno_name(-r).c_str());
@@ -130,6 +132,8 @@ void BusRecovery::attempt() {
 void BusRecovery::wait_node() {
     const int r = bus_.open();
     if (r == 0) {
+        if (reopen_node_holders_)
+            reopen_node_holders_();
         finish();
         return;
     }

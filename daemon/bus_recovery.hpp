@@ -16,6 +16,7 @@
 #include "platform/gpio_backend.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace caracara {
@@ -26,6 +27,13 @@ public:
                 Vehicle& vehicle, VehicleEvents& events);
 
     void bus_locked_up(const std::string& reason) override;
+    // Other holders of the I2C node (the emergency stop's connection) that must let go of it
+    // while the driver is unbound, and may take it again once it is back: the kernel's
+    // i2c_del_adapter() waits for every open /dev/i2c-N, so the unbind would never return.
+    void set_node_holders(std::function<void()> release, std::function<void()> reopen) {
+        release_node_holders_ = std::move(release);
+        reopen_node_holders_ = std::move(reopen);
+    }
     void stop() {
         timer_.reset();
         lost_timer_.reset();
@@ -56,6 +64,8 @@ private:
     uint32_t last_pulses_ = 0;
     SourcePtr timer_;
     SourcePtr lost_timer_; // a lockup longer than the command timeout is a lost bus
+    std::function<void()> release_node_holders_;
+    std::function<void()> reopen_node_holders_;
 };
 
 } // namespace caracara

@@ -161,8 +161,14 @@ int main(int argc, char** argv) {
             log_warning("emergency stop not armed: %s", perr.c_str());
         else if (std::string e = estop.arm(std::move(panic_hw.io), cr.config->i2c.device, cr.config->thrusters, cr.config->spi); !e.empty())
             log_warning("emergency stop not armed: %s", e.c_str());
-        else
+        else {
             EmergencyStop::install_fatal_handlers(&estop);
+            daemon.recovery().set_node_holders([&estop] { estop.release(); },
+                                               [&estop] {
+                                                   if (std::string why = estop.reopen(); !why.empty())
+                                                       log_warning("emergency stop not re-armed: %s", why.c_str());
+                                               });
+        }
     }
 
     dbus::BusPtr bus;

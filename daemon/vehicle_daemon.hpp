@@ -43,6 +43,7 @@ public:
     ControlLoop& loop() { return loop_; }
     const ControlLoop& loop() const { return loop_; }
     ServiceStatus& status() { return status_; }
+    BusRecovery& recovery() { return recovery_; }
 
 private:
     sd_event* event_;

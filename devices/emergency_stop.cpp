@@ -35,6 +35,7 @@ std::string EmergencyStop::arm(std::unique_ptr<DeviceIo> io, const std::string& 
     }
     count_ = thrusters.size();
     io_ = std::move(io);
+    path_ = i2c_path;
     fd_ = fd;
     if (auto stop = teensy::encode_stop(0); stop.ok()) {
         auto dev = std::make_unique<SpiDev>(*io_, spi.device, spi.spi);
@@ -46,19 +47,38 @@ std::string EmergencyStop::arm(std::unique_ptr<DeviceIo> io, const std::string& 
     return {};
 }
 
+void EmergencyStop::release() {
+    const int fd = fd_;
+    if (fd < 0)
+        return;
+    fd_ = -1; // first, so a signal arriving now does not use a closed descriptor
+    io_->close(fd);
+}
+
+std::string EmergencyStop::reopen() {
+    if (!io_ || fd_ >= 0)
+        return {};
+    int fd = io_->open(path_.c_str(), O_RDWR);
+    if (fd < 0)
+        return "cannot open " + path_ + ": " + errno_name(-fd);
+    fd_ = fd;
+    return {};
+}
+
 void EmergencyStop::fire() noexcept {
-    if (fd_ < 0)
+    const int fd = fd_;
+    if (fd < 0)
         return;
     for (size_t i = 0; i < count_; ++i) {
         Prepared& p = prepared_[i];
         if (p.has_mux) {
             i2c_msg sel{p.mux_addr7, 0, 1, &p.mux_control};
             i2c_rdwr_ioctl_data d{&sel, 1};
-            io_->ioctl(fd_, I2C_RDWR, &d);
+            io_->ioctl(fd, I2C_RDWR, &d);
         }
         i2c_msg m{p.addr7, 0, static_cast<__u16>(p.order.size()), p.order.data()};
         i2c_rdwr_ioctl_data d{&m, 1};
-        io_->ioctl(fd_, I2C_RDWR, &d);
+        io_->ioctl(fd, I2C_RDWR, &d);
     }
     // Other muxes may still have a channel on; the next daemon instance sorts that out.
     if (spi_) // SpiDev::transfer allocates nothing; one try, no busy retries

@@ -28,6 +28,13 @@ public:
                     const SpiSettings& spi);
     // Sends the zero orders. Async-signal-safe; errors are ignored (there is no one to tell).
     void fire() noexcept;
+    // Closes the prepared connection while the I2C adapter's driver is unbound and rebound:
+    // the kernel's i2c_del_adapter() waits until every open /dev/i2c-N is closed, so a file
+    // kept open here would hang the unbinding write (and the daemon) for good. fire() does
+    // nothing until reopen().
+    void release();
+    // Opens the node again after the rebind; "" or why not (then it stays released).
+    std::string reopen();
     bool armed() const { return fd_ >= 0; }
 
     // Every signal whose default action ends the process and that the daemon does not handle
@@ -54,7 +61,8 @@ private:
     std::unique_ptr<SpiDev> spi_;
     teensy::Frame stop_frame_;
     std::array<uint8_t, teensy::kMaxFrame> stop_reply_{};
-    int fd_ = -1;
+    std::string path_;
+    volatile int fd_ = -1; // read by fire() in a signal handler
     std::array<Prepared, 8> prepared_{};
     size_t count_ = 0;
 };

@@ -3,6 +3,7 @@
 #include "sim/device_server.hpp"
 #include "platform/io_error.hpp"
 #include "sim/inspect.hpp"
+#include "sim/kernel_bridge.hpp"
 #include "dbus/sdbus.hpp"
 #include "sim/sim_config.hpp"
 #include "sim/vehicle.hpp"
@@ -23,6 +24,9 @@ void usage(FILE* f) {
     std::fputs("Usage: caracara-sim [OPTIONS]\n"
                "Simulated Caracara vehicle: serves the device protocol for caracarad --hardware=sim:SOCKET.\n\n"
                "  --socket PATH         device socket to serve (default /run/caracara/sim.sock)\n"
+               "  --kernel-bridge DEV   also serve the test kernel module's bridge device (tests/kernel):\n"
+               "                        caracarad then runs --hardware=linux on the kernel's own nodes;\n"
+               "                        the device socket is served only if --socket is given\n"
                "  --config FILE         vehicle description (TOML; [i2c], [spi], [[thruster]], [sim])\n"
                "  --system              inspection API on the system bus\n"
                "  --user                inspection API on the user bus (default)\n"
@@ -55,6 +59,8 @@ int on_physics(sd_event_source* s, uint64_t usec, void* userdata) {
 int main(int argc, char** argv) {
     std::string socket_path = "/run/caracara/sim.sock";
     std::string config_path;
+    std::string kernel_bridge;
+    bool socket_given = false;
     dbus::BusChoice bus_choice{dbus::BusChoice::Kind::User, {}};
     bool use_dbus = true;
     int realistic = -1;
@@ -70,7 +76,8 @@ int main(int argc, char** argv) {
             }
             return argv[++i];
         };
-        if (a == "--socket") socket_path = value("--socket");
+        if (a == "--socket") { socket_path = value("--socket"); socket_given = true; }
+        else if (a == "--kernel-bridge") kernel_bridge = value("--kernel-bridge");
         else if (a == "--config") config_path = value("--config");
         else if (a == "--system") bus_choice = {dbus::BusChoice::Kind::System, {}};
         else if (a == "--user") bus_choice = {dbus::BusChoice::Kind::User, {}};
@@ -124,9 +131,21 @@ int main(int argc, char** argv) {
     sd_event_add_signal(event.get(), nullptr, SIGINT, nullptr, nullptr);
 
     DeviceServer server(event.get(), vehicle);
-    if (int r = server.listen(socket_path); r < 0) {
+    if (!kernel_bridge.empty() && !socket_given)
+        socket_path = "(none)";
+    else if (int r = server.listen(socket_path); r < 0) {
         std::fprintf(stderr, "caracara-sim: cannot listen on %s: %s\n", socket_path.c_str(), errno_name(-r).c_str());
         return 1;
+    }
+
+    std::unique_ptr<KernelBridge> bridge;
+    if (!kernel_bridge.empty()) {
+        bridge = std::make_unique<KernelBridge>(event.get(), vehicle, cfg);
+        if (int r = bridge->open(kernel_bridge); r < 0) {
+            std::fprintf(stderr, "caracara-sim: cannot serve the kernel bridge %s: %s\n", kernel_bridge.c_str(),
+                         errno_name(-r).c_str());
+            return 1;
+        }
     }
 
     dbus::BusPtr bus;
@@ -153,9 +172,10 @@ int main(int argc, char** argv) {
     sd_event_source_set_enabled(phys, SD_EVENT_ON);
     dbus::SourcePtr phys_guard(phys);
 
-    std::printf("caracara-sim: %zu thrusters on %s at %u Hz%s; device socket %s\n", vehicle.thrusters().size(),
+    std::printf("caracara-sim: %zu thrusters on %s at %u Hz%s; device socket %s%s%s\n", vehicle.thrusters().size(),
                 vehicle.i2c_path().c_str(), vehicle.i2c().clock_hz(),
-                vehicle.realistic_timing() ? " (realistic timing)" : "", socket_path.c_str());
+                vehicle.realistic_timing() ? " (realistic timing)" : "", socket_path.c_str(),
+                bridge ? "; kernel bridge " : "", kernel_bridge.c_str());
     std::fflush(stdout);
     sd_notify(0, "READY=1\nSTATUS=Simulating the vehicle");
 

@@ -1,0 +1,11 @@
+# The kernel test (issue #14): Debian's kernel under QEMU with the test module
+# tests/kernel/module/caracara_bridge.c, caracara-sim --kernel-bridge and caracarad on the
+# kernel's own /dev/i2c-1, /dev/spidev0.0 and /dev/gpiochip0 (tests/kernel/run.sh).
+# Needs root (apt-get download into /var/cache/caracara-kernel, QEMU and i2c-tools packages);
+# exit 77 = skipped when not root. Only in the normal build: the sanitizer build would boot
+# the same kernel again for nothing (the daemon in the VM is a --coverage build of its own).
+# Run alone with `ctest -L kernel`.
+if(NOT CARACARA_SANITIZE)
+  add_test(NAME kernel COMMAND ${CMAKE_CURRENT_LIST_DIR}/run.sh ${CMAKE_BINARY_DIR}/kernel)
+  set_tests_properties(kernel PROPERTIES LABELS kernel TIMEOUT 900 SKIP_RETURN_CODE 77)
+endif()
