@@ -4,7 +4,8 @@
 
 The guest wrote its .gcda files under GCOV_PREFIX_DIR (GCOV_PREFIX) at the build tree's
 absolute paths; each is put beside its .gcno in a scratch directory and read with Debian's
-gcov. Prints one line per file and the total.
+gcov. Prints one line per file and the total, then every function of the project's own in
+those files that never ran (gcov's function summaries, demangled).
 """
 import glob
 import os
@@ -22,6 +23,7 @@ def main():
     sources = sorted(p for pat in FILES for p in glob.glob(os.path.join(top, pat)))
     scratch = tempfile.mkdtemp(prefix="kcov-")
     total_hit = total = 0
+    never = []
     try:
         for src in sources:
             rel = os.path.relpath(src, top)
@@ -38,8 +40,12 @@ def main():
             gcda = prefix + gcno[:-len(".gcno")] + ".gcda"
             if os.path.exists(gcda):
                 shutil.copy(gcda, d)
-            r = subprocess.run(["gcov", "-n", os.path.join(d, os.path.basename(gcno))], cwd=top,
+            r = subprocess.run(["gcov", "-n", "-f", "-m", os.path.join(d, os.path.basename(gcno))], cwd=top,
                                capture_output=True, text=True)
+            for fn, fpct in re.findall(r"Function '([^']*)'\nLines executed:([\d.]+)%", r.stdout):
+                # The project's own functions; the standard library's inlined templates are not ours.
+                if float(fpct) == 0.0 and fn.startswith("caracara::"):
+                    never.append("%s: %s" % (rel, fn))
             m = re.search(r"File '([^']*%s)'\nLines executed:([\d.]+)%% of (\d+)" % re.escape(rel), r.stdout)
             if not m:
                 print("%-34s gcov: no summary (%s)" % (rel, r.stderr.strip()[:100]))
@@ -51,6 +57,9 @@ def main():
             print("%-34s %6.1f%% of %4d lines%s" % (rel, pct, n, "" if os.path.exists(gcda) else " (never ran)"))
         if total:
             print("%-34s %6.1f%% of %4d lines" % ("total", 100.0 * total_hit / total, total))
+        print("functions never executed: %d" % len(never))
+        for f in never:
+            print("  " + f)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
 

@@ -56,7 +56,9 @@ class KernelRig(Rig):
     def __init__(self, **kw):
         kw.setdefault("control", {"arming_delay_ms": 300, "command_timeout_ms": 60000})
         kw.setdefault("gpio", False)
-        kw.setdefault("extra_config", {"gpio": GPIO, "recovery": RECOVERY, "i2c": {"device": I2C_DEV}})
+        # timeout_ms and retries: the real i2c-dev takes I2C_TIMEOUT and I2C_RETRIES at every open.
+        kw.setdefault("extra_config", {"gpio": GPIO, "recovery": RECOVERY,
+                                       "i2c": {"device": I2C_DEV, "timeout_ms": 100, "retries": 1}})
         kw.setdefault("extra_toml", THRUSTERS)
         super().__init__(**kw)
 
