@@ -74,7 +74,10 @@ void print_table(std::ostream& out, const std::vector<std::vector<std::string>>&
 void print_vehicle(std::ostream& out, const Props& v) {
     const std::string state = prop(v, "State").s;
     const std::string source = prop(v, "KillSource").s;
-    key_line(out, "State", state == "killed" || !source.empty() ? state + " (source: " + or_dash(source) + ")" : state);
+    std::string shown = state == "killed" || !source.empty() ? state + " (source: " + or_dash(source) + ")" : state;
+    if (source == "start")
+        shown += "; every start comes up killed: `caracaractl clear-kill` arms it";
+    key_line(out, "State", shown);
     const std::string controller = prop(v, "Controller").s;
     key_line(out, "Controller", controller.empty() ? "none" : controller);
     auto values = [](const Value& list) { return join(list, " ", [](const Value& x) { return render(x); }); };

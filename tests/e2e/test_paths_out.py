@@ -404,6 +404,8 @@ class StartKilledTest(unittest.TestCase):
         time.sleep(0.6)  # twice the arming delay: nothing arms by itself
         self.assertEqual(rig.state(), "killed")
         self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+        # caracaractl status says why and what to do.
+        self.assertIn("every start comes up killed: `caracaractl clear-kill` arms it", rig.ctl("status").stdout)
         # A packet's all clear clears only a packet kill, not the start kill.
         self.assertEqual(error_name(rig.packet, packet()), ERR + "Killed")
         rig.vcall("ClearKill")
