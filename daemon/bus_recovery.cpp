@@ -12,6 +12,7 @@ namespace caracara {
 
 namespace {
 constexpr uint64_t kNodePollNs = 5'000'000;
+constexpr uint64_t kIdlePollNs = 1'000'000;
 } // namespace
 
 BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio,
@@ -92,15 +93,23 @@ void BusRecovery::schedule(uint64_t delay_ns) {
 
 int BusRecovery::on_timer(sd_event_source*, uint64_t, void* userdata) {
     auto* self = static_cast<BusRecovery*>(userdata);
-    if (self->phase_ == Phase::WaitingNode)
-        self->wait_node();
-    else
-        self->attempt();
+    switch (self->phase_) {
+    case Phase::WaitingNode: self->wait_node(); break;
+    case Phase::Verifying: self->verify(); break;
+    case Phase::Idle:
+    case Phase::Backoff: self->attempt(); break;
+    }
     return 0;
 }
 
 void BusRecovery::attempt() {
     const RecoverySettings& rc = config_.recovery;
+    if (!bus_.idle()) {
+        // A transfer is still on the wire (bounded by the adapter's timeout): the descriptor
+        // cannot be closed under it.
+        schedule(kIdlePollNs);
+        return;
+    }
     policy_.next_attempt();
     phase_ = Phase::Idle;
     bus_.close(); // before unbinding: the driver cannot go while the node is open
@@ -146,14 +155,21 @@ void BusRecovery::wait_node() {
 
 void BusRecovery::finish() {
     phase_ = Phase::Idle;
-    // The current orders go out at once, a pending kill first: zeros while the vehicle may not
-    // drive. Still flagged as recovering, so these transfers decide the outcome below instead
-    // of starting a new recovery.
-    if (vehicle_.may_drive())
-        for (size_t i = 0; i < bus_.size(); ++i)
-            bus_.send_order(i, vehicle_.order_value(i));
-    else
-        bus_.zero_all();
+    // The current orders go out at once (zeros while the vehicle may not drive). Still flagged
+    // as recovering, so these transfers decide the outcome (verify) instead of starting a new
+    // recovery.
+    for (size_t i = 0; i < bus_.size(); ++i)
+        bus_.send_order(i, vehicle_.order_value(i));
+    phase_ = Phase::Verifying;
+    schedule(kIdlePollNs);
+}
+
+void BusRecovery::verify() {
+    if (!bus_.idle()) {
+        schedule(kIdlePollNs); // the orders are still on the wire (the worker's thread)
+        return;
+    }
+    phase_ = Phase::Idle;
     if (!bus_.any_online()) {
         // The lines were cleared and the node is back, but nothing gets through: not recovered.
         bus_.close();

@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
     for (int sig : {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU})
         signal(sig, SIG_IGN);
 
-    VehicleDaemon daemon(event.get(), *hw.io, *hw.gpio, *cr.config);
+    VehicleDaemon daemon(event.get(), *hw.io, hw.bus_io(), *hw.gpio, *cr.config);
     if (std::string e = daemon.start(); !e.empty()) {
         log_error("%s", e.c_str());
         sd_notifyf(0, "STATUS=%s", e.c_str());

@@ -21,7 +21,8 @@ namespace caracara {
 
 class VehicleDaemon {
 public:
-    VehicleDaemon(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config);
+    // `bus_io` carries the I2C transfers on the bus worker's thread; `io` everything else.
+    VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, GpioBackend& gpio, DaemonConfig config);
     ~VehicleDaemon() { shutdown(); }
     VehicleDaemon(const VehicleDaemon&) = delete;
     VehicleDaemon& operator=(const VehicleDaemon&) = delete;

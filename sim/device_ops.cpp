@@ -63,6 +63,7 @@ size_t DeviceOps::handle(DeviceSession& session, std::span<const uint8_t> req, s
                          uint64_t& wire_ns) {
     Request q{*this, session, simproto::Reader(req), simproto::Writer(reply), {}, Op::Open, reply};
     wire_ns = 0;
+    held_ns_ = 0;
     if (!q.r.header(q.h) || (q.h.op & simproto::kReplyBit)) {
         // Not even a header we understand: answer with a bare error so the client is not left hanging.
         q.op = static_cast<Op>(q.h.op & ~simproto::kReplyBit);
@@ -147,6 +148,7 @@ uint64_t DeviceOps::i2c_rdwr(Request& q) {
         return q.bad(-EBADMSG);
     const uint64_t start = vehicle_.wire_start(monotonic_ns());
     auto res = vehicle_.i2c().transfer(msgs, start);
+    held_ns_ = res.held_ns;
     q.begin(res.ret);
     if (res.ret >= 0)
         for (auto& m : msgs)
@@ -213,7 +215,11 @@ uint64_t DeviceOps::ioctl(Request& q) {
     } else if (it->second.kind == SimVehicle::NodeKind::I2c) {
         switch (request) {
         case I2C_FUNCS: out = kI2cFuncs; break;
-        case I2C_TIMEOUT: vehicle_.i2c_timeout = static_cast<int64_t>(value); break;
+        case I2C_TIMEOUT:
+            // Units of 10 ms, as i2c-dev takes it.
+            vehicle_.i2c_timeout = static_cast<int64_t>(value);
+            vehicle_.i2c().set_timeout_ns(value * 10'000'000ull);
+            break;
         case I2C_RETRIES: vehicle_.i2c_retries = static_cast<int64_t>(value); break;
         case I2C_SLAVE:
         case I2C_SLAVE_FORCE: break;

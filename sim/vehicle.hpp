@@ -88,7 +88,7 @@ public:
 
 private:
     SimConfig cfg_;
-    WireLog log_;
+    WireLog log_{cfg_.wire_log_entries};
     I2cBusModel i2c_;
     std::vector<std::unique_ptr<ThrusterModel>> thrusters_;
     std::map<std::string, SpiPort> spi_;

@@ -264,9 +264,23 @@ TEST_CASE("a confirmed power-off asserts the power-off line after zeroing the th
     REQUIRE(d.set_thrust({1000, 1000, 0, 0, 0, 0, 0, 0}) == "");
     CHECK(d.call("PowerOff", "s", "yes") == "org.caracara.Vehicle1.Error.ConfirmationRequired");
     CHECK_FALSE(f.root_bool("PowerOffOutput"));
+    REQUIRE(f.call(kSim, kSimIface, "ClearWireLog", "") == "");
     REQUIRE(d.call("PowerOff", "s", "power-off") == "");
-    CHECK(f.root_bool("PowerOffOutput"));
+    // The zero orders are on the wire before the power-off line moves (judged by the order
+    // of the wire log's entries, not their stamps).
+    REQUIRE(d.wait_for([&] { return f.root_bool("PowerOffOutput"); }));
     CHECK(all_at(f, std::vector<int32_t>(8, 0)));
+    const auto log = f.wire_log();
+    uint64_t last_zero = 0, power_off_edge = 0;
+    for (const auto& e : log) {
+        if (e.bus == "i2c" && !e.read && e.result == "ack" && e.data.size() == 3 && e.data[0] == speed_byte(0))
+            last_zero = e.index;
+        if (e.bus == "gpio" && power_off_edge == 0 && last_zero != 0)
+            power_off_edge = e.index; // the first line edge after the zeros (the kill output's is before)
+    }
+    INFO("last zero order #" << last_zero << ", then line edge #" << power_off_edge);
+    CHECK(last_zero > 0);
+    CHECK(power_off_edge > last_zero);
     CHECK(d.vehicle_string("State") == "powered-off");
     // Clean exits: a sanitizer report or a crash would show here.
     CHECK(d.daemon.terminate() == 0);
