@@ -10,6 +10,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace caracara {
 
@@ -20,6 +21,8 @@ public:
         virtual ~Listener() = default;
         // The switch's current reading (set = kill), on every edge and every backstop poll.
         virtual void kill_switch_read(bool set) = 0;
+        // An output line could not be written (its chip or the simulator went away).
+        virtual void device_lost(std::string_view why) = 0;
     };
 
     SafetyLines(sd_event* event, GpioBackend& gpio, const GpioSettings& settings)
@@ -43,6 +46,10 @@ private:
     static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
     // Requests the switch and watches its edges; "" or why not.
     std::string open_switch();
+    // An output (kill, power-off) could not be written: dropped, the vehicle killed, and asked
+    // for again with the reopen timer (the kill output then starts asserted).
+    void output_lost(std::unique_ptr<GpioLine>& line, const char* what, int err);
+    void schedule_reopen();
     // The switch cannot be read (its chip or the simulator went away): its source goes (no busy
     // loop), it counts as set (a kill), and it is asked for again once a second.
     void switch_lost(const std::string& why);
@@ -56,6 +63,7 @@ private:
     std::unique_ptr<GpioLine> power_off_;
     SourcePtr kill_switch_source_;
     SourcePtr reopen_timer_;
+    bool kill_asserted_ = true; // what the kill output should show (for a reopened line)
 };
 
 } // namespace caracara

@@ -132,6 +132,8 @@ void ThrusterBus::note(IoError e) {
     if (t == LockupDetector::Transfer::Ok || t == LockupDetector::Transfer::BadReply) {
         // A bad reply still crossed the bus: the thruster is at fault, not the wire.
         if (tm_.state != BusState::Ok) {
+            if (tm_.state == BusState::Lost)
+                log_notice("I2C bus %s is back; the vehicle stays killed until ClearKill", device_.c_str());
             tm_.state = BusState::Ok;
             events_.changed(kChangeState | kChangeBus);
         }
