@@ -122,6 +122,7 @@ constexpr dbus::Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("SetClock", SD_BUS_ARGS("u", hz), SD_BUS_NO_RESULT, m_set_clock, kUnpriv)),
     property<[](I i) { return gpio(i).kill_switch_engaged(); }>("KillSwitch"),
     property<[](I) { return GpioModel::kKillSwitch; }>("KillSwitchLine", kConst),
+    property<[](I) { return GpioModel::kKillOut; }>("KillOutputLine", kConst),
     property<[](I i) { return gpio(i).kill_switch_active_low(); }>("KillSwitchActiveLow", kConst),
     property<[](I i) { return gpio(i).level(GpioModel::kKillOut); }>("KillOutput"),
     property<[](I i) { return gpio(i).level(GpioModel::kPowerOff); }>("PowerOffOutput"),
