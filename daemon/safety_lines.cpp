@@ -20,6 +20,7 @@ std::string SafetyLines::open(bool kill_asserted, Listener* listener) {
         kill_out_ = gpio_.request(line_spec(*settings_.kill_output), GpioMode::Output, kill_asserted ? 1 : 0, err);
         if (!kill_out_)
             return "gpio.kill_output: " + err;
+        kill_output_changed();
     }
     if (settings_.power_off_output) {
         power_off_ = gpio_.request(line_spec(*settings_.power_off_output), GpioMode::Output, 0, err);
@@ -53,6 +54,8 @@ std::string SafetyLines::open_switch() {
 }
 
 void SafetyLines::close() {
+    if (kill_output_watcher_)
+        kill_output_watcher_(nullptr);
     kill_switch_source_.reset();
     reopen_timer_.reset();
 }
@@ -113,8 +116,10 @@ int SafetyLines::on_reopen(sd_event_source*, uint64_t, void* userdata) {
             return;
         std::string err;
         line = self->gpio_.request(line_spec(*cfg), GpioMode::Output, value, err);
-        if (line)
+        if (line) {
             log_notice("%s %s is back", what, line_spec(*cfg).describe().c_str());
+            self->kill_output_changed();
+        }
         else
             missing = true;
     };
@@ -134,6 +139,8 @@ int SafetyLines::on_reopen(sd_event_source*, uint64_t, void* userdata) {
 }
 
 void SafetyLines::output_lost(std::unique_ptr<GpioLine>& line, const char* what, int err) {
+    if (&line == &kill_out_ && kill_output_watcher_)
+        kill_output_watcher_(nullptr);
     line.reset();
     log_error("%s cannot be written (%s): vehicle killed; asking for it again once a second", what,
               errno_name(-err).c_str());

@@ -8,6 +8,7 @@
 #include "platform/event_loop.hpp"
 #include "platform/gpio_backend.hpp"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -38,6 +39,12 @@ public:
     void set_kill_output(bool asserted);
     bool has_power_off() const { return power_off_ != nullptr; }
     void assert_power_off();
+    // Told the kill output line whenever it changes (null before it goes): the fatal-signal
+    // emergency stop writes it first.
+    void set_kill_output_watcher(std::function<void(GpioLine*)> fn) {
+        kill_output_watcher_ = std::move(fn);
+        kill_output_changed();
+    }
     // The switch's event fd (for the loop's "is anything waiting" check), or -1.
     int kill_switch_fd() const { return kill_switch_ ? kill_switch_->event_fd() : -1; }
 
@@ -64,6 +71,11 @@ private:
     SourcePtr kill_switch_source_;
     SourcePtr reopen_timer_;
     bool kill_asserted_ = true; // what the kill output should show (for a reopened line)
+    std::function<void(GpioLine*)> kill_output_watcher_;
+    void kill_output_changed() {
+        if (kill_output_watcher_)
+            kill_output_watcher_(kill_out_.get());
+    }
 };
 
 } // namespace caracara

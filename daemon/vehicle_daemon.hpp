@@ -45,6 +45,7 @@ public:
     const ControlLoop& loop() const { return loop_; }
     ServiceStatus& status() { return status_; }
     BusRecovery& recovery() { return recovery_; }
+    SafetyLines& lines() { return lines_; }
 
 private:
     sd_event* event_;

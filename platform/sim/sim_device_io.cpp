@@ -189,6 +189,21 @@ int SimDeviceIo::simple(Op op, int32_t a, int32_t b) {
     return roundtrip(w.size(), op, r);
 }
 
+bool SimDeviceIo::gpio_set_in_signal_handler(int line, int value) noexcept {
+    const int h = wire_handle(line);
+    if (h < 0 || sock_ < 0)
+        return false;
+    std::array<uint8_t, 32> buf{};
+    Writer w(buf);
+    w.header(Op::GpioSet, 0);
+    w.i32(h);
+    w.u8(value ? 1 : 0);
+    const int saved = errno;
+    const bool ok = w.ok() && ::send(sock_, buf.data(), w.size(), MSG_NOSIGNAL | MSG_DONTWAIT) > 0;
+    errno = saved;
+    return ok;
+}
+
 int SimDeviceIo::gpio_get(int line) { return simple(Op::GpioGet, line); }
 int SimDeviceIo::gpio_set(int line, int value) { return simple(Op::GpioSet, line, value); }
 int SimDeviceIo::gpio_release(int line) { return simple(Op::GpioRelease, line); }

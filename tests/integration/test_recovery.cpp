@@ -294,6 +294,7 @@ TEST_CASE("a crashing daemon, or one ended by a stray signal, zeroes the thruste
         DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"));
         const std::vector<int32_t> v = {2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000};
         drive(d, f, v);
+        REQUIRE(f.call(kSim, kSimIface, "ClearWireLog", "") == "");
         kill(d.daemon.pid(), sig);
         const int status = d.daemon.wait_exit(10000);
         // Died of that signal, as it would have without the handler (ASan may turn SIGSEGV into
@@ -303,6 +304,17 @@ TEST_CASE("a crashing daemon, or one ended by a stray signal, zeroes the thruste
         else
             CHECK(status == 128 + sig);
         CHECK(all_at(f, std::vector<int32_t>(8, 0)));
+        // The handler asserted the kill output before its first zero order (wire-log order).
+        uint64_t kill_edge = 0, first_zero = 0;
+        for (const auto& e : f.wire_log()) {
+            if (e.bus == "gpio" && e.addr == 27 && kill_edge == 0)
+                kill_edge = e.index;
+            if (e.bus == "i2c" && !e.read && e.data.size() == 3 && e.data[0] == speed_byte(0) && first_zero == 0)
+                first_zero = e.index;
+        }
+        INFO("kill output edge #" << kill_edge << ", first zero order #" << first_zero);
+        CHECK(kill_edge > 0);
+        CHECK(kill_edge < first_zero);
         CHECK(f.sim.terminate() == 0);
     }
 }
