@@ -60,7 +60,7 @@ const DeviceOps::Entry DeviceOps::kTable[] = {
 };
 
 size_t DeviceOps::handle(DeviceSession& session, std::span<const uint8_t> req, std::span<uint8_t> reply,
-                         uint64_t& wire_ns) {
+                         uint64_t& wire_ns, bool truncated) {
     Request q{*this, session, simproto::Reader(req), simproto::Writer(reply), {}, Op::Open, reply};
     wire_ns = 0;
     held_ns_ = 0;
@@ -71,6 +71,10 @@ size_t DeviceOps::handle(DeviceSession& session, std::span<const uint8_t> req, s
         return q.w.size();
     }
     q.op = static_cast<Op>(q.h.op);
+    if (truncated) {
+        q.bad(-EMSGSIZE);
+        return q.w.size();
+    }
     Handler handler = nullptr;
     for (const Entry& e : kTable)
         if (e.op == q.op)

@@ -19,7 +19,10 @@ public:
     // Serves one request of `session` and writes its reply into `reply`; returns the reply's
     // length and, in `wire_ns`, the wire time the request occupied. Every request gets exactly
     // one reply: a malformed one -EBADMSG, one whose reply would not fit -EMSGSIZE.
-    size_t handle(DeviceSession& session, std::span<const uint8_t> req, std::span<uint8_t> reply, uint64_t& wire_ns);
+    // `truncated`: the request was longer than kMaxMessage (only its start is in `req`); it is
+    // refused whole with -EMSGSIZE, never served cut short.
+    size_t handle(DeviceSession& session, std::span<const uint8_t> req, std::span<uint8_t> reply, uint64_t& wire_ns,
+                  bool truncated = false);
     uint64_t bad_requests() const { return bad_requests_; }
     // Of the last request's wire time, how long a slave held the clock (a hung device): the
     // reply waits that long even when the wire's own timing is not simulated.

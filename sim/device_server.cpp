@@ -118,7 +118,8 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
     auto* c = static_cast<Client*>(userdata);
     DeviceServer* self = c->server;
     uint8_t buf[simproto::kMaxMessage];
-    ssize_t n = ::recv(fd, buf, sizeof buf, MSG_DONTWAIT);
+    // MSG_TRUNC: the real length of a longer message, whose rest the socket discards.
+    ssize_t n = ::recv(fd, buf, sizeof buf, MSG_DONTWAIT | MSG_TRUNC);
     if (n < 0 && (errno == EAGAIN || errno == EINTR))
         return 0;
     if (n <= 0 || (revents & (EPOLLHUP | EPOLLERR) && n <= 0)) {
@@ -126,7 +127,9 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
         return 0;
     }
     uint64_t wire_ns = 0;
-    c->reply_len = self->ops_.handle(c->session, {buf, static_cast<size_t>(n)}, c->reply, wire_ns);
+    const bool truncated = static_cast<size_t>(n) > sizeof buf;
+    c->reply_len = self->ops_.handle(c->session, {buf, truncated ? sizeof buf : static_cast<size_t>(n)}, c->reply,
+                                     wire_ns, truncated);
     uint64_t due_ns = 0;
     if (self->vehicle_.realistic_timing() && wire_ns > 0) {
         // Realistic timing: the reply leaves when the transaction is over on the wire, and the
