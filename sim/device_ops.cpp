@@ -41,6 +41,8 @@ struct DeviceOps::Request {
     const DeviceSession::Handle* device(int32_t hnd, SimVehicle::NodeKind kind, int& err) {
         auto it = session.handles.find(hnd);
         err = it == session.handles.end() ? -EBADF : it->second.kind != kind ? -ENOTTY : 0;
+        if (!err && it->second.epoch != ops.vehicle_.node_epoch(kind))
+            err = -ENODEV; // the device vanished after this handle was opened
         return err ? nullptr : &it->second;
     }
 };
@@ -107,7 +109,7 @@ uint64_t DeviceOps::open(Request& q) {
     if (kind == SimVehicle::NodeKind::None)
         return q.bad(-ENOENT);
     int hnd = q.session.next_handle++;
-    q.session.handles[hnd] = {kind, std::string(path)};
+    q.session.handles[hnd] = {kind, std::string(path), vehicle_.node_epoch(kind)};
     q.begin(hnd);
     return 0;
 }

@@ -144,6 +144,59 @@ class HungThrusterDefaultTimeoutTest(unittest.TestCase):
         rig.sim_thruster_call(HUNG, "SetHang", 0, signature="u")
 
 
+class VanishTest(unittest.TestCase):
+    """A device node vanishes for 1.5 s and returns (the simulator's Vanish: hot unplug, its
+    driver gone): killed, one log line, reopened once a second, killed until ClearKill."""
+
+    def setUp(self):
+        self.rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
+        self.addCleanup(self.rig.stop_checked)
+        self.rig.start()
+        self.rig.arm()
+        self.rig.thrust([600] * MOTORS)
+        self.rig.wait_sim_speeds([speed_byte(600)] * MOTORS)
+
+    def back_and_driving(self):
+        rig = self.rig
+        poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10, message="ClearKill refused after the return")
+        rig.wait_state("ready")
+        rig.thrust([700] * MOTORS)
+        rig.wait_sim_speeds([speed_byte(700)] * MOTORS)
+
+    def test_adapter(self):
+        rig = self.rig
+        t0 = time.monotonic()
+        rig.sim_call("Vanish", "i2c", 1500, signature="su")
+        poll(lambda: rig.state() == "killed", 5, message="a vanished adapter did not kill")
+        killed = time.monotonic() - t0
+        self.assertEqual(rig.vget("KillSource"), "bus")
+        self.assertEqual(error_name(rig.vcall, "ClearKill"), ERR + "BusLost")
+        poll(lambda: bus_state(rig) == "ok", 10, interval=0.05, message="the adapter never came back")
+        back = time.monotonic() - t0
+        self.assertEqual(rig.state(), "killed")
+        self.assertEqual(rig.log().count("recovery is not configured"), 1)
+        print("\nI2C adapter gone for 1.5 s: killed after %.0f ms, bus ok again %.1f s after it went" %
+              (killed * 1000, back))
+        self.back_and_driving()
+
+    def test_teensy_spi(self):
+        rig = self.rig
+        t0 = time.monotonic()
+        rig.sim_call("Vanish", "spi", 1500, signature="su")
+        poll(lambda: rig.state() == "killed", 5, message="a vanished Teensy did not kill")
+        killed = time.monotonic() - t0
+        self.assertEqual(rig.vget("KillSource"), "device")
+        self.assertFalse(rig.vget("Online", path="/org/caracara/Vehicle1/teensy", iface="org.caracara.Vehicle1.Teensy"))
+        poll(lambda: rig.vget("Online", path="/org/caracara/Vehicle1/teensy", iface="org.caracara.Vehicle1.Teensy"),
+             10, interval=0.05, message="the Teensy never came back")
+        back = time.monotonic() - t0
+        self.assertEqual(rig.state(), "killed")
+        self.assertEqual(rig.log().count("Teensy SPI"), 2)  # went away; is back
+        print("\nTeensy SPI gone for 1.5 s: killed after %.0f ms, online again %.1f s after it went" %
+              (killed * 1000, back))
+        self.back_and_driving()
+
+
 class SimulatorRestartTest(unittest.TestCase):
     """caracara-sim ends under a running daemon and is started again: the daemon stays quiet and
     killed while it is gone, then reopens the lines, the adapter and the Teensy by itself; the
