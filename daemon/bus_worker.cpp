@@ -64,7 +64,9 @@ void BusWorker::stop() {
     }
 }
 
-void BusWorker::submit(const BusJob& job) {
+void BusWorker::submit(const BusJob& in) {
+    BusJob job = in;
+    job.epoch = epoch_.load();
     if (!running()) {
         // Before the thread starts or after it stopped: on the caller's thread.
         const BusJobDone d{job, execute(*drivers_[job.index], job)};
@@ -91,7 +93,10 @@ void BusWorker::submit_first(std::span<const BusJob> jobs) {
         std::lock_guard lk(mu_);
         outstanding_ -= queue_.size();
         queue_.clear();
-        queue_.insert(queue_.end(), jobs.begin(), jobs.end());
+        for (BusJob j : jobs) {
+            j.epoch = epoch_.load();
+            queue_.push_back(j);
+        }
     }
     outstanding_ += jobs.size();
     wake_.notify_one();
@@ -113,10 +118,12 @@ void BusWorker::run() {
         queue_.pop_front();
         busy_ = true;
         lk.unlock();
-        const IoError e = execute(*drivers_[job.index], job); // the transfer: nothing held
+        // A non-zero order from before the last kill is dropped here, at the last moment.
+        const bool skip = job.kind == BusJobKind::Order && job.value != 0 && job.epoch != epoch_.load();
+        const IoError e = skip ? IoError::None : execute(*drivers_[job.index], job); // nothing held
         lk.lock();
         published_[job.index] = *drivers_[job.index];
-        done_.push_back({job, e});
+        done_.push_back({job, e, skip});
         busy_ = false;
         finished_.notify_all();
         const uint64_t one = 1;

@@ -11,6 +11,7 @@
 #include "platform/event_loop.hpp"
 #include "platform/io_error.hpp"
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -29,12 +30,14 @@ enum class BusJobKind : uint8_t { Order, Status };
 struct BusJob {
     BusJobKind kind = BusJobKind::Order;
     uint32_t index = 0;
-    int32_t value = 0; // the motor value of an order
+    int32_t value = 0;  // the motor value of an order
+    uint64_t epoch = 0; // hold_orders() count when it was handed over (set by submit)
 };
 
 struct BusJobDone {
     BusJob job;
     IoError error = IoError::None;
+    bool skipped = false; // a non-zero order that a kill overtook: never sent
 };
 
 class BusWorker {
@@ -57,6 +60,10 @@ public:
     void submit_first(std::span<const BusJob> jobs);
     // Drops what is queued but not yet on the wire (the bus is closed for recovery).
     void drop_queued();
+    // From now on, a non-zero order handed over before this call is not sent: a kill calls it
+    // before it writes the kill output, so no such order can follow the kill output onto the
+    // wire once the worker has seen it (at most the one whose transfer had already begun).
+    void hold_orders() { epoch_.fetch_add(1); }
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
     bool idle() const { return outstanding_ == 0; }
     // Blocks until idle, handing the finished jobs to `done`: start-up and shutdown only,
@@ -75,6 +82,7 @@ private:
     std::vector<ThrusterDriver> views_;     // loop thread
     std::vector<ThrusterDriver> published_; // under mu_: the worker's copy after each job
     std::size_t outstanding_ = 0;           // loop thread
+    std::atomic<uint64_t> epoch_{0};
 
     mutable std::mutex mu_;
     std::condition_variable wake_;      // the worker: a job or stop

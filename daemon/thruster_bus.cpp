@@ -78,7 +78,8 @@ void ThrusterBus::when_idle(std::function<void()> fn) {
 }
 
 void ThrusterBus::done(const BusJobDone& d) {
-    note(d.error);
+    if (!d.skipped)
+        note(d.error);
     if (d.job.kind == BusJobKind::Status && d.error == IoError::None)
         report_faults(d.job.index);
     if (worker_.idle() && !when_idle_.empty()) {

@@ -66,6 +66,8 @@ public:
     void read_status(std::size_t i);
     // Zero to every thruster, back to back: nothing may come between a kill and its zeros.
     void zero_all(ZeroOrder where = ZeroOrder::First);
+    // Before a kill's kill output: no non-zero order handed over earlier goes out after it.
+    void hold_orders() { worker_.hold_orders(); }
     // Blocks until the worker is idle: at start-up and shutdown, where the zeros must be on the
     // wire before the daemon goes on.
     void wait_idle() { worker_.wait_idle(); }

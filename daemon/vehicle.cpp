@@ -49,8 +49,10 @@ void Vehicle::handle(const SafetyAction& a) {
     // A kill reaches the kill output first: it is one GPIO write, and the zero orders behind it
     // are bus transfers that a hung device can delay. Releasing it (arming) waits for the zeros.
     const bool assert_first = a.state_changed && safety_.kill_output_asserted();
-    if (assert_first)
+    if (assert_first) {
+        bus_.hold_orders();
         lines_.set_kill_output(true);
+    }
     if (a.zero_outputs) {
         // A kill's zeros go before anything queued; a timeout's or a departed client's go
         // behind what that client had sent.
