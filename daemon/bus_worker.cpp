@@ -1,5 +1,6 @@
 #include "daemon/bus_worker.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <sys/eventfd.h>
@@ -8,6 +9,8 @@
 namespace caracara {
 
 namespace {
+constexpr std::size_t kWakeEvery = 16;
+
 IoError execute(ThrusterDriver& d, const BusJob& job) {
     return job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
 }
@@ -64,7 +67,7 @@ void BusWorker::stop() {
     }
 }
 
-void BusWorker::submit(const BusJob& in) {
+void BusWorker::submit(const BusJob& in, bool replace) {
     BusJob job = in;
     job.epoch = epoch_.load();
     if (!running()) {
@@ -78,7 +81,20 @@ void BusWorker::submit(const BusJob& in) {
     ++outstanding_;
     {
         std::lock_guard lk(mu_);
-        queue_.push_back(job);
+        if (job.kind == BusJobKind::Order) {
+            // Orders go before the status reads, and a newer order for a thruster replaces one
+            // still queued for it: a new command waits at most for the transfer on the wire.
+            for (auto it = queue_.begin(); replace && it != queue_.end(); ++it)
+                if (it->kind == BusJobKind::Order && it->index == job.index) {
+                    queue_.erase(it);
+                    --outstanding_;
+                    break;
+                }
+            auto pos = std::find_if(queue_.begin(), queue_.end(), [](const BusJob& j) { return j.kind != BusJobKind::Order; });
+            queue_.insert(pos, job);
+        } else {
+            queue_.push_back(job);
+        }
     }
     wake_.notify_one();
 }
@@ -126,9 +142,14 @@ void BusWorker::run() {
         done_.push_back({job, e, skip});
         busy_ = false;
         finished_.notify_all();
-        const uint64_t one = 1;
-        // A full counter (never, at 2^64 - 1) would only merge wake-ups.
-        [[maybe_unused]] const ssize_t n = ::write(efd_, &one, sizeof one);
+        // One wake-up of the loop per batch (the queue ran dry), or every kWakeEvery jobs so the
+        // books stay fresh when the bus never rests: a wake-up per transfer would cost the loop
+        // more than the transfer when the device answers at once.
+        if (queue_.empty() || done_.size() >= kWakeEvery) {
+            const uint64_t one = 1;
+            // A full counter (never, at 2^64 - 1) would only merge wake-ups.
+            [[maybe_unused]] const ssize_t n = ::write(efd_, &one, sizeof one);
+        }
     }
 }
 

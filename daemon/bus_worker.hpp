@@ -55,7 +55,9 @@ public:
     void stop();
     bool running() const { return thread_.joinable(); }
 
-    void submit(const BusJob& job);
+    // An order goes before the queued status reads and, with `replace`, takes the place of one
+    // still queued for the same thruster; a status read goes last.
+    void submit(const BusJob& job, bool replace = true);
     // `jobs` go before everything queued, which is dropped (a kill's zero orders).
     void submit_first(std::span<const BusJob> jobs);
     // Drops what is queued but not yet on the wire (the bus is closed for recovery).

@@ -88,11 +88,14 @@ void ControlLoop::step_aside() {
 
 int ControlLoop::on_work(sd_event_source*, void* userdata) {
     auto* self = static_cast<ControlLoop*>(userdata);
-    // The Teensy's slots run here, back to back while nothing else waits; an I2C transfer is
-    // handed to the bus worker, and its end (bus_done) brings the work back.
+    // The cycle's transfers are handed to the bus worker as one batch (orders first; see
+    // BusWorker::submit); the Teensy's slots run here meanwhile. The end of the batch
+    // (bus_done) brings the work back to close the cycle.
     for (int n = 0; n < kTransactionsPerDispatch; ++n) {
         const Work w = self->work_one();
-        if (w == Work::Transfer || w == Work::Waiting) {
+        if (w == Work::Transfer)
+            continue;
+        if (w == Work::Waiting) {
             sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
             return 0;
         }
@@ -163,8 +166,6 @@ void ControlLoop::cycle() {
 }
 
 ControlLoop::Work ControlLoop::work_one() {
-    if (!bus_.idle())
-        return Work::Waiting; // one transfer at a time: a new command's order is next in line
     const OrderSchedule::Item item = bus_.schedule().next(!bus_.recovering());
     switch (item.kind) {
     case OrderSchedule::Kind::Order:
@@ -178,7 +179,8 @@ ControlLoop::Work ControlLoop::work_one() {
         return Work::Other;
     case OrderSchedule::Kind::None: break;
     }
-    return Work::None;
+    // The cycle ends once its transfers are done too.
+    return bus_.idle() ? Work::None : Work::Waiting;
 }
 
 bool ControlLoop::healthy(uint64_t now_ns) const {

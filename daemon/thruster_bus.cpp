@@ -62,7 +62,7 @@ void ThrusterBus::zero_all(ZeroOrder where) {
         worker_.submit_first(std::span<const BusJob>(zeros).first(n));
     else
         for (std::size_t i = 0; i < n; ++i)
-            worker_.submit(zeros[i]);
+            worker_.submit(zeros[i], false); // behind what is queued, not instead of it
 }
 
 void ThrusterBus::read_status(std::size_t i) {
