@@ -90,7 +90,7 @@ fi
 builds=$cache_dir/builds
 build=$builds/$(basename "$cache" .tar)-$(printf '%s' "$src" | sha256sum | cut -c1-12)
 mkdir -p "$build"
-find "$builds" -mindepth 1 -maxdepth 1 -mtime +14 ! -path "$build" -exec rm -rf --one-file-system {} +
+find "$builds" -mindepth 1 -maxdepth 1 -mtime +14 ! -path "$build" ! -path "$build-kernel" -exec rm -rf --one-file-system {} +
 touch "$build"
 
 # --- this run's root ---------------------------------------------------------------------------
@@ -109,7 +109,9 @@ trap 'exit 130' INT TERM
 mkdir -p "$root"
 tar -C "$root" --numeric-owner -xpf "$cache"
 # What the chroot inside the QEMU guest finds at the host's paths (step 4).
-mkdir -p "$root$src" "$root$build" "$root$work/kernel"
+# Not under /var/tmp: the guest mounts a tmpfs there.
+kwork=$build-kernel
+mkdir -p "$kwork" "$root$src" "$root$build" "$root$kwork"
 
 cat >"$root/usr/local/bin/caracara-build-and-test" <<'SCRIPT'
 #!/bin/bash
@@ -121,7 +123,7 @@ echo "== build (scripts/build.sh, CARACARA_WERROR=ON)"
 "$SRC/scripts/build.sh" "$BUILD" -DCARACARA_WERROR=ON
 grep -E '^(GPIODCXX_VERSION|Catch2_DIR|TOMLPP_VERSION|SYSTEMD_VERSION)' "$BUILD/CMakeCache.txt" | sed 's/^/   /'
 echo "== ctest (all but the tests labelled system or kernel)"
-ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel'
+CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel'
 SCRIPT
 chmod 0755 "$root/usr/local/bin/caracara-build-and-test"
 
@@ -140,7 +142,7 @@ if [ "$rc" -ne 0 ]; then
   tail -n 150 "$work/build.log"
   die "the build or ctest failed in the Debian 13 root"
 fi
-ctest_line=$(grep -E 'tests passed, [0-9]+ tests failed out of' "$work/build.log" | tail -n 1)
+ctest_line=$(sed 's/\x1b\[[0-9;]*m//g' "$work/build.log" | grep -E 'tests passed, [0-9]+ tests failed out of' | tail -n 1 || true)
 
 failed=0
 say "system test in a booted Debian 13 container (tests/system/run.sh, CARACARA_SYSTEST_SUITE=trixie)"
@@ -158,10 +160,10 @@ if [ "${CARACARA_DEBIAN13_KERNEL:-1}" != 0 ]; then
   # directory must be where the host has them.
   mount --bind -o ro "$src" "$root$src"
   mount --bind "$build" "$root$build"
-  mount --bind "$work/kernel" "$root$work/kernel"
+  mount --bind "$kwork" "$root$kwork"
   t3=$(date +%s)
   kernel_rc=0
-  CARACARA_KERNEL_ROOT=$root CARACARA_KERNEL_BUILD=$build "$src/tests/kernel/run.sh" "$work/kernel" || kernel_rc=$?
+  CARACARA_KERNEL_ROOT=$root CARACARA_KERNEL_BUILD=$build "$src/tests/kernel/run.sh" "$kwork" || kernel_rc=$?
   kernel_s=$(($(date +%s) - t3))
   [ "$kernel_rc" -eq 0 ] || failed=1
 fi
