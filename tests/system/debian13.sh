@@ -90,8 +90,11 @@ fi
 builds=$cache_dir/builds
 build=$builds/$(basename "$cache" .tar)-$(printf '%s' "$src" | sha256sum | cut -c1-12)
 mkdir -p "$build"
-find "$builds" -mindepth 1 -maxdepth 1 -mtime +14 ! -path "$build" ! -path "$build-kernel" -exec rm -rf --one-file-system {} +
 touch "$build"
+# About 200 MB each: the three used last are kept (a CI clone at a new path each time makes one).
+for old in $(ls -1dt "$builds"/*/ | sed 's#/$##' | grep -v -- '-kernel$' | tail -n +4); do
+  rm -rf --one-file-system "$old" "$old-kernel"
+done
 
 # --- this run's root ---------------------------------------------------------------------------
 # The lock above is held by one run at a time: a run directory left now is a killed run's.
