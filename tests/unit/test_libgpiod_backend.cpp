@@ -1,7 +1,8 @@
 // The libgpiod backend this build has (v1 on libgpiod 1.6, v2 on libgpiod 2.x: the same test
 // for both). Without a GPIO chip (none on CI) only the paths that need no chip run: a chip that
 // cannot be found or opened fails the request with the line's description in the error.
-// Requests on a real chip (modes, active-low, edges) are covered by the QEMU kernel test.
+// Requests on a real chip (modes, active-low, edges, lookups, consumer) are covered by the QEMU
+// kernel test: CTest `kernel` for this build, `system_debian13` for the libgpiod 2 build.
 #include "platform/gpio_line.hpp"
 #include "platform/linux/libgpiod_backend.hpp"
 #include "tests/catch.hpp"
