@@ -1,4 +1,5 @@
-// GpioBackend on libgpiod's v1 C++ binding (gpiod.hpp, Debian 12). Only this file knows it.
+// GpioBackend on libgpiod's v1 C++ binding (gpiod.hpp 1.6: Debian 12, Raspberry Pi OS bookworm).
+// Only this file knows it; libgpiod2_backend.cpp does the same on libgpiod 2 (CMake builds one).
 #include "platform/linux/libgpiod_backend.hpp"
 
 #include "platform/linux/libgpiod_output_line.hpp"
@@ -8,10 +9,6 @@
 #include <system_error>
 
 namespace caracara {
-
-std::string GpioLineSpec::describe() const {
-    return offset ? chip + " line " + std::to_string(*offset) : chip + ":" + name;
-}
 
 namespace {
 

@@ -3,7 +3,7 @@
 #include "tests/integration/daemon_fixture.hpp"
 #include "tests/integration/sim_fixture.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <csignal>
 #include <chrono>
 #include <ctime>

@@ -5,7 +5,7 @@
 #include "tests/integration/sim_fixture.hpp"
 #include "protocol/sim_protocol.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cerrno>
 #include <fcntl.h>
 #include <linux/i2c-dev.h>

@@ -6,7 +6,7 @@
 #include "protocol/teensy_codec.hpp"
 #include "devices/teensy_link.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cmath>
 #include <ctime>
 #include <memory>

@@ -7,7 +7,7 @@
 #include "tests/integration/sim_fixture.hpp"
 #include "devices/thruster_driver.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <memory>
 #include <stdexcept>
 #include <thread>

@@ -3,7 +3,7 @@
 # bridge module, then the scenarios; results go to $OUT (shared with the host).
 set -u
 export PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
-echo "guest: $(uname -r), $(nproc) CPU"
+echo "guest: $(uname -r), $(nproc) CPU, $(. /etc/os-release && echo "$PRETTY_NAME")"
 [ -n "${TOP:-}" ] || { echo "guest: no environment"; exit 1; }
 if ! /sbin/insmod "$WORK/module/caracara_bridge.ko"; then
   echo "FAIL module: insmod" > "$OUT/results.txt"; exit 1

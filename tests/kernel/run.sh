@@ -7,6 +7,10 @@
 #
 #   tests/kernel/run.sh [WORK_DIR]     (default: build-kernel in the source tree)
 #   CARACARA_KERNEL_SCENARIOS='start kill' tests/kernel/run.sh    only those scenarios
+#   CARACARA_KERNEL_ROOT=DIR CARACARA_KERNEL_BUILD=BUILD tests/kernel/run.sh WORK_DIR
+#       the guest runs in the root DIR instead of the host's (tests/system/debian13.sh: a Debian
+#       13 root with libgpiod 2) with the binaries of BUILD (not rebuilt, no coverage); the
+#       source tree, BUILD and WORK_DIR must be at the same paths in DIR as on the host.
 #
 # Fetches the kernel, headers and kbuild .debs with apt-get download into
 # /var/cache/caracara-kernel/VERSION (unpacked there, never installed), builds the module
@@ -77,11 +81,17 @@ nice -n 10 make -s -C "$kroot/usr/src/linux-headers-$kver" M="$mod" -j2 modules 
 [ -f "$mod/caracara_bridge.ko" ] || { echo "kernel: module build failed"; exit 1; }
 
 # --- caracarad and caracara-sim with coverage ----------------------------------------------
-step "building caracarad and caracara-sim with --coverage"
-cov=$work/cov
-nice -n 10 cmake -S "$top" -B "$cov" -DCMAKE_BUILD_TYPE=Debug -DCARACARA_WERROR=ON -DCMAKE_CXX_FLAGS=--coverage >/dev/null
-nice -n 10 cmake --build "$cov" -j2 --target caracarad caracara-sim >/dev/null
-find "$cov" -name '*.gcda' -delete
+guest_root=${CARACARA_KERNEL_ROOT:-/}
+if [ -n "${CARACARA_KERNEL_BUILD:-}" ]; then
+  cov=$CARACARA_KERNEL_BUILD
+  step "using caracarad and caracara-sim of $cov in the guest root $guest_root"
+else
+  step "building caracarad and caracara-sim with --coverage"
+  cov=$work/cov
+  nice -n 10 cmake -S "$top" -B "$cov" -DCMAKE_BUILD_TYPE=Debug -DCARACARA_WERROR=ON -DCMAKE_CXX_FLAGS=--coverage >/dev/null
+  nice -n 10 cmake --build "$cov" -j2 --target caracarad caracara-sim >/dev/null
+  find "$cov" -name '*.gcda' -delete
+fi
 
 # --- initramfs: busybox, the 9p modules, /init ----------------------------------------------
 step "initramfs"
@@ -129,7 +139,7 @@ timeout 600 nice -n 10 qemu-system-x86_64 -machine q35 -accel tcg -cpu max -m 76
   -kernel "$kroot/boot/vmlinuz-$kver" -initrd "$work/initramfs.gz" \
   -append "console=ttyS0 panic=-1 quiet loglevel=4" \
   -nographic -no-reboot -nic none \
-  -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
+  -virtfs "local,path=$guest_root,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap" \
   -virtfs "local,path=$out,mount_tag=results,security_model=none" \
   > "$work/console.log" 2>&1
 qemu_rc=$?

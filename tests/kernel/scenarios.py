@@ -10,6 +10,7 @@ writes one line per scenario, "PASS name (seconds)" or "FAIL name: reason", to R
 """
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -424,6 +425,51 @@ def sc_unwired_line(rig):
     check("GPIO5" in out and "kill_output" in out, "the error does not name the line: %r" % out[-400:])
 
 
+def gpio_debugfs():
+    """The kernel's own view of the GPIO lines in use: {line name: (consumer, "in"/"out")}."""
+    try:
+        with open("/sys/kernel/debug/gpio") as f:
+            text = f.read()
+    except OSError as e:
+        raise AssertionError("cannot read /sys/kernel/debug/gpio: %s" % e)
+    lines = {}
+    for m in re.finditer(r"^\s*gpio-\d+ \((.*?)\s*\|(.*?)\s*\) (in|out) ", text, re.M):
+        lines[m.group(1)] = (m.group(2), m.group(3))
+    return lines
+
+
+def sc_gpio_lookup(rig):
+    """The chip named by number, label and path, lines by offset as well as by name (as
+    configurations written for either libgpiod find them): the kernel shows each line requested
+    by "caracarad" in its direction, and the kill output and the kill switch work through them."""
+    gpio = dict(GPIO,
+                kill_switch={"chip": "0", "line": 17},
+                kill_output={"chip": "caracara-gpio", "line": 27},
+                power_off_output={"chip": "/dev/gpiochip0", "line": "GPIO22"})
+    try:
+        restart_with(rig, gpio=gpio)
+        used = gpio_debugfs()
+        for name, direction in (("GPIO17", "in"), ("GPIO27", "out"), ("GPIO22", "out")):
+            check(used.get(name, ("", ""))[0] == "caracarad", "%s not requested by caracarad: %r" % (name, used))
+            check(used[name][1] == direction, "%s is %s, not %s" % (name, used[name][1], direction))
+        since = rig.wire_next()
+        rig.vcall("Kill")
+        wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5,
+                  "the kill output found by label and offset did not go high")
+        rig.vcall("ClearKill")
+        rig.wait_state("ready", 20)
+        rig.sim_call("SetKillSwitch", True, signature="b")
+        try:
+            rig.wait_state("killed", 10)
+            check(rig.vget("KillSource") == "switch", "KillSource %r" % rig.vget("KillSource"))
+        finally:
+            rig.sim_call("SetKillSwitch", False, signature="b")
+        rig.vcall("ClearKill")
+        rig.wait_state("ready", 20)
+    finally:
+        restart_with(rig, gpio=GPIO)
+
+
 def sc_per_byte_spi_active_low(rig):
     """Per-byte SPI transfers (one spi_ioc_transfer per byte with a delay) through spidev, and
     an active-low kill output inverted by gpiolib: the wire shows the physical levels."""
@@ -489,6 +535,7 @@ SCENARIOS = [
     ("scl_held_low_bus_kill", sc_scl_low),
     ("per_byte_spi_and_active_low_output", sc_per_byte_spi_active_low),
     ("unwired_gpio_line_refused", sc_unwired_line),
+    ("gpio_chip_by_number_label_path_line_by_offset", sc_gpio_lookup),
     ("sigterm", sc_sigterm),
     # With no daemon: i2c-tools alone on the adapter; it leaves thruster 1 running.
     ("i2ctransfer_reference", sc_i2ctransfer),

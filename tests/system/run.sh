@@ -3,6 +3,8 @@
 # unit files, bus policy and configuration, in a Debian 12 container.
 #
 #   tests/system/run.sh BUILD_DIR
+#   CARACARA_SYSTEST_SUITE=trixie tests/system/run.sh BUILD_DIR    a Debian 13 container (for a
+#                                  build made in Debian 13: tests/system/debian13.sh does that)
 #
 # 1. Builds a minimal Debian 12 root with debootstrap, once: the result is cached as a
 #    tarball under /var/cache/caracara-systest/ (CARACARA_SYSTEST_CACHE), keyed by the
@@ -24,13 +26,19 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 build=${1:?usage: run.sh BUILD_DIR}
 build=$(cd "$build" && pwd)
-suite=bookworm
+# The Debian release of the container: bookworm (Debian 12, the default) or trixie (Debian 13,
+# for tests/system/debian13.sh, which passes a build made in Debian 13).
+suite=${CARACARA_SYSTEST_SUITE:-bookworm}
 arch=$(dpkg --print-architecture)
 cache_dir=${CARACARA_SYSTEST_CACHE:-/var/cache/caracara-systest}
 timeout_s=${CARACARA_SYSTEST_TIMEOUT:-420}
 # What the container needs besides debootstrap's minbase: an init, the system bus, and the
-# shared libraries of caracarad, caracara-sim and caracaractl.
-packages=(systemd systemd-sysv dbus libsystemd0 libgpiod2 libtomlplusplus3)
+# shared libraries of caracarad, caracara-sim and caracaractl (their names differ by release).
+case $suite in
+  bookworm) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod2 libtomlplusplus3) ;;
+  trixie) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod3 libtomlplusplus3t64) ;;
+  *) echo "system-test: CARACARA_SYSTEST_SUITE must be bookworm or trixie, not '$suite'" >&2; exit 2 ;;
+esac
 # Bump when the way the cached root is made changes.
 recipe=1
 
@@ -56,59 +64,15 @@ if ((${#need[@]})); then
   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
 fi
 
-# --- the Debian mirror this machine's apt uses ------------------------------------------------
-# deb822 files first (Debian 12's default), then one-line sources. Only a "deb" source of the
-# suite itself counts (not -updates, -security, or another distribution).
-find_mirror() {
-  if [ -n "${CARACARA_SYSTEST_MIRROR:-}" ]; then
-    echo "$CARACARA_SYSTEST_MIRROR"
-    return
-  fi
-  local f uri
-  for f in /etc/apt/sources.list.d/*.sources; do
-    [ -f "$f" ] || continue
-    uri=$(awk -v suite="$suite" '
-      BEGIN { RS = ""; FS = "\n" }
-      {
-        types = ""; uris = ""; suites = ""; enabled = "yes"
-        for (i = 1; i <= NF; i++) {
-          line = $i
-          if (line ~ /^[ \t]*#/) continue
-          split(line, kv, ":")
-          key = tolower(kv[1]); val = substr(line, length(kv[1]) + 2)
-          gsub(/^[ \t]+|[ \t]+$/, "", val)
-          if (key == "types") types = val
-          else if (key == "uris") uris = val
-          else if (key == "suites") suites = val
-          else if (key == "enabled") enabled = tolower(val)
-        }
-        if (enabled == "no") next
-        if ((" " types " ") !~ / deb /) next
-        if ((" " suites " ") !~ (" " suite " ")) next
-        split(uris, u, /[ \t]+/)
-        print u[1]; exit
-      }' "$f")
-    if [[ $uri =~ ^(https?|file):// ]]; then echo "$uri"; return; fi
-  done
-  for f in /etc/apt/sources.list /etc/apt/sources.list.d/*.list; do
-    [ -f "$f" ] || continue
-    uri=$(awk -v suite="$suite" '
-      $1 == "deb" {
-        i = 2
-        if ($i ~ /^\[/) { while ($i !~ /\]$/ && i < NF) i++; i++ }
-        if ($(i + 1) == suite) { print $i; exit }
-      }' "$f")
-    if [[ $uri =~ ^(https?|file):// ]]; then echo "$uri"; return; fi
-  done
-  return 1
-}
+# --- the Debian mirror this machine's apt uses (tests/system/mirror.sh) ----------------------
+. "$here/mirror.sh"
 
-# --- the cached Debian 12 root ------------------------------------------------------------------
+# --- the cached Debian root ----------------------------------------------------------------------
 key=$(printf '%s\n' "$suite" "$arch" minbase "$recipe" "${packages[@]}" | sha256sum | cut -c1-16)
 cache=$cache_dir/$suite-$arch-$key.tar
 t0=$(date +%s)
 if [ ! -f "$cache" ]; then
-  mirror=$(find_mirror) || die "no Debian $suite mirror in this machine's apt sources (set CARACARA_SYSTEST_MIRROR)"
+  mirror=$(find_mirror "$suite") || die "no Debian $suite mirror in this machine's apt sources (set CARACARA_SYSTEST_MIRROR)"
   say "building the $suite root with debootstrap from $mirror (cached in $cache)"
   mkdir -p "$cache_dir"
   boot=$(mktemp -d "$cache_dir/debootstrap.XXXXXX")

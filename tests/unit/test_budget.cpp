@@ -1,6 +1,6 @@
 #include "core/budget.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cstdlib>
 #include <limits>
 

@@ -1,6 +1,6 @@
 #include "core/config.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cctype>
 #include <fstream>
 #include <random>

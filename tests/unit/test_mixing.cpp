@@ -1,6 +1,6 @@
 #include "core/mixing.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cmath>
 #include <limits>
 #include <set>

@@ -1,7 +1,7 @@
 // The motor demand: profile before budget, announcements only on change, a profile switch.
 #include "core/motor_demand.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 
 using namespace caracara;
 

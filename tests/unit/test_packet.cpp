@@ -1,6 +1,6 @@
 #include "core/packet.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <limits>
 #include <vector>
 

@@ -4,7 +4,7 @@
 #include "core/order_schedule.hpp"
 #include "core/recovery_policy.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 
 #include <vector>
 

@@ -1,6 +1,6 @@
 #include "core/safety.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 
 using namespace caracara;
 

@@ -5,7 +5,7 @@
 #include "protocol/pca9544a.hpp"
 #include "protocol/seabotix.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cerrno>
 #include <cstdint>
 #include <deque>

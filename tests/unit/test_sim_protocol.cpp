@@ -1,7 +1,7 @@
 #include "platform/io_error.hpp"
 #include "protocol/sim_protocol.hpp"
 
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cerrno>
 #include <linux/i2c-dev.h>
 #include <linux/spi/spidev.h>

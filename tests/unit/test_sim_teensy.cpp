@@ -4,7 +4,7 @@
 #include "sim/vehicle_body.hpp"
 
 #include <algorithm>
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cmath>
 #include <cstring>
 #include <numbers>

@@ -5,7 +5,7 @@
 #include "devices/teensy_link.hpp"
 
 #include <algorithm>
-#include <catch2/catch.hpp>
+#include "tests/catch.hpp"
 #include <cerrno>
 #include <fcntl.h>
 #include <cmath>

@@ -1,0 +1,193 @@
+#!/usr/bin/env bash
+# The Debian 13 (trixie) test: this source tree built and tested on Debian 13's own toolchain and
+# libraries (GCC 14, libgpiod 2 and its C++ binding, Catch2 3, toml++ 3.4, systemd 257, Python
+# 3.13), then run under Debian 13's systemd and dbus and on a real kernel's GPIO chip.
+#
+#   tests/system/debian13.sh SOURCE_DIR
+#
+# 1. A minbase trixie root with the build and test dependencies is made with debootstrap once
+#    and cached as a tarball under /var/cache/caracara-systest/ (CARACARA_SYSTEST_CACHE), keyed
+#    by the package list, so later runs unpack it in seconds and install nothing.
+# 2. The root is unpacked under /var/tmp. systemd-nspawn runs there, with SOURCE_DIR bound
+#    read-only and a build tree (kept between runs under the cache directory, one per source
+#    directory) bound writable, both at their host paths: scripts/build.sh with warnings as
+#    errors (-j2), then ctest without the tests labelled system or kernel (they boot a
+#    container or a VM of their own; both are run next, from the host).
+# 3. tests/system/run.sh with CARACARA_SYSTEST_SUITE=trixie: the system test's checks
+#    (check.sh) in a booted Debian 13 container with this build installed.
+# 4. tests/kernel/run.sh with CARACARA_KERNEL_ROOT set to the Debian 13 root: the kernel test's
+#    scenarios under QEMU, caracarad's libgpiod 2 backend on the test module's GPIO chip.
+#    CARACARA_DEBIAN13_KERNEL=0 leaves this step out.
+#
+# Needs root. Exit status 77 (skipped) when not root or when CARACARA_SKIP_DEBIAN13=1; 0 when
+# every step passed.
+set -euo pipefail
+
+here=$(cd "$(dirname "$0")" && pwd)
+src=$(cd "${1:?usage: debian13.sh SOURCE_DIR}" && pwd)
+suite=trixie
+arch=$(dpkg --print-architecture)
+cache_dir=${CARACARA_SYSTEST_CACHE:-/var/cache/caracara-systest}
+build_timeout_s=${CARACARA_DEBIAN13_BUILD_TIMEOUT:-1500}
+# Build and test dependencies (scripts/deps.sh's, by their Debian 13 names), and what the kernel
+# test's guest runs in this root: insmod, i2c-tools.
+packages=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev libcatch2-dev
+          libtomlplusplus-dev dbus python3 python3-dbus python3-gi systemd kmod i2c-tools)
+# Bump when the way the cached root is made changes.
+recipe=1
+
+say() { echo "debian13: $*"; }
+die() { echo "debian13: FAIL: $*" >&2; exit 1; }
+
+if [ "$(id -u)" -ne 0 ]; then
+  say "SKIP: needs root (debootstrap, systemd-nspawn)"
+  exit 77
+fi
+if [ "${CARACARA_SKIP_DEBIAN13:-0}" = 1 ]; then
+  say "SKIP: CARACARA_SKIP_DEBIAN13=1"
+  exit 77
+fi
+t0=$(date +%s)
+need=()
+command -v debootstrap >/dev/null || need+=(debootstrap)
+command -v systemd-nspawn >/dev/null || need+=(systemd-container)
+if ((${#need[@]})); then
+  say "installing ${need[*]}"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
+fi
+
+# --- the cached build root ---------------------------------------------------------------------
+# Named apart from run.sh's roots ($suite-$arch-KEY.tar), which run.sh prunes by that pattern.
+mkdir -p "$cache_dir"
+exec {lock}>"$cache_dir/.$suite-build.lock"
+flock "$lock"
+key=$(printf '%s\n' "$suite" "$arch" minbase "$recipe" "${packages[@]}" | sha256sum | cut -c1-16)
+cache=$cache_dir/$suite-build-$arch-$key.tar
+if [ ! -f "$cache" ]; then
+  . "$here/mirror.sh"
+  mirror=$(find_mirror "$suite") || die "no Debian mirror in this machine's apt sources (set CARACARA_SYSTEST_MIRROR)"
+  say "building the $suite build root with debootstrap from $mirror (cached in $cache)"
+  tmp=$(mktemp -d "$cache_dir/debootstrap.XXXXXX")
+  trap 'rm -rf --one-file-system "$tmp"' EXIT
+  if ! debootstrap --variant=minbase --components=main --include="$(IFS=,; echo "${packages[*]}")" \
+      "$suite" "$tmp/root" "$mirror" >"$tmp/debootstrap.log" 2>&1; then
+    tail -n 30 "$tmp/debootstrap.log" >&2
+    die "debootstrap failed"
+  fi
+  chroot "$tmp/root" apt-get clean
+  rm -rf "$tmp/root/var/lib/apt/lists/"* "$tmp/root/var/log/"*.log
+  tar -C "$tmp/root" --numeric-owner -cpf "$tmp/root.tar" .
+  mv "$tmp/root.tar" "$cache"
+  rm -rf --one-file-system "$tmp"
+  trap - EXIT
+  find "$cache_dir" -maxdepth 1 -name "$suite-build-$arch-*.tar" ! -path "$cache" -delete
+  say "build root made in $(($(date +%s) - t0)) s"
+fi
+
+# The build tree survives the run, so a rerun rebuilds only what changed: one per source
+# directory (make trusts timestamps) and per root (another compiler makes everything stale).
+builds=$cache_dir/builds
+build=$builds/$(basename "$cache" .tar)-$(printf '%s' "$src" | sha256sum | cut -c1-12)
+mkdir -p "$build"
+touch "$build"
+# About 200 MB each: the three used last are kept (a CI clone at a new path each time makes one).
+for old in $(ls -1dt "$builds"/*/ | sed 's#/$##' | grep -v -- '-kernel$' | tail -n +4); do
+  rm -rf --one-file-system "$old" "$old-kernel"
+done
+
+# --- this run's root ---------------------------------------------------------------------------
+# The lock above is held by one run at a time: a run directory left now is a killed run's.
+unmount_under() {
+  local m
+  for m in $(awk -v w="$1" 'index($2, w) == 1 { print $2 }' /proc/self/mounts | sort -r); do
+    umount -l "$m" 2>/dev/null || true
+  done
+}
+for stale in /var/tmp/caracara-debian13.*; do
+  [ -d "$stale" ] || continue
+  say "removing $stale, left by an earlier run"
+  unmount_under "$stale"
+  rm -rf --one-file-system "$stale"
+done
+work=$(mktemp -d /var/tmp/caracara-debian13.XXXXXX)
+root=$work/root
+cleanup() {
+  local rc=$?
+  unmount_under "$work"
+  rm -rf --one-file-system "$work"
+  exit "$rc"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+mkdir -p "$root"
+tar -C "$root" --numeric-owner -xpf "$cache"
+# What the chroot inside the QEMU guest finds at the host's paths (step 4).
+# Not under /var/tmp: the guest mounts a tmpfs there.
+kwork=$build-kernel
+mkdir -p "$kwork" "$root$src" "$root$build" "$root$kwork"
+
+cat >"$root/usr/local/bin/caracara-build-and-test" <<'SCRIPT'
+#!/bin/bash
+# Run by tests/system/debian13.sh inside the Debian 13 root: SRC and BUILD are host paths.
+set -euo pipefail
+. /etc/os-release
+echo "== $PRETTY_NAME, $(g++ --version | head -n 1), cmake $(cmake --version | sed -n '1s/.* //p')"
+echo "== build (scripts/build.sh, CARACARA_WERROR=ON)"
+"$SRC/scripts/build.sh" "$BUILD" -DCARACARA_WERROR=ON
+grep -E '^(GPIODCXX_VERSION|Catch2_DIR|TOMLPP_VERSION|SYSTEMD_VERSION)' "$BUILD/CMakeCache.txt" | sed 's/^/   /'
+echo "== ctest (all but the tests labelled system or kernel)"
+CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel'
+SCRIPT
+chmod 0755 "$root/usr/local/bin/caracara-build-and-test"
+
+say "building and testing $src in the Debian 13 root (at most ${build_timeout_s} s)"
+t1=$(date +%s)
+rc=0
+timeout --kill-after=20 "$build_timeout_s" \
+  systemd-nspawn --quiet --keep-unit --register=no --directory="$root" --private-network \
+    --bind-ro="$src" --bind="$build" --setenv=HOME=/root --setenv=SRC="$src" --setenv=BUILD="$build" \
+    /usr/local/bin/caracara-build-and-test >"$work/build.log" 2>&1 || rc=$?
+grep -E '^== |^   |tests passed|tests failed|Total Test time|\*\*\*|Failed|error:|warning:' "$work/build.log" | head -n 60
+build_s=$(($(date +%s) - t1))
+say "build and ctest: $build_s s (exit status $rc)"
+if [ "$rc" -ne 0 ]; then
+  echo "---- build and test log (last 150 lines) ----"
+  tail -n 150 "$work/build.log"
+  die "the build or ctest failed in the Debian 13 root"
+fi
+ctest_line=$(sed 's/\x1b\[[0-9;]*m//g' "$work/build.log" | grep -E 'tests passed, [0-9]+ tests failed out of' | tail -n 1 || true)
+
+failed=0
+say "system test in a booted Debian 13 container (tests/system/run.sh, CARACARA_SYSTEST_SUITE=trixie)"
+t2=$(date +%s)
+system_rc=0
+CARACARA_SYSTEST_SUITE=$suite "$here/run.sh" "$build" || system_rc=$?
+system_s=$(($(date +%s) - t2))
+[ "$system_rc" -eq 0 ] || failed=1
+
+kernel_rc=skipped
+kernel_s=0
+case $src in
+  # The guest mounts a tmpfs on these: the source tree would not be there.
+  /var/tmp/*|/run/*|/dev/shm/*)
+    say "FAIL: the kernel step needs the source tree outside /var/tmp, /run and /dev/shm ($src)"
+    kernel_rc=1; failed=1 ;;
+  *) ;;
+esac
+if [ "$kernel_rc" = skipped ] && [ "${CARACARA_DEBIAN13_KERNEL:-1}" != 0 ]; then
+  say "kernel test with the Debian 13 build (tests/kernel/run.sh, guest root: the Debian 13 root)"
+  # The guest chroots into this root over 9p: the source, the build and the kernel test's work
+  # directory must be where the host has them.
+  mount --bind -o ro "$src" "$root$src"
+  mount --bind "$build" "$root$build"
+  mount --bind "$kwork" "$root$kwork"
+  t3=$(date +%s)
+  kernel_rc=0
+  CARACARA_KERNEL_ROOT=$root CARACARA_KERNEL_BUILD=$build "$src/tests/kernel/run.sh" "$kwork" || kernel_rc=$?
+  kernel_s=$(($(date +%s) - t3))
+  [ "$kernel_rc" -eq 0 ] || failed=1
+fi
+
+say "Debian 13: ctest ${ctest_line:-?} ($build_s s with the build); system test exit $system_rc ($system_s s); kernel test exit $kernel_rc ($kernel_s s); $(($(date +%s) - t0)) s in all"
+exit "$failed"
