@@ -2,7 +2,7 @@
 # Builds the Debian packages caracarad and caracara-sim with dpkg-buildpackage, then runs
 # lintian on them (an error fails the script).
 #
-#   scripts/package.sh [amd64|arm64] [OUTDIR]
+#   scripts/package.sh [amd64|arm64|native] [OUTDIR]
 #
 # amd64 (or whatever this machine is) is a native build that runs the test suite (less the
 # system and kernel tests) unless DEB_BUILD_OPTIONS has nocheck. arm64 is a cross build with
@@ -13,7 +13,8 @@
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 native=$(dpkg --print-architecture)
-arch=${1:-$native}
+arch=${1:-native}
+[ "$arch" != native ] || arch=$native
 out=${2:-$top/build-deb}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
@@ -68,8 +69,12 @@ version=$(dpkg-parsechangelog -l "$top/debian/changelog" -S Version)
 work=$out/src-$arch
 rm -rf "$work"
 mkdir -p "$work/caracarad-$version"
-(cd "$top" && git ls-files -z --cached --others --exclude-standard | \
-   tar --null --ignore-failed-read -T - -cf - 2>/dev/null) | tar -C "$work/caracarad-$version" -xf -
+if git -C "$top" rev-parse --git-dir >/dev/null 2>&1; then
+  (cd "$top" && git ls-files -z --cached --others --exclude-standard | \
+     tar --null --ignore-failed-read -T - -cf - 2>/dev/null) | tar -C "$work/caracarad-$version" -xf -
+else
+  tar -C "$top" --exclude='./build*' --exclude='./obj-*' -cf - . | tar -C "$work/caracarad-$version" -xf -
+fi
 [ -f "$work/caracarad-$version/debian/rules" ] || { echo "package: no debian/ in the copy" >&2; exit 1; }
 
 # --- build ------------------------------------------------------------------------------------
@@ -85,6 +90,8 @@ fi
 grep -E '^[0-9]+% tests passed|^Total Test time' "$log" || true
 say "built in $(($(date +%s) - t1)) s"
 changes=caracarad_${version}_$arch.changes
+# Only this build's packages for this architecture in OUTDIR (run.sh --debs takes the newest).
+rm -f "$out"/caracara{d,-sim}{,-dbgsym}_*_"$arch".deb "$out"/caracarad_*_"$arch".{changes,buildinfo}
 for f in "$work"/*_"$version"_"$arch".*; do
   mv -f "$f" "$out/"
 done
