@@ -45,11 +45,11 @@ if [ "$arch" != "$native" ]; then
   fi
   cross=(-a arm64)
   # Nothing runs arm64 code during a package build (no emulator there): no tests.
-  opts="nocheck $opts"
+  opts="nocheck${opts:+ $opts}"
 fi
 profiles=()
 case " $opts " in *" nocheck "*) profiles=(-Pnocheck) ;; esac
-opts="$opts parallel=$(nproc)"
+opts="${opts:+$opts }parallel=$(nproc)"
 
 # --- the tools, then the build dependencies (as debian/control lists them) --------------------
 need=()
@@ -79,9 +79,9 @@ fi
 
 # --- build ------------------------------------------------------------------------------------
 log=$out/build-$arch.log
-say "dpkg-buildpackage -b ${cross[*]} ${profiles[*]} (DEB_BUILD_OPTIONS='${opts# }'), log in $log"
+say "dpkg-buildpackage -b ${cross[*]} ${profiles[*]} (DEB_BUILD_OPTIONS='$opts'), log in $log"
 t1=$(date +%s)
-if ! (cd "$work/caracarad-$version" && DEB_BUILD_OPTIONS="${opts# }" \
+if ! (cd "$work/caracarad-$version" && DEB_BUILD_OPTIONS="$opts" \
         dpkg-buildpackage -b -us -uc "${cross[@]}" "${profiles[@]}") >"$log" 2>&1; then
   tail -n 60 "$log" >&2
   echo "package: dpkg-buildpackage failed (log: $log)" >&2
