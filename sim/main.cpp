@@ -14,6 +14,7 @@
 #include <string>
 #include <systemd/sd-daemon.h>
 #include <ctime>
+#include <unistd.h>
 
 using namespace caracara;
 using namespace caracara::sim;
@@ -28,6 +29,8 @@ void usage(FILE* f) {
                "                        caracarad then runs --hardware=linux on the kernel's own nodes;\n"
                "                        the device socket is served only if --socket is given\n"
                "  --config FILE         vehicle description (TOML; [i2c], [spi], [[thruster]], [sim])\n"
+               "  --config-if-exists FILE  the same, but the built-in vehicle when FILE does not exist\n"
+               "                        (caracara-sim.service: caracarad's file, absent on defaults)\n"
                "  --system              inspection API on the system bus\n"
                "  --user                inspection API on the user bus (default)\n"
                "  --bus-address ADDR    inspection API on the bus at ADDR\n"
@@ -59,6 +62,7 @@ int on_physics(sd_event_source* s, uint64_t usec, void* userdata) {
 int main(int argc, char** argv) {
     std::string socket_path = "/run/caracara/sim.sock";
     std::string config_path;
+    bool config_optional = false;
     std::string kernel_bridge;
     bool socket_given = false;
     dbus::BusChoice bus_choice{dbus::BusChoice::Kind::User, {}};
@@ -79,6 +83,7 @@ int main(int argc, char** argv) {
         if (a == "--socket") { socket_path = value("--socket"); socket_given = true; }
         else if (a == "--kernel-bridge") kernel_bridge = value("--kernel-bridge");
         else if (a == "--config") config_path = value("--config");
+        else if (a == "--config-if-exists") { config_path = value("--config-if-exists"); config_optional = true; }
         else if (a == "--system") bus_choice = {dbus::BusChoice::Kind::System, {}};
         else if (a == "--user") bus_choice = {dbus::BusChoice::Kind::User, {}};
         else if (a == "--bus-address") bus_choice = {dbus::BusChoice::Kind::Address, value("--bus-address")};
@@ -100,6 +105,9 @@ int main(int argc, char** argv) {
 
     SimConfig cfg = default_sim_config();
     std::string err;
+    // caracarad runs on the same built-in vehicle when its file is absent.
+    if (config_optional && access(config_path.c_str(), F_OK) != 0)
+        config_path.clear();
     if (!config_path.empty() && !load_sim_config(config_path, cfg, err)) {
         std::fprintf(stderr, "caracara-sim: %s\n", err.c_str());
         return 1;

@@ -8,7 +8,7 @@ foreach(name vehicle introspection caracaractl mission paths_out faults)
            COMMAND /usr/bin/python3 -m unittest -v test_${name}
            WORKING_DIRECTORY ${CARACARA_E2E_DIR})
   set_tests_properties(e2e_${name} PROPERTIES
-                       ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1"
+                       ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
                        TIMEOUT 600
                        LABELS e2e)
 endforeach()

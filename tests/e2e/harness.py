@@ -49,6 +49,17 @@ def binary(name):
     return os.path.join(BUILD_DIR, sub, name)
 
 
+# A cross build's programs are foreign binaries: they run through the emulator ctest runs the
+# tests with (CARACARA_TEST_EMULATOR, set by tests/CMakeLists.txt), while python3, busctl and
+# dbus-daemon stay native.
+EMULATOR = os.environ.get("CARACARA_TEST_EMULATOR", "").split()
+
+
+def command(name):
+    """The argv that starts a built program (before its arguments)."""
+    return EMULATOR + [binary(name)]
+
+
 # --- the D-Bus names -------------------------------------------------------------------------
 
 VEHICLE = "org.caracara.Vehicle1"
@@ -388,15 +399,15 @@ class Rig:
 
     def start_sim(self):
         """Starts caracara-sim (again, after a test ended it: the daemon is to pick it up)."""
-        self._spawn("caracara-sim", [binary("caracara-sim"), "--socket", self.sim_socket,
-                                     "--bus-address", self.address])
+        self._spawn("caracara-sim", command("caracara-sim") + ["--socket", self.sim_socket,
+                                                               "--bus-address", self.address])
         poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,
              message="caracara-sim did not take its name")
         self._check_alive("caracara-sim")
 
     def start_daemon(self):
         self.daemon_exit = None
-        self._spawn("caracarad", [binary("caracarad"), "--hardware=sim:" + self.sim_socket,
+        self._spawn("caracarad", command("caracarad") + ["--hardware=sim:" + self.sim_socket,
                                   "--bus-address", self.address, "--config", self.config_path])
         poll(lambda: self.conn.name_has_owner(VEHICLE) or self._died("caracarad"), self.START_TIMEOUT,
              message="caracarad did not take its name")
@@ -609,7 +620,7 @@ class Rig:
                               capture_output=True, text=True, timeout=timeout)
 
     def ctl(self, *args, timeout=90):
-        return subprocess.run([binary("caracaractl"), "--bus-address", self.address] + [str(a) for a in args],
+        return subprocess.run(command("caracaractl") + ["--bus-address", self.address] + [str(a) for a in args],
                               capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
 
     # -- test conveniences --

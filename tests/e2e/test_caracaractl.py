@@ -10,7 +10,7 @@ import unittest
 
 import harness
 from harness import (DEFAULT_MT, ERR, MOTORS, ZERO, Rig, SEED_AXIS_MOTORS, VehicleTestCase, binary,
-                     speed_byte)
+                     command, speed_byte)
 
 OK, REFUSED, USAGE, UNAVAILABLE, DENIED = 0, 1, 2, 3, 4
 
@@ -31,7 +31,7 @@ class CaracaractlTest(VehicleTestCase):
         return self.rig.ctl(*args, **kw)
 
     def hold(self, *args):
-        return subprocess.Popen([binary("caracaractl"), "--bus-address", self.rig.address] + [str(a) for a in args],
+        return subprocess.Popen(command("caracaractl") + ["--bus-address", self.rig.address] + [str(a) for a in args],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                 stdin=subprocess.DEVNULL, preexec_fn=harness._die_with_parent)
 
@@ -239,7 +239,7 @@ class CaracaractlUnavailableTest(unittest.TestCase):
                 self.assertIn("not running", r.stderr)
 
     def test_bus_unreachable(self):
-        r = subprocess.run([binary("caracaractl"), "--bus-address", "unix:path=/nonexistent/caracara-bus", "status"],
+        r = subprocess.run(command("caracaractl") + ["--bus-address", "unix:path=/nonexistent/caracara-bus", "status"],
                            capture_output=True, text=True, timeout=60)
         self.assertEqual(r.returncode, UNAVAILABLE)
         self.assertIn("/nonexistent/caracara-bus", r.stderr)
@@ -249,7 +249,7 @@ class CaracaractlUnavailableTest(unittest.TestCase):
         self.addCleanup(rig.stop_checked)
         rig.start()
         rig.arm()
-        proc = subprocess.Popen([binary("caracaractl"), "--bus-address", rig.address, "thrust", "800", "0", "0",
+        proc = subprocess.Popen(command("caracaractl") + ["--bus-address", rig.address, "thrust", "800", "0", "0",
                                  "0", "0", "0", "0", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                 stdin=subprocess.DEVNULL, preexec_fn=harness._die_with_parent)
         try:

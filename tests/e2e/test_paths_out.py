@@ -15,7 +15,7 @@ import signal
 import dbus
 
 import harness
-from harness import (ERR, MOTORS, ZERO, DEFAULT_MT, Rig, VehicleTestCase, binary, error_name, poll, speed_byte)
+from harness import (ERR, MOTORS, ZERO, DEFAULT_MT, Rig, VehicleTestCase, command, error_name, poll, speed_byte)
 
 MISSION = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples", "mission_square.py")
 KILL_OUT = 27  # the simulator's kill output line (GpioModel::kKillOut)
@@ -554,7 +554,7 @@ class ZeroThrustersStepTest(unittest.TestCase):
         self.assertEqual(rig.sim_speeds(), [speed_byte(v) for v in values])
         since = rig.wire_next()
         t0 = time.monotonic()
-        p = subprocess.run([binary("caracarad"), "--zero-thrusters", "--config", rig.config_path,
+        p = subprocess.run(command("caracarad") + ["--zero-thrusters", "--config", rig.config_path,
                             "--hardware=sim:" + rig.sim_socket], capture_output=True, text=True, timeout=60)
         took = time.monotonic() - t0
         self.assertEqual(p.returncode, 0, p.stderr)
@@ -579,7 +579,7 @@ class ZeroThrustersStepTest(unittest.TestCase):
         # A slave holds SCL low: every transfer on the bus fails from then on.
         rig.sim_call("HoldScl")
         t0 = time.monotonic()
-        p = subprocess.run([binary("caracarad"), "--zero-thrusters", "--config", rig.config_path,
+        p = subprocess.run(command("caracarad") + ["--zero-thrusters", "--config", rig.config_path,
                             "--hardware=sim:" + rig.sim_socket], capture_output=True, text=True, timeout=120)
         took = time.monotonic() - t0
         print("\n--zero-thrusters on a bus held low: exit %d in %.1f s" % (p.returncode, took))

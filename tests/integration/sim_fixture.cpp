@@ -9,6 +9,7 @@
 #include <fcntl.h>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <stdexcept>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -21,7 +22,25 @@ using namespace std::chrono_literals;
 
 std::string bin(const char* name) { return std::string(CARACARA_BUILD_DIR) + "/" + name; }
 
-void Process::start(const std::vector<std::string>& argv, const std::string& log_path) {
+namespace {
+// A cross build's programs are foreign binaries: the tests start them through the emulator
+// ctest runs the tests with (CARACARA_TEST_EMULATOR, words separated by spaces; set by
+// tests/CMakeLists.txt from CMAKE_CROSSCOMPILING_EMULATOR). Other programs run natively.
+std::vector<std::string> with_emulator(const std::vector<std::string>& argv) {
+    const char* emu = std::getenv("CARACARA_TEST_EMULATOR");
+    if (!emu || !*emu || argv.empty() || argv[0].rfind(std::string(CARACARA_BUILD_DIR) + "/", 0) != 0)
+        return argv;
+    std::vector<std::string> out;
+    std::istringstream words(emu);
+    for (std::string w; words >> w;)
+        out.push_back(w);
+    out.insert(out.end(), argv.begin(), argv.end());
+    return out;
+}
+} // namespace
+
+void Process::start(const std::vector<std::string>& command, const std::string& log_path) {
+    const std::vector<std::string> argv = with_emulator(command);
     pid_ = fork();
     if (pid_ < 0)
         throw std::runtime_error("fork failed");
@@ -38,7 +57,7 @@ void Process::start(const std::vector<std::string>& argv, const std::string& log
         for (auto& a : argv)
             args.push_back(const_cast<char*>(a.c_str()));
         args.push_back(nullptr);
-        execv(args[0], args.data());
+        execvp(args[0], args.data());
         _exit(127);
     }
 }

@@ -18,8 +18,9 @@ public:
     Process(const Process&) = delete;
     Process& operator=(const Process&) = delete;
     ~Process() { stop(); }
-    // Starts argv[0] with the given arguments; stdout/stderr go to `log_path`.
-    void start(const std::vector<std::string>& argv, const std::string& log_path);
+    // Starts command[0] (found in PATH if it has no slash) with the given arguments, a built
+    // program through the cross build's emulator; stdout/stderr go to `log_path`.
+    void start(const std::vector<std::string>& command, const std::string& log_path);
     void stop(int sig = 15);    // signal, then wait
     // SIGTERM and wait: the exit status (128 + signal if killed by one), -1 if not running.
     // A sanitizer report in the child shows up here as a non-zero status.

@@ -27,7 +27,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "e2e"))
 import dbus  # noqa: E402
 
-from harness import MOTORS, SIM, SIM_GPIO, Rig, binary, poll, speed_byte  # noqa: E402
+from harness import MOTORS, SIM, SIM_GPIO, Rig, command, poll, speed_byte  # noqa: E402
 
 KILL_OUT = 27
 TIMEOUT_MS = 300
@@ -46,8 +46,8 @@ class SoakRig(Rig):
         conf = os.path.join(self.dir, "sim.toml")
         with open(conf, "w") as f:
             f.write("[sim]\nwire_log_entries = 2000000\n")
-        self._spawn("caracara-sim", [binary("caracara-sim"), "--socket", self.sim_socket,
-                                     "--bus-address", self.address, "--config", conf])
+        self._spawn("caracara-sim", command("caracara-sim") + ["--socket", self.sim_socket,
+                                                               "--bus-address", self.address, "--config", conf])
         poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,
              message="caracara-sim did not take its name")
         self._check_alive("caracara-sim")

@@ -24,6 +24,14 @@
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
+# run.sh --debs DIR: install the Debian packages built in DIR (scripts/package.sh) with apt-get
+# inside the booted container instead of a build tree with cmake --install (what CTest and CI
+# do); check-debs.sh adds an upgrade while the thrusters run, and the purge.
+debs=
+if [ "${1:-}" = --debs ]; then
+  debs=$(cd "${2:?usage: run.sh --debs DIR}" && pwd)
+  set -- "$debs"
+fi
 build=${1:?usage: run.sh BUILD_DIR}
 build=$(cd "$build" && pwd)
 # The Debian release of the container: bookworm (Debian 12, the default) or trixie (Debian 13,
@@ -49,7 +57,7 @@ if [ "$(id -u)" -ne 0 ]; then
   say "SKIP: needs root (debootstrap, systemd-nspawn)"
   exit 77
 fi
-for bin in caracarad caracara-sim caracaractl; do
+[ -n "$debs" ] || for bin in caracarad caracara-sim caracaractl; do
   case $bin in caracarad) p=daemon/$bin ;; caracara-sim) p=sim/$bin ;; *) p=tools/$bin ;; esac
   [ -x "$build/$p" ] || die "$build/$p is not built"
 done
@@ -141,9 +149,28 @@ mkdir -p "$root" "$out"
 chmod 0777 "$out"
 tar -C "$root" --numeric-owner -xpf "$cache"
 
-say "installing $build into the root (cmake --install --prefix /usr)"
-DESTDIR=$root cmake --install "$build" --prefix /usr >"$work/install.log" 2>&1 \
-  || { cat "$work/install.log" >&2; die "cmake --install failed"; }
+if [ -n "$debs" ]; then
+  # check.sh installs them with apt-get once the container runs (the maintainer scripts under
+  # a real systemd and bus). For the upgrade check, copies one version up: the same files,
+  # only the version (and caracara-sim's dependency on it) changed.
+  for p in caracarad caracara-sim; do
+    f=$(find "$debs" -maxdepth 1 -name "${p}_*_$arch.deb" | sort -V | tail -n 1)
+    [ -n "$f" ] || die "no ${p}_*_$arch.deb in $debs (scripts/package.sh $arch $debs)"
+    say "the root gets $f"
+    install -D -m 0644 "$f" "$root/systest-debs/$(basename "$f")"
+    dpkg-deb -R "$f" "$work/next-$p"
+    sed -i -E 's/^(Version: .*)$/\1+systest1/; s/^(Depends: .*caracarad \(= [^)]*)\)/\1+systest1)/' \
+      "$work/next-$p/DEBIAN/control"
+    mkdir -p "$root/systest-debs-next"
+    dpkg-deb -b "$work/next-$p" "$root/systest-debs-next/" >/dev/null
+    rm -rf "$work/next-$p"
+  done
+  install -D -m 0755 "$here/check-debs.sh" "$root/usr/local/libexec/caracara-systest/check-debs.sh"
+else
+  say "installing $build into the root (cmake --install --prefix /usr)"
+  DESTDIR=$root cmake --install "$build" --prefix /usr >"$work/install.log" 2>&1 \
+    || { cat "$work/install.log" >&2; die "cmake --install failed"; }
+fi
 
 # The checks: a test-only unit that runs check.sh once the system is up, then powers off.
 install -D -m 0755 "$here/check.sh" "$root/usr/local/libexec/caracara-systest/check.sh"

@@ -1,9 +1,18 @@
 # The system test (tests/system/run.sh): caracarad under a real systemd and system bus in a
-# Debian 12 container booted with systemd-nspawn, with the files `cmake --install` puts in
-# place. Needs root; exit status 77 (skipped) otherwise. Run once, in the normal build.
-if(NOT CARACARA_SANITIZE)
-  add_test(NAME system_nspawn COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/system/run.sh ${CMAKE_BINARY_DIR})
-  set_tests_properties(system_nspawn PROPERTIES TIMEOUT 1200 LABELS system SKIP_RETURN_CODE 77)
+# Debian 12 container booted with systemd-nspawn, installed from this tree's Debian packages
+# with apt-get (then upgraded while the thrusters run, and purged). system_debs builds them
+# first (scripts/package.sh, nocheck: the suite runs here anyway; alone, so that its compile
+# does not slow the timing-sensitive tests down). Needs root; exit status 77 (skipped) otherwise.
+# Run once, in the normal build.
+if(NOT CARACARA_SANITIZE AND NOT CMAKE_CROSSCOMPILING)
+  add_test(NAME system_debs
+           COMMAND ${CMAKE_COMMAND} -E env DEB_BUILD_OPTIONS=nocheck
+                   ${CMAKE_SOURCE_DIR}/scripts/package.sh native ${CMAKE_BINARY_DIR}/debs)
+  set_tests_properties(system_debs PROPERTIES TIMEOUT 900 LABELS system RUN_SERIAL TRUE
+                       FIXTURES_SETUP caracara_debs)
+  add_test(NAME system_nspawn COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/system/run.sh --debs ${CMAKE_BINARY_DIR}/debs)
+  set_tests_properties(system_nspawn PROPERTIES TIMEOUT 1200 LABELS system SKIP_RETURN_CODE 77
+                       FIXTURES_REQUIRED caracara_debs)
 endif()
 # The Debian 13 test (tests/system/debian13.sh): this source tree built with warnings as errors
 # and tested (ctest) in a cached Debian 13 root, then the checks above in a booted Debian 13
