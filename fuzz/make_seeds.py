@@ -36,9 +36,133 @@ def packet_seeds():
     write("packet", "empty", b"")
 
 
+def csum(b):
+    return sum(b) & 0xFF
+
+
+def seabotix_seeds():
+    def codec(reply, mt=0x52, order=b"", motor=0):
+        return bytes([len(reply), mt]) + bytes(reply) + bytes(order) + struct.pack("<i", motor)
+
+    def thruster(mt, legacy=False, mux=None, reversed_=False, info=100):
+        flags = (1 if legacy else 0) | (2 if mux else 0) | (4 if reversed_ else 0)
+        muxb = ((mux[0] - 0x70) | (mux[1] << 3)) if mux else 0
+        return bytes([(mt - 0x10) // 2, flags, muxb, info])
+
+    def bus(thrusters, muxregs=(0,) * 8):
+        return bytes([len(thrusters) - 1]) + b"".join(thrusters) + bytes(muxregs)
+
+    def order(i, value, faults=(0,)):
+        return bytes([(i << 2) | 0]) + struct.pack("<h", value) + bytes(faults)
+
+    def status(i, fields, mode=0, faults=(0,), flip=None):
+        # mode 0: well formed from fields; 1: raw bytes; 2: well formed, then one byte flipped.
+        b = bytes([(i << 2) | 1, mode]) + bytes(fields)
+        if mode == 2:
+            b += bytes(flip)
+        return b + bytes(faults)
+
+    sb = [0x53, 0x12, 0x00, 0x25, 0xB3, 0x1E]
+    write("seabotix", "codec-seabotix-ok", codec(sb + [csum(sb)]) + bus([thruster(0x52)]))
+    lg = [0x55, 0x20, 0x40]
+    write("seabotix", "codec-legacy-ok", codec(lg + [csum(lg)], mt=0x54, motor=-8850) + bus([thruster(0x54, True)]))
+    write("seabotix", "codec-bad-checksum", codec(sb + [csum(sb) ^ 1], order=[0x80, 100, (0x52 + 0x80 + 100) & 0xFF]))
+    write("seabotix", "codec-idle-high", codec([0xFF] * 7, motor=8851))
+    write("seabotix", "codec-order-0x7f", codec([], order=[0x7F, 100, (0x52 + 0x7F + 100) & 0xFF], motor=-43))
+    write("seabotix", "codec-motor-int-min", codec([], motor=-2**31))
+    # The vehicle: two same-address thrusters behind two muxes, one more on a second channel,
+    # one legacy thruster on the trunk; the muxes start with stale channels enabled.
+    four = bus([thruster(0x52, mux=(0x70, 0)), thruster(0x52, mux=(0x71, 0)),
+                thruster(0x56, mux=(0x70, 1), reversed_=True), thruster(0x54, legacy=True)],
+               muxregs=(0x05, 0x04, 0, 0, 0, 0, 0, 0))
+    ops = (order(0, 4425) + order(1, -8850) + order(2, 1000) + order(3, 8850) +
+           status(0, [0x12, 0x00, 0x25, 0xB3, 0x1E]) + status(1, [0x12, 0x09, 0x25, 0x40, 0x50]) +
+           status(2, [0x02, 0x1F, 0x00, 0xE6, 0x1E]) + status(3, [0x41, 0x9C]) +
+           status(0, [0x12, 0x00, 0x25, 0xB3, 0x1E], mode=2, flip=[3, 0x10]) +
+           status(1, [0x53, 0x12, 0x00, 0x25, 0xB3, 0x1E, 0x00], mode=1))
+    write("seabotix", "bus-four-thrusters", codec([]) + four + ops)
+    faults = (order(0, 100, faults=(0, 0, 0x0C)) +            # disable 0x71 fails but latches
+              order(1, 200, faults=(0, 4)) +                  # the mux write is NACKed
+              order(1, 200, faults=(0, 0, 5)) +               # the thruster times out
+              bytes([(1 << 2) | 2]) + order(1, 300) +         # mux 0x71 browns out: NACK
+              order(1, 300) + status(3, [0x20, 0x80], faults=(6,)) +
+              bytes([3]) + order(2, 9000) + order(2, -32768) + status(2, [0x22, 0x01, 0x10, 0x7F, 0x30], faults=(7,)))
+    write("seabotix", "bus-faults", codec([]) + four + faults)
+    write("seabotix", "bus-conflict", codec([]) + bus([thruster(0x52), thruster(0x52, mux=(0x70, 0))]) + order(0, 1))
+    write("seabotix", "bus-mux-address", codec([]) + bus([thruster(0xE0), thruster(0x52, mux=(0x70, 0))]))
+
+
+def teensy_seeds():
+    size = {1: 3, 2: 4, 3: 6, 4: 6, 5: 3, 6: 4, 7: 5, 8: 7, 9: 5}
+    h16 = lambda v: struct.pack("<h", v)
+
+    def ack(cmd, before=None):   # the Teensy acks: bytes before the ack slot, then the command
+        b = before if before is not None else [0] * (size[cmd] - 1)
+        return bytes([0]) + bytes(b)
+
+    def busy(cmd):
+        return bytes([1]) + bytes(size[cmd] - 1)
+
+    def raw(b):
+        return bytes([2]) + bytes(b)
+
+    fail = bytes([3])
+    short = bytes([4])
+
+    def link(flags=2, busy_retries=10, servos=4, sensors=4):
+        return bytes([flags, busy_retries, servos, sensors])
+
+    # The pure decoder: Confirm's reply "finished" (0xFF in the answer slot is data, not busy).
+    pure_ok = bytes([0, 3, 0x00, 0xFF, 0x01])
+    pure_torn = bytes([6, 3, 0x07, 0x00, 0x00])
+    ops = (bytes([0]) + h16(100) + h16(-100) + ack(2) +
+           bytes([1, 0]) + h16(1500) + busy(3) + ack(3) +
+           bytes([2, 1]) + struct.pack("<d", -3.14159) + ack(4) +
+           bytes([3]) + h16(255) + ack(5) +
+           bytes([4]) + h16(3) + h16(180) + ack(6) +
+           bytes([5]) + h16(1) + ack(7, [0, 0, 0xE8, 0x03]) +
+           bytes([6]) + h16(2) + ack(8, [0, 0] + list(struct.pack("<f", 0.5))) +
+           bytes([7]) + h16(255) + h16(0) + h16(128) + ack(9) +
+           bytes([8, 0]) + ack(1, [0xFF]))
+    write("teensy", "link-every-command", pure_ok + link() + ops)
+    refused = (bytes([0]) + h16(128) + h16(0) + bytes([1, 1]) + struct.pack("<d", float("nan")) +
+               bytes([2, 1]) + struct.pack("<d", 1e39) + bytes([3]) + h16(-1) +
+               bytes([4]) + h16(4) + h16(0) + bytes([4]) + h16(0) + h16(181) + bytes([5]) + h16(4) +
+               bytes([6]) + h16(3) + bytes([7]) + h16(256) + h16(0) + h16(0))
+    write("teensy", "link-refused-arguments", pure_torn + link() + refused)
+    errors = (bytes([1, 0]) + h16(700) + raw([3, 0, 0, 0, 0, 0x00]) +         # Turn: link error, never resent
+              bytes([0]) + h16(5) + h16(5) + raw([0, 0, 0, 0x42]) + ack(2) +   # Set Speed: resent once
+              bytes([0]) + h16(5) + h16(5) + busy(2) + busy(2) + busy(2) +      # busy, exhausted after 2
+              bytes([5]) + h16(0) + fail + bytes([5]) + h16(0) + short +
+              bytes([6]) + h16(0) + ack(8, [0, 0, 0, 0, 0x80, 0x7F]))           # +Inf: bad answer
+    write("teensy", "link-errors-per-byte", bytes([0x08, 3, 0x42, 0x04, 0x00, 0x08]) + link(flags=0x13, busy_retries=2) +
+          errors)
+    hs = (bytes([9]) + struct.pack("<I", 20_000_000) + bytes([0]) + struct.pack("<I", 1_000_000_000) + bytes([3]) +
+          bytes([0]) + struct.pack("<I", 1000) +
+          bytes([0]) + ack(1, [0x00]) +                        # poll: still turning
+          bytes([0]) +                                         # too early: wait
+          bytes([1]) + struct.pack("<I", 20_000_001) +
+          bytes([0]) + ack(1, [0xFF]) +                        # finished
+          bytes([2, 0, 0x42]) +                                # a stray answer
+          bytes([0]) + busy(1) + ack(1, [0x00]) +              # the acknowledgement, after a busy
+          bytes([0]))                                          # done
+    write("teensy", "handshake-finished", pure_ok + link() + hs)
+    hs_timeout = (bytes([9]) + struct.pack("<I", 0) + bytes([1]) + struct.pack("<Q", 2**64 - 1) + bytes([0]) +
+                  bytes([1]) + struct.pack("<Q", 2**64 - 5) +
+                  bytes([0]) + ack(1, [0xFF]) + bytes([0]) + fail + bytes([1]) + struct.pack("<I", 10) + bytes([0]) +
+                  bytes([3]) + bytes([0]) + ack(1, [0x07]))
+    write("teensy", "handshake-saturated-ack-fails", pure_ok + link() + hs_timeout)
+    hs_short = (bytes([9]) + struct.pack("<I", 1000) + bytes([0]) + struct.pack("<I", 5000) + bytes([2]) +
+                bytes([0]) + struct.pack("<I", 0) + bytes([0]) + ack(1, [0]) + bytes([1]) + struct.pack("<I", 6000) +
+                bytes([0]) + bytes([0]))
+    write("teensy", "handshake-timeout", pure_ok + link() + hs_short)
+
+
 def main():
     shutil.rmtree(os.path.join(HERE, "corpus"), ignore_errors=True)
     packet_seeds()
+    seabotix_seeds()
+    teensy_seeds()
 
 
 if __name__ == "__main__":
