@@ -158,11 +158,74 @@ def teensy_seeds():
     write("teensy", "handshake-timeout", pure_ok + link() + hs_short)
 
 
+def config_seeds():
+    with open(os.path.join(HERE, "..", "daemon", "caracarad.toml.example")) as f:
+        write("config", "example", f.read())
+    write("config", "empty", "")
+    muxed = "".join('[[thruster]]\naddress = 0x52\nvariant = "%s"\nmux_address = 0x%x\nmux_channel = %d\n'
+                    % ("legacy" if i % 2 else "seabotix", 0x70 + i // 4, i % 4) for i in range(8))
+    write("config", "eight-muxed", "[i2c]\ndevice = \"/dev/i2c-1\"\nclock_hz = 400000\n" + muxed)
+    write("config", "gpio-recovery", """[gpio]
+kill_switch = { chip = "gpiochip0", line = 17, active_low = true }
+kill_output = { line = "KILL_OUT" }
+power_off_output = { chip = "gpiochip1", line = 4 }
+scl = { line = 3 }
+sda = { line = 2 }
+[recovery]
+enabled = true
+attempts = 10
+driver_id = "fe804000.i2c"
+[control]
+profile = "air"
+budget_policy = "reject"
+loop_rate_hz = 0
+[profiles]
+air = 0.15
+water = 1
+""")
+    write("config", "every-error", """[i2c]
+device = "dev/i2c-1"
+clock_hz = 99999999999999999999
+timeout_ms = -1
+retries = "3"
+[spi]
+servos = 257
+speed_hz = 1e6
+[[thruster]]
+address = 0x53
+mux_address = 0xE0
+mux_channel = 4
+[mixing]
+matrix = [[1, 2], "x", [nan, inf, -inf, 1.5, 0, 0]]
+[control]
+profile = "space"
+arm_at_start = 1
+status_reads_per_tick = 0
+[gpio]
+scl = { line = 3 }
+kill_switch = { line = 3 }
+[recovery]
+enabled = true
+driver_id = "a b"
+[profiles]
+bad = 0
+worse = "x"
+[unknown]
+cntrol = 1
+""")
+    write("config", "sim-section", '[sim]\nrealistic_timing = true\nrebind_delay_ms = 70000\n[[thruster]]\naddress = 0x54\nbrushless = false\n')
+    write("config", "syntax-error", '[i2c\ndevice = "/dev/i2c-1"\n[[thruster]]\naddress = 0x52\naddress = 0x54\n')
+    write("config", "duplicate-mux-route", "".join('[[thruster]]\naddress = 0x%x\nmux_address = 0x70\nmux_channel = 0\n'
+                                                  % (0x52 if i < 2 else 0x52 + 2 * i) for i in range(8)))
+    write("config", "utf8-keys", '"ключ" = 1\n[profiles]\n"водa" = 0.5\n[control]\nprofile = "водa"\n')
+
+
 def main():
     shutil.rmtree(os.path.join(HERE, "corpus"), ignore_errors=True)
     packet_seeds()
     seabotix_seeds()
     teensy_seeds()
+    config_seeds()
 
 
 if __name__ == "__main__":
