@@ -220,12 +220,85 @@ cntrol = 1
     write("config", "utf8-keys", '"ключ" = 1\n[profiles]\n"водa" = 0.5\n[control]\nprofile = "водa"\n')
 
 
+def sim_request_seeds():
+    seq = [0]
+
+    def hdr(op):
+        seq[0] += 1
+        return struct.pack("<IHHI", 0x4D495343, op, 0, seq[0])
+
+    def s(text):
+        b = text.encode()
+        return struct.pack("<I", len(b)) + b
+
+    def req(body):
+        return struct.pack("<H", len(body)) + body
+
+    OPEN, CLOSE, I2C, SPI, IOCTL, WRITE, GREQ, GGET, GSET, GREL, GWATCH = range(1, 12)
+    opens = (req(hdr(OPEN) + s("/dev/i2c-1") + struct.pack("<i", 2)) +            # handle 3
+             req(hdr(OPEN) + s("/dev/spidev0.0") + struct.pack("<i", 2)) +        # handle 4
+             req(hdr(OPEN) + s("/sys/bus/platform/drivers/i2c-bcm2835/unbind") + struct.pack("<i", 1)) +  # 5
+             req(hdr(OPEN) + s("/sys/bus/platform/drivers/i2c-bcm2835/bind") + struct.pack("<i", 1)))     # 6
+
+    def i2c(msgs):
+        b = hdr(I2C) + struct.pack("<iI", 3, len(msgs))
+        for addr, rd, data in msgs:
+            b += struct.pack("<HHH", addr, 1 if rd else 0, data if rd else len(data))
+            if not rd:
+                b += bytes(data)
+        return req(b)
+
+    def spi(xfers):
+        b = hdr(SPI) + struct.pack("<iI", 4, len(xfers))
+        for tx, rx in xfers:
+            b += struct.pack("<IIHBBBB", len(tx), 500000, 0, 8, 0, 1, 1 if rx else 0) + bytes(tx)
+        return req(b)
+
+    def ioctl(h, request, value):
+        return req(hdr(IOCTL) + struct.pack("<iQQ", h, request, value))
+
+    I2C_FUNCS, I2C_TIMEOUT, SPI_WR_MODE, SPI_RD_SPEED = 0x0705, 0x0702, 0x40016B01, 0x80046B04
+    order = [0x80, 100, (0x52 + 0x80 + 100) & 0xFF]
+    thrusters = (i2c([(0x29, False, order)]) + i2c([(0x29, True, 7)]) + i2c([(0x2B, False, order), (0x2B, True, 7)]) +
+                 i2c([(0x70, False, [0x04])]) + i2c([(0x10, True, 1)]))
+    teensy = spi([([0x02, 10, 0xF6, 0], True)]) + spi([([0x01, 0, 0], True)]) + spi([([0x07, 0, 0, 0, 0], True)]) + \
+        spi([([0x08], True), ([0], True), ([0, 0, 0, 0, 0], True)])
+    ioctls = (ioctl(3, I2C_FUNCS, 0) + ioctl(3, I2C_TIMEOUT, 10) + ioctl(4, SPI_WR_MODE, 0) + ioctl(4, SPI_RD_SPEED, 0) +
+              ioctl(5, I2C_FUNCS, 0) + ioctl(3, 0xDEAD, 0))
+    write("sim_request", "devices", opens + thrusters + teensy + ioctls + req(hdr(CLOSE) + struct.pack("<i", 3)) +
+          req(hdr(CLOSE) + struct.pack("<i", 3)))
+    gpio = (req(hdr(GREQ) + s("gpiochip0") + s("") + struct.pack("<iBBB", 27, 2, 0, 1)) +            # 3
+            req(hdr(GREQ) + s("gpiochip0") + s("KILL_SWITCH") + struct.pack("<iBBB", -1, 1, 1, 0)) +  # 4
+            req(hdr(GREQ) + s("/dev/gpiochip0") + s("") + struct.pack("<iBBB", 3, 3, 0, 1)) +        # 5
+            req(hdr(GSET) + struct.pack("<iB", 3, 0)) + req(hdr(GGET) + struct.pack("<i", 4)) +
+            req(hdr(GSET) + struct.pack("<iB", 5, 0)) + req(hdr(GSET) + struct.pack("<iB", 5, 1)) +
+            req(hdr(GSET) + struct.pack("<iB", 4, 1)) + req(hdr(GREL) + struct.pack("<i", 5)) +
+            req(hdr(GWATCH) + s("gpiochip0") + s("KILL_SWITCH") + struct.pack("<i", -1)))
+    write("sim_request", "gpio", gpio)
+    recovery = (opens + req(hdr(WRITE) + struct.pack("<iI", 5, 13) + b"fe804000.i2c\n") +
+                i2c([(0x29, True, 7)]) + req(hdr(WRITE) + struct.pack("<iI", 6, 12) + b"fe804000.i2c") +
+                req(hdr(WRITE) + struct.pack("<iI", 6, 12) + b"fe804000.i2c") + req(hdr(WRITE) + struct.pack("<iI", 3, 1) + b"x"))
+    write("sim_request", "unbind-bind", recovery)
+    malformed = (opens + req(hdr(OPEN) + s("/dev/i2c-1")) + req(hdr(CLOSE) + struct.pack("<iB", 3, 0)) +
+                 req(struct.pack("<IHHI", 0x4D495343, 0x8003, 0, 9)) + req(struct.pack("<IHH", 0x4D495343, 3, 0)) +
+                 req(struct.pack("<IHHI", 0x12345678, 1, 0, 1)) + req(hdr(12) + struct.pack("<iQ", 0, 0)) +
+                 req(hdr(I2C) + struct.pack("<iI", 3, 0)) + req(hdr(I2C) + struct.pack("<iI", 3, 43)) +
+                 req(hdr(I2C) + struct.pack("<iIHHH", 3, 1, 0x29, 1, 8193)) +
+                 req(hdr(SPI) + struct.pack("<iI", 4, 1) + struct.pack("<IIHBBBB", 8193, 0, 0, 8, 0, 0, 1)) +
+                 req(hdr(SPI) + struct.pack("<iI", 4, 513)) + req(b"") +
+                 req(hdr(I2C) + struct.pack("<iIHHH", 4, 1, 0x29, 0, 1) + b"\x80"))
+    write("sim_request", "malformed", malformed)
+    big = opens + i2c([(0x29, True, 8192)] * 8) + spi([([0] * 4096, True), ([0] * 4096, True)])
+    write("sim_request", "reply-too-long", big)
+
+
 def main():
     shutil.rmtree(os.path.join(HERE, "corpus"), ignore_errors=True)
     packet_seeds()
     seabotix_seeds()
     teensy_seeds()
     config_seeds()
+    sim_request_seeds()
 
 
 if __name__ == "__main__":

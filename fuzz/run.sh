@@ -23,7 +23,7 @@ echo "fuzz $name: ${seconds}s from ${dirs[*]:1}"
 status=0
 "$fuzzer" "${opts[@]}" "${dirs[@]}" 2>"$out/log" || status=$?
 # The figures a reader wants, then the report when it failed.
-grep -E '^(stat::|#[0-9]+ +(INITED|DONE))' "$out/log" || true
+grep -E '^(stat::|#[0-9]+[[:space:]]+(INITED|DONE))' "$out/log" || true
 if [ "$status" -ne 0 ]; then
   echo "fuzz $name: FAILED (exit $status); log: $out/log; input: $(ls "$out" | grep -E '^(crash|leak|timeout|oom)-' || echo none)"
   tail -n 60 "$out/log"
