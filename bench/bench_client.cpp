@@ -6,6 +6,7 @@
 //   caracara-bench rtt        --bus ADDR [--calls N] [--warmup N] [--settle-us US]
 //   caracara-bench cmd2wire   --bus ADDR [--samples N] [--phase-ms MS] [--seed S]
 //   caracara-bench kill2wire  --bus ADDR [--samples N] [--source dbus|switch] [--phase-ms MS]
+//   caracara-bench kill2output --bus ADDR [--samples N] [--source dbus|switch] [--phase-ms MS]
 //   caracara-bench cycles     --bus ADDR --seconds S
 //   caracara-bench stream     --bus ADDR --hz H --seconds S
 //   caracara-bench wait-ready --bus ADDR [--timeout-ms MS]   (arms a daemon that started killed)
@@ -231,7 +232,7 @@ struct Args {
 Args parse(int argc, char** argv) {
     Args a;
     if (argc < 2) {
-        std::fprintf(stderr, "usage: caracara-bench rtt|cmd2wire|kill2wire|cycles|stream|wait-ready --bus ADDR ...\n");
+        std::fprintf(stderr, "usage: caracara-bench rtt|cmd2wire|kill2wire|kill2output|cycles|stream|wait-ready --bus ADDR ...\n");
         std::exit(2);
     }
     a.command = argv[1];
@@ -689,6 +690,73 @@ int cmd_kill2wire(const Args& a) {
     return 0;
 }
 
+// --- 6. a kill to the kill output (the run enable), healthy or with a hung thruster -------------
+
+// From Kill() (the client's clock before the call) or the kill switch edge (its wire-log stamp)
+// to the kill output's edge in the wire log: the one GPIO write that de-energizes the thrusters,
+// which must not wait behind a transfer on the wire. The zero orders are not waited for (a hung
+// thruster's never completes).
+int cmd_kill2output(const Args& a) {
+    const bool by_switch = a.source == "switch";
+    Client c(a.bus);
+    uint32_t out_line = 0;
+    if (c.read_trivial(kSim, kSimPath, kSim, "KillOutputLine", 'u', &out_line) < 0) {
+        std::fprintf(stderr, "caracara-bench: the simulator does not name its kill output line\n");
+        return 1;
+    }
+    const std::optional<SwitchLine> line = by_switch ? switch_line(c) : std::nullopt;
+    if (by_switch && !line) {
+        std::fprintf(stderr, "caracara-bench: the simulator does not name its kill switch line\n");
+        return 1;
+    }
+    Rng rng(a.seed + 11);
+    std::vector<double> us;
+    long missing = 0;
+    for (long s = 0; s < a.samples; ++s) {
+        if (by_switch)
+            c.set_kill_switch(false);
+        if (c.state() == "killed")
+            c.vehicle_call("ClearKill");
+        if (!c.wait_ready(5'000'000'000ull)) {
+            std::fprintf(stderr, "caracara-bench: the vehicle does not become ready again\n");
+            return 1;
+        }
+        c.set_thrust((s % 2 == 0) ? kSetA : kSetB);
+        sleep_ns(static_cast<uint64_t>(rng.below(static_cast<uint64_t>(a.phase_ms * 1e6))));
+        const uint64_t since = c.wire_next();
+        const uint64_t t0 = mono_ns();
+        if (by_switch ? c.set_kill_switch(true) < 0 : c.vehicle_call("Kill") < 0)
+            return 1;
+        std::vector<Entry> log;
+        const Entry* out = nullptr;
+        const Entry* edge = nullptr;
+        poll_log(c, since, log, mono_ns() + 3'000'000'000ull, [&](const std::vector<Entry>& l) {
+            out = edge = nullptr;
+            for (const Entry& e : l) {
+                if (e.bus != "gpio")
+                    continue;
+                if (line && !edge && e.addr == line->offset)
+                    edge = &e;
+                if (!out && e.addr == out_line)
+                    out = &e;
+            }
+            return out && (!line || edge);
+        });
+        if (!out || (line && !edge)) {
+            ++missing;
+            continue;
+        }
+        const uint64_t start = line ? edge->time_ns : t0;
+        us.push_back(out->time_ns > start ? static_cast<double>(out->time_ns - start) / 1000.0 : 0.0);
+    }
+    if (by_switch)
+        c.set_kill_switch(false);
+    std::printf("{\"source\": \"%s\", \"samples\": %ld, \"missing\": %ld, \"kill_output_us\": %s, "
+                "\"raw\": {\"kill_output_us\": %s}}\n",
+                a.source.c_str(), a.samples, missing, stats_json(us).c_str(), array_json(us).c_str());
+    return 0;
+}
+
 // --- 4. loop rate, and a command stream for the cost figures ---------------------------------
 
 int cmd_cycles(const Args& a) {
@@ -741,6 +809,7 @@ int main(int argc, char** argv) {
     if (a.command == "rtt") return cmd_rtt(a);
     if (a.command == "cmd2wire") return cmd_cmd2wire(a);
     if (a.command == "kill2wire") return cmd_kill2wire(a);
+    if (a.command == "kill2output") return cmd_kill2output(a);
     if (a.command == "cycles") return cmd_cycles(a);
     if (a.command == "stream") return cmd_stream(a);
     if (a.command == "wait-ready") return cmd_wait_ready(a);

@@ -28,7 +28,9 @@ struct I2cSettings {
     // The bus clock is set by the device tree (dtparam=i2c_arm_baudrate), not by the
     // daemon; the key describes the vehicle (caracara-sim reads it from the same file).
     uint32_t clock_hz = 100000;
-    std::optional<uint32_t> timeout_ms;  // I2C_TIMEOUT (kernel units of 10 ms); unset: kernel default
+    // I2C_TIMEOUT (kernel units of 10 ms): a few times the longest transfer at 100 kHz
+    // (a status read, ~1.2 ms), rounded up to the kernel's unit.
+    std::optional<uint32_t> timeout_ms = 20;
     std::optional<uint32_t> retries;     // I2C_RETRIES; unset: kernel default
 };
 

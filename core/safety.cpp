@@ -20,6 +20,7 @@ std::string_view kill_source_name(KillSource s) {
     case KillSource::Packet: return "packet";
     case KillSource::Fault: return "bus"; // the escalated fault is the I2C bus that could not be recovered
     case KillSource::Start: return "start";
+    case KillSource::Device: return "device";
     }
     return "?";
 }

@@ -33,8 +33,10 @@ enum class KillSource {
     Packet,  // a legacy packet with killState != 0
     Fault,   // an escalated fault, e.g. the I2C bus could not be recovered
     Start,   // every start of the daemon, until someone decides to arm it (ClearKill)
+    Device,  // a line or device the daemon drives went away (kill/power-off output, the Teensy's SPI)
 };
-std::string_view kill_source_name(KillSource s);  // "none", "dbus", "switch", "packet", "bus", "start"
+// "none", "dbus", "switch", "packet", "bus", "start", "device"
+std::string_view kill_source_name(KillSource s);
 
 enum class SafetyError {
     None,

@@ -12,6 +12,8 @@ namespace caracara {
 
 namespace {
 constexpr uint64_t kNodePollNs = 5'000'000;
+constexpr uint64_t kIdlePollNs = 1'000'000;
+constexpr uint64_t kReopenNs = 1'000'000'000;
 } // namespace
 
 BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio,
@@ -31,9 +33,14 @@ void BusRecovery::bus_locked_up(const std::string& reason) {
         return;
     if (!config_.recovery.enabled) {
         // Nothing to clear the bus with: report it and keep trying the transfers each tick.
-        log_error("I2C bus %s lost (%s); recovery is not configured", bus_.device().c_str(), reason.c_str());
+        log_error("I2C bus %s lost (%s); recovery is not configured: reopening the adapter once a second",
+                  bus_.device().c_str(), reason.c_str());
         events_.bus_lost(reason);
         declare_lost(reason);
+        // An adapter that went away (unbound, a restarted simulator) is only found again by
+        // opening its node anew; the transfers of each cycle then tell whether it is back.
+        phase_ = Phase::Reopening;
+        schedule(kReopenNs);
         return;
     }
     bus_.set_recovering(true);
@@ -66,6 +73,26 @@ int BusRecovery::on_lost_timer(sd_event_source*, uint64_t, void* userdata) {
     return 0;
 }
 
+void BusRecovery::reopen() {
+    if (bus_.telemetry().state != BusState::Lost) {
+        phase_ = Phase::Idle; // a transfer got through: the bus is back
+        return;
+    }
+    if (!bus_.idle()) {
+        schedule(kIdlePollNs); // not under a transfer on the worker's thread
+        return;
+    }
+    bus_.close();
+    bus_.mux().invalidate();
+    // Quietly: one line when it went, one when it is back (ThrusterBus::note). The emergency
+    // stop's connection to the node is renewed with it (a restarted simulator).
+    if (release_node_holders_)
+        release_node_holders_();
+    if (bus_.open() == 0 && reopen_node_holders_)
+        reopen_node_holders_();
+    schedule(kReopenNs);
+}
+
 void BusRecovery::declare_lost(const std::string& why) {
     BusTelemetry& tm = bus_.telemetry();
     if (tm.state == BusState::Lost)
@@ -92,15 +119,24 @@ void BusRecovery::schedule(uint64_t delay_ns) {
 
 int BusRecovery::on_timer(sd_event_source*, uint64_t, void* userdata) {
     auto* self = static_cast<BusRecovery*>(userdata);
-    if (self->phase_ == Phase::WaitingNode)
-        self->wait_node();
-    else
-        self->attempt();
+    switch (self->phase_) {
+    case Phase::WaitingNode: self->wait_node(); break;
+    case Phase::Verifying: self->verify(); break;
+    case Phase::Reopening: self->reopen(); break;
+    case Phase::Idle:
+    case Phase::Backoff: self->attempt(); break;
+    }
     return 0;
 }
 
 void BusRecovery::attempt() {
     const RecoverySettings& rc = config_.recovery;
+    if (!bus_.idle()) {
+        // A transfer is still on the wire (bounded by the adapter's timeout): the descriptor
+        // cannot be closed under it.
+        schedule(kIdlePollNs);
+        return;
+    }
     policy_.next_attempt();
     phase_ = Phase::Idle;
     bus_.close(); // before unbinding: the driver cannot go while the node is open
@@ -146,14 +182,21 @@ void BusRecovery::wait_node() {
 
 void BusRecovery::finish() {
     phase_ = Phase::Idle;
-    // The current orders go out at once, a pending kill first: zeros while the vehicle may not
-    // drive. Still flagged as recovering, so these transfers decide the outcome below instead
-    // of starting a new recovery.
-    if (vehicle_.may_drive())
-        for (size_t i = 0; i < bus_.size(); ++i)
-            bus_.send_order(i, vehicle_.order_value(i));
-    else
-        bus_.zero_all();
+    // The current orders go out at once (zeros while the vehicle may not drive). Still flagged
+    // as recovering, so these transfers decide the outcome (verify) instead of starting a new
+    // recovery.
+    for (size_t i = 0; i < bus_.size(); ++i)
+        bus_.send_order(i, vehicle_.order_value(i));
+    phase_ = Phase::Verifying;
+    schedule(kIdlePollNs);
+}
+
+void BusRecovery::verify() {
+    if (!bus_.idle()) {
+        schedule(kIdlePollNs); // the orders are still on the wire (the worker's thread)
+        return;
+    }
+    phase_ = Phase::Idle;
     if (!bus_.any_online()) {
         // The lines were cleared and the node is back, but nothing gets through: not recovered.
         bus_.close();

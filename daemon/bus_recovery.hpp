@@ -40,12 +40,14 @@ public:
     }
 
 private:
-    enum class Phase { Idle, WaitingNode, Backoff };
+    enum class Phase { Idle, WaitingNode, Verifying, Backoff, Reopening };
     static int on_timer(sd_event_source*, uint64_t usec, void* userdata);
     void schedule(uint64_t delay_ns);
     void attempt();
     void wait_node();
     void finish();
+    void verify(); // once the re-sent orders are done: did any thruster answer?
+    void reopen(); // lost without recovery configured: the adapter's node opened anew
     void failed(const std::string& why);
     // The thrusters cannot be reached: the vehicle is killed (source bus) and stays so.
     void declare_lost(const std::string& why);

@@ -17,6 +17,8 @@ public:
     // A command that moves something, from `client`: accepted only when ready, it restarts the
     // command timeout and makes `client` the commanding client, as SetThrust does.
     virtual Result accept_command(std::string_view client) = 0;
+    // A device that moves something went away under the daemon: the vehicle is killed.
+    virtual void device_lost(std::string_view why) = 0;
 };
 
 } // namespace caracara

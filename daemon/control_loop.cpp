@@ -88,10 +88,14 @@ void ControlLoop::step_aside() {
 
 int ControlLoop::on_work(sd_event_source*, void* userdata) {
     auto* self = static_cast<ControlLoop*>(userdata);
-    // Transactions back to back while nothing else waits; the check between them keeps a
-    // Kill or a command at most one transaction away.
+    // The Teensy's slots run here, back to back while nothing else waits; an I2C transfer is
+    // handed to the bus worker, and its end (bus_done) brings the work back.
     for (int n = 0; n < kTransactionsPerDispatch; ++n) {
         const Work w = self->work_one();
+        if (w == Work::Transfer || w == Work::Waiting) {
+            sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
+            return 0;
+        }
         if (w == Work::None) {
             self->in_cycle_ = false;
             self->last_cycle_ns_ = monotonic_ns();
@@ -102,14 +106,19 @@ int ControlLoop::on_work(sd_event_source*, void* userdata) {
                 sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
             return 0;
         }
-        if (w == Work::Order && !self->bus_.schedule().any_order_due()) {
-            self->step_aside(); // the orders are out: announce, then the rest
-            return 0;
-        }
         if (self->input_pending())
             return 0;
     }
     return 0;
+}
+
+void ControlLoop::bus_done(const BusJob& job) {
+    if (!started_ || !bus_.idle())
+        return; // more of a kill's zeros to come
+    if (job.kind == BusJobKind::Order && !bus_.schedule().any_order_due())
+        step_aside(); // the orders are out: announce, then the rest
+    else
+        schedule_work();
 }
 
 int ControlLoop::on_resume(sd_event_source*, void* userdata) {
@@ -154,14 +163,16 @@ void ControlLoop::cycle() {
 }
 
 ControlLoop::Work ControlLoop::work_one() {
+    if (!bus_.idle())
+        return Work::Waiting; // one transfer at a time: a new command's order is next in line
     const OrderSchedule::Item item = bus_.schedule().next(!bus_.recovering());
     switch (item.kind) {
     case OrderSchedule::Kind::Order:
         bus_.send_order(item.index, vehicle_.order_value(item.index));
-        return Work::Order;
+        return Work::Transfer;
     case OrderSchedule::Kind::Status:
         bus_.read_status(item.index);
-        return Work::Other;
+        return Work::Transfer;
     case OrderSchedule::Kind::Teensy:
         teensy_.poll();
         return Work::Other;

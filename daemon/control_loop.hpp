@@ -1,9 +1,10 @@
 // The control loop's event sources and their priorities. A tick at the loop rate starts a
 // cycle (safety timeouts, every order refreshed, status reads, the Teensy's slot); the bus
-// work runs below D-Bus, several transactions per dispatch with a check for a waiting caller
-// or kill switch edge between them, so a Kill or a new command waits at most for the
-// transaction already on the wire. The work steps aside after each burst of orders and at the
-// end of a cycle, so what is below it (the announcements) runs even when the bus never rests.
+// work runs below D-Bus: each I2C transfer is handed to the bus worker's thread (one at a
+// time, so a new command's order is next in line) and the loop goes on serving D-Bus, the
+// kill switch and the timers while it is on the wire. The work steps aside after each burst
+// of orders and at the end of a cycle, so what is below it (the announcements) runs even
+// when the bus never rests.
 #pragma once
 
 #include "core/config.hpp"
@@ -37,13 +38,16 @@ public:
     // There is bus work due (a new command's orders): run it soon, unless the work has
     // stepped aside, in which case it resumes right after the announcements.
     void schedule_work();
+    // A transfer handed to the bus worker is over (ThrusterBus's done callback).
+    void bus_done(const BusJob& job);
 
     uint64_t cycles() const { return cycles_; }
     // Healthy = a cycle completed recently (fed to the systemd watchdog).
     bool healthy(uint64_t now_ns) const;
 
 private:
-    enum class Work { None, Order, Other };
+    // Transfer: handed to the bus worker; Waiting: the worker still has one; Other: done here.
+    enum class Work { None, Transfer, Waiting, Other };
     static int on_tick(sd_event_source*, uint64_t usec, void* userdata);
     static int on_work(sd_event_source*, void* userdata);
     static int on_resume(sd_event_source*, void* userdata);

@@ -144,7 +144,9 @@ int main(int argc, char** argv) {
     for (int sig : {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU})
         signal(sig, SIG_IGN);
 
-    VehicleDaemon daemon(event.get(), *hw.io, *hw.gpio, *cr.config);
+    // Made before the daemon so that it outlives it: the daemon's lines tell it their kill output.
+    EmergencyStop estop;
+    VehicleDaemon daemon(event.get(), *hw.io, hw.bus_io(), *hw.gpio, *cr.config);
     if (std::string e = daemon.start(); !e.empty()) {
         log_error("%s", e.c_str());
         sd_notifyf(0, "STATUS=%s", e.c_str());
@@ -153,7 +155,6 @@ int main(int argc, char** argv) {
 
     // If the daemon itself crashes, zero the thrusters from the signal handler instead of
     // leaving them at speed until systemd has restarted us.
-    EmergencyStop estop;
     {
         Hardware panic_hw;
         std::string perr;
@@ -163,6 +164,7 @@ int main(int argc, char** argv) {
             log_warning("emergency stop not armed: %s", e.c_str());
         else {
             EmergencyStop::install_fatal_handlers(&estop);
+            daemon.lines().set_kill_output_watcher([&estop](GpioLine* line) { estop.set_kill_output(line); });
             daemon.recovery().set_node_holders([&estop] { estop.release(); },
                                                [&estop] {
                                                    if (std::string why = estop.reopen(); !why.empty())

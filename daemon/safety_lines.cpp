@@ -14,11 +14,13 @@ constexpr uint64_t kReopenUs = 1'000'000;
 
 std::string SafetyLines::open(bool kill_asserted, Listener* listener) {
     listener_ = listener;
+    kill_asserted_ = kill_asserted;
     std::string err;
     if (settings_.kill_output) {
         kill_out_ = gpio_.request(line_spec(*settings_.kill_output), GpioMode::Output, kill_asserted ? 1 : 0, err);
         if (!kill_out_)
             return "gpio.kill_output: " + err;
+        kill_output_changed();
     }
     if (settings_.power_off_output) {
         power_off_ = gpio_.request(line_spec(*settings_.power_off_output), GpioMode::Output, 0, err);
@@ -52,6 +54,8 @@ std::string SafetyLines::open_switch() {
 }
 
 void SafetyLines::close() {
+    if (kill_output_watcher_)
+        kill_output_watcher_(nullptr);
     kill_switch_source_.reset();
     reopen_timer_.reset();
 }
@@ -84,6 +88,10 @@ void SafetyLines::switch_lost(const std::string& why) {
               line_spec(*settings_.kill_switch).describe().c_str(), why.c_str());
     if (listener_)
         listener_->kill_switch_read(true);
+    schedule_reopen();
+}
+
+void SafetyLines::schedule_reopen() {
     sd_event_source* s = nullptr;
     uint64_t now_us = 0;
     sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
@@ -97,27 +105,61 @@ void SafetyLines::switch_lost(const std::string& why) {
     sd_event_source_set_enabled(reopen_timer_.get(), SD_EVENT_ONESHOT);
 }
 
-int SafetyLines::on_reopen(sd_event_source* s, uint64_t usec, void* userdata) {
+int SafetyLines::on_reopen(sd_event_source*, uint64_t, void* userdata) {
     auto* self = static_cast<SafetyLines*>(userdata);
-    if (std::string e = self->open_switch(); !e.empty()) {
-        // Still gone: quietly again in a second (one log line when it went, one when it is back).
-        sd_event_source_set_time(s, usec + kReopenUs);
-        sd_event_source_set_enabled(s, SD_EVENT_ONESHOT);
-        return 0;
+    const GpioSettings& g = self->settings_;
+    bool missing = false;
+    // Quietly while gone: one log line when a line went, one when it is back.
+    auto reopen_output = [&](std::unique_ptr<GpioLine>& line, const std::optional<GpioLineSettings>& cfg, int value,
+                             const char* what) {
+        if (line || !cfg)
+            return;
+        std::string err;
+        line = self->gpio_.request(line_spec(*cfg), GpioMode::Output, value, err);
+        if (line) {
+            log_notice("%s %s is back", what, line_spec(*cfg).describe().c_str());
+            self->kill_output_changed();
+        }
+        else
+            missing = true;
+    };
+    reopen_output(self->kill_out_, g.kill_output, self->kill_asserted_ ? 1 : 0, "kill output");
+    reopen_output(self->power_off_, g.power_off_output, 0, "power-off output");
+    if (g.kill_switch && !self->kill_switch_) {
+        if (std::string e = self->open_switch(); e.empty()) {
+            log_notice("kill switch %s is back; its level decides", line_spec(*g.kill_switch).describe().c_str());
+            self->poll();
+        } else {
+            missing = true;
+        }
     }
-    log_notice("kill switch %s is back; its level decides", line_spec(*self->settings_.kill_switch).describe().c_str());
-    self->poll();
+    if (missing)
+        self->schedule_reopen();
     return 0;
 }
 
+void SafetyLines::output_lost(std::unique_ptr<GpioLine>& line, const char* what, int err) {
+    if (&line == &kill_out_ && kill_output_watcher_)
+        kill_output_watcher_(nullptr);
+    line.reset();
+    log_error("%s cannot be written (%s): vehicle killed; asking for it again once a second", what,
+              errno_name(-err).c_str());
+    schedule_reopen();
+    if (listener_)
+        listener_->device_lost(std::string(what) + " went away");
+}
+
 void SafetyLines::set_kill_output(bool asserted) {
+    kill_asserted_ = asserted;
     if (kill_out_)
-        kill_out_->set(asserted ? 1 : 0);
+        if (int r = kill_out_->set(asserted ? 1 : 0); r < 0)
+            output_lost(kill_out_, "kill output", r);
 }
 
 void SafetyLines::assert_power_off() {
     if (power_off_)
-        power_off_->set(1);
+        if (int r = power_off_->set(1); r < 0)
+            output_lost(power_off_, "power-off output", r);
 }
 
 } // namespace caracara

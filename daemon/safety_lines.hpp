@@ -8,8 +8,10 @@
 #include "platform/event_loop.hpp"
 #include "platform/gpio_backend.hpp"
 
+#include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace caracara {
 
@@ -20,6 +22,8 @@ public:
         virtual ~Listener() = default;
         // The switch's current reading (set = kill), on every edge and every backstop poll.
         virtual void kill_switch_read(bool set) = 0;
+        // An output line could not be written (its chip or the simulator went away).
+        virtual void device_lost(std::string_view why) = 0;
     };
 
     SafetyLines(sd_event* event, GpioBackend& gpio, const GpioSettings& settings)
@@ -35,6 +39,12 @@ public:
     void set_kill_output(bool asserted);
     bool has_power_off() const { return power_off_ != nullptr; }
     void assert_power_off();
+    // Told the kill output line whenever it changes (null before it goes): the fatal-signal
+    // emergency stop writes it first.
+    void set_kill_output_watcher(std::function<void(GpioLine*)> fn) {
+        kill_output_watcher_ = std::move(fn);
+        kill_output_changed();
+    }
     // The switch's event fd (for the loop's "is anything waiting" check), or -1.
     int kill_switch_fd() const { return kill_switch_ ? kill_switch_->event_fd() : -1; }
 
@@ -43,6 +53,10 @@ private:
     static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
     // Requests the switch and watches its edges; "" or why not.
     std::string open_switch();
+    // An output (kill, power-off) could not be written: dropped, the vehicle killed, and asked
+    // for again with the reopen timer (the kill output then starts asserted).
+    void output_lost(std::unique_ptr<GpioLine>& line, const char* what, int err);
+    void schedule_reopen();
     // The switch cannot be read (its chip or the simulator went away): its source goes (no busy
     // loop), it counts as set (a kill), and it is asked for again once a second.
     void switch_lost(const std::string& why);
@@ -56,6 +70,12 @@ private:
     std::unique_ptr<GpioLine> power_off_;
     SourcePtr kill_switch_source_;
     SourcePtr reopen_timer_;
+    bool kill_asserted_ = true; // what the kill output should show (for a reopened line)
+    std::function<void(GpioLine*)> kill_output_watcher_;
+    void kill_output_changed() {
+        if (kill_output_watcher_)
+            kill_output_watcher_(kill_out_.get());
+    }
 };
 
 } // namespace caracara

@@ -2,6 +2,9 @@
 
 #include "core/clock.hpp"
 #include "daemon/log.hpp"
+#include "platform/io_error.hpp"
+
+#include <cerrno>
 
 #include <cmath>
 #include <string>
@@ -18,6 +21,10 @@ Result teensy_result(teensy::TeensyError e, std::string_view what) {
 
 } // namespace
 
+namespace {
+constexpr uint64_t kReopenUs = 1'000'000;
+} // namespace
+
 TeensyPort::TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate,
                        VehicleEvents& events)
     : event_(event), gate_(gate), events_(events), spi_(io, settings.device, settings.spi), link_(spi_, settings.teensy) {
@@ -28,6 +35,8 @@ TeensyPort::TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& setting
 int TeensyPort::open() {
     const int r = spi_.open();
     tm_.online = r >= 0;
+    if (r < 0)
+        schedule_reopen(); // a Teensy that comes later is picked up
     return r;
 }
 
@@ -35,7 +44,46 @@ void TeensyPort::close() {
     if (turn_done_)
         finish_turn({Status::Hardware, "the daemon is shutting down"});
     turn_source_.reset();
+    reopen_timer_.reset();
     spi_.close();
+}
+
+void TeensyPort::schedule_reopen() {
+    uint64_t now_us = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
+    if (!reopen_timer_) {
+        sd_event_source* s = nullptr;
+        if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now_us + kReopenUs, 1000, on_reopen, this) < 0)
+            return;
+        reopen_timer_.reset(s);
+    }
+    sd_event_source_set_time(reopen_timer_.get(), now_us + kReopenUs);
+    sd_event_source_set_enabled(reopen_timer_.get(), SD_EVENT_ONESHOT);
+}
+
+int TeensyPort::on_reopen(sd_event_source*, uint64_t, void* userdata) {
+    auto* self = static_cast<TeensyPort*>(userdata);
+    if (self->spi_.is_open())
+        return 0;
+    if (self->spi_.open() < 0) {
+        self->schedule_reopen(); // quietly: one line when it went, one when it is back
+        return 0;
+    }
+    log_notice("Teensy SPI %s is back", self->spi_.path().c_str());
+    // Whatever the wheels were doing before, they stop now (as at every start).
+    self->stop_motion();
+    self->tm_.online = true;
+    return 0;
+}
+
+void TeensyPort::link_lost() {
+    log_error("Teensy SPI %s went away (%s): vehicle killed; asking for it again once a second",
+              spi_.path().c_str(), errno_name(spi_.last_errno()).c_str());
+    spi_.close();
+    wheels_moving_ = false;
+    tm_.online = false;
+    gate_.device_lost("the Teensy's SPI device went away");
+    schedule_reopen();
 }
 
 void TeensyPort::poll() {
@@ -57,6 +105,8 @@ void TeensyPort::poll() {
             tm_.distances[sensor] = r.value;
     }
     tm_.online = ok;
+    if (!ok && spi_.last_errno() == ENODEV)
+        link_lost();
 }
 
 void TeensyPort::stop_motion() {

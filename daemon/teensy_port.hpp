@@ -63,6 +63,11 @@ public:
 
 private:
     static int on_turn_step(sd_event_source*, uint64_t usec, void* userdata);
+    static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
+    // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, the vehicle
+    // killed (the wheels cannot be stopped), and asked for again once a second.
+    void link_lost();
+    void schedule_reopen();
     void turn_step();
     void finish_turn(const Result& r);
 
@@ -78,6 +83,7 @@ private:
     teensy::ConfirmHandshake handshake_;
     std::function<void(const Result&)> turn_done_;
     SourcePtr turn_source_;
+    SourcePtr reopen_timer_;
 };
 
 } // namespace caracara

@@ -3,8 +3,18 @@
 #include "daemon/log.hpp"
 
 #include <algorithm>
+#include <array>
 
 namespace caracara {
+
+namespace {
+std::vector<std::unique_ptr<ThrusterDriver>> make_drivers(I2cDev& i2c, MuxTracker& mux, const DaemonConfig& config) {
+    std::vector<std::unique_ptr<ThrusterDriver>> out;
+    for (const auto& tc : config.thrusters)
+        out.push_back(std::make_unique<ThrusterDriver>(i2c, mux, tc));
+    return out;
+}
+} // namespace
 
 std::string_view bus_state_name(BusState s) {
     switch (s) {
@@ -19,30 +29,67 @@ ThrusterBus::ThrusterBus(DeviceIo& io, const DaemonConfig& config, VehicleEvents
     : events_(events),
       device_(config.i2c.device),
       i2c_(io, config.i2c.device, {config.i2c.timeout_ms, config.i2c.retries}),
+      thrusters_(make_drivers(i2c_, mux_, config)),
+      worker_(thrusters_),
       ordered_(config.thrusters.size(), 0),
       faults_(config.thrusters.size()),
       schedule_(config.thrusters.size()),
-      lockup_(static_cast<uint32_t>(kMotorCount)) {
-    for (const auto& tc : config.thrusters)
-        thrusters_.push_back(std::make_unique<ThrusterDriver>(i2c_, mux_, tc));
+      lockup_(static_cast<uint32_t>(kMotorCount)) {}
+
+std::string ThrusterBus::start(sd_event* event, int64_t priority, std::function<void(const BusJob&)> done) {
+    on_done_ = std::move(done);
+    return worker_.start(event, priority, [this](const BusJobDone& d) { this->done(d); });
 }
 
 void ThrusterBus::send_order(std::size_t i, int32_t value) {
     ordered_[i] = value;
-    note(thrusters_[i]->send_order(value));
+    worker_.submit({BusJobKind::Order, static_cast<uint32_t>(i), value});
 }
 
-void ThrusterBus::zero_all() {
+void ThrusterBus::zero_all(ZeroOrder where) {
     schedule_.drop_orders();
-    for (std::size_t i = 0; i < thrusters_.size(); ++i)
-        send_order(i, 0);
+    std::array<BusJob, kMotorCount> zeros{};
+    const std::size_t n = std::min(thrusters_.size(), zeros.size());
+    for (std::size_t i = 0; i < n; ++i) {
+        ordered_[i] = 0;
+        zeros[i] = {BusJobKind::Order, static_cast<uint32_t>(i), 0};
+    }
+    // While recovering, the adapter is closed or about to be: the zeros go out when it is
+    // back (BusRecovery::finish), not as failures that would hold the bus clear up.
+    if (recovering_)
+        return;
+    if (where == ZeroOrder::First)
+        worker_.submit_first(std::span<const BusJob>(zeros).first(n));
+    else
+        for (std::size_t i = 0; i < n; ++i)
+            worker_.submit(zeros[i]);
 }
 
 void ThrusterBus::read_status(std::size_t i) {
-    const IoError e = thrusters_[i]->read_status();
-    note(e);
-    if (e == IoError::None)
-        report_faults(i);
+    worker_.submit({BusJobKind::Status, static_cast<uint32_t>(i), 0});
+}
+
+void ThrusterBus::when_idle(std::function<void()> fn) {
+    if (worker_.idle()) {
+        fn();
+        return;
+    }
+    when_idle_.push_back(std::move(fn));
+}
+
+void ThrusterBus::done(const BusJobDone& d) {
+    if (!d.skipped)
+        note(d.error);
+    if (d.job.kind == BusJobKind::Status && d.error == IoError::None)
+        report_faults(d.job.index);
+    if (worker_.idle() && !when_idle_.empty()) {
+        auto fns = std::move(when_idle_);
+        when_idle_.clear();
+        for (auto& fn : fns)
+            fn();
+    }
+    if (on_done_)
+        on_done_(d.job);
 }
 
 void ThrusterBus::report_faults(std::size_t i) {
@@ -59,14 +106,18 @@ void ThrusterBus::report_faults(std::size_t i) {
 
 void ThrusterBus::set_recovering(bool r) {
     recovering_ = r;
-    if (r)
+    if (r) {
         schedule_.drop_bus_work();
-    else
+        worker_.drop_queued(); // the adapter is about to close; what is on the wire finishes
+    } else
         lockup_.reset();
 }
 
 bool ThrusterBus::any_online() const {
-    return std::any_of(thrusters_.begin(), thrusters_.end(), [](const auto& t) { return t->online(); });
+    for (std::size_t i = 0; i < thrusters_.size(); ++i)
+        if (thruster(i).online())
+            return true;
+    return false;
 }
 
 void ThrusterBus::note(IoError e) {
@@ -82,6 +133,8 @@ void ThrusterBus::note(IoError e) {
     if (t == LockupDetector::Transfer::Ok || t == LockupDetector::Transfer::BadReply) {
         // A bad reply still crossed the bus: the thruster is at fault, not the wire.
         if (tm_.state != BusState::Ok) {
+            if (tm_.state == BusState::Lost)
+                log_notice("I2C bus %s is back; the vehicle stays killed until ClearKill", device_.c_str());
             tm_.state = BusState::Ok;
             events_.changed(kChangeState | kChangeBus);
         }

@@ -1,12 +1,13 @@
 // The I2C bus to the thrusters: the adapter, the PCA9544A state, one driver per thruster,
 // the schedule of what goes on the wire next, lockup detection and the bus's telemetry.
-// Every transfer's outcome passes through note(), which spots a locked bus and tells the
-// listener (BusRecovery).
+// The transfers themselves run on the BusWorker's thread; every outcome comes back to the
+// loop thread through note(), which spots a locked bus and tells the listener (BusRecovery).
 #pragma once
 
 #include "core/config.hpp"
 #include "core/lockup_detector.hpp"
 #include "core/order_schedule.hpp"
+#include "daemon/bus_worker.hpp"
 #include "daemon/vehicle_events.hpp"
 #include "devices/mux_tracker.hpp"
 #include "devices/thruster_driver.hpp"
@@ -15,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -44,17 +46,35 @@ public:
         virtual ~Listener() = default;
         virtual void bus_locked_up(const std::string& reason) = 0;
     };
+    // Where a kill's zero orders go: in front of everything queued (dropping it), or behind
+    // it (a command timeout or a client that left: what it had sent goes out first).
+    enum class ZeroOrder { First, Behind };
 
     ThrusterBus(DeviceIo& io, const DaemonConfig& config, VehicleEvents& events);
 
+    // The adapter is opened and closed only while the worker is idle (see BusWorker).
     int open() { return i2c_.open(); } // 0 or -errno
     void close() { i2c_.close(); }
+    // Starts the worker thread; `done` runs on the loop thread after each finished job (the
+    // loop hands over the next one).
+    std::string start(sd_event* event, int64_t priority, std::function<void(const BusJob&)> done);
+    void stop() { worker_.stop(); }
     void set_listener(Listener* l) { listener_ = l; }
 
+    // Each hands one transfer to the worker; its outcome arrives later through note().
     void send_order(std::size_t i, int32_t value);
-    // Zero to every thruster, back to back: nothing may come between a kill and its zeros.
-    void zero_all();
     void read_status(std::size_t i);
+    // Zero to every thruster, back to back: nothing may come between a kill and its zeros.
+    void zero_all(ZeroOrder where = ZeroOrder::First);
+    // Before a kill's kill output: no non-zero order handed over earlier goes out after it.
+    void hold_orders() { worker_.hold_orders(); }
+    // Blocks until the worker is idle: at start-up and shutdown, where the zeros must be on the
+    // wire before the daemon goes on.
+    void wait_idle() { worker_.wait_idle(); }
+    // No transfer queued or on the wire.
+    bool idle() const { return worker_.idle(); }
+    // Runs `fn` once the transfers handed over so far are done (at once when idle).
+    void when_idle(std::function<void()> fn);
 
     OrderSchedule& schedule() { return schedule_; }
     // While recovering, the adapter is closed on purpose: no bus work, and failures say nothing.
@@ -64,7 +84,8 @@ public:
     bool any_online() const;
 
     std::size_t size() const { return thrusters_.size(); }
-    const ThrusterDriver& thruster(std::size_t i) const { return *thrusters_[i]; }
+    // Thruster i as of its last finished transfer.
+    const ThrusterDriver& thruster(std::size_t i) const { return worker_.view(i); }
     int32_t ordered_value(std::size_t i) const { return ordered_[i]; }
     // The fault bits last reported for thruster i (logged once per change).
     FaultSet faults(std::size_t i) const { return faults_[i]; }
@@ -73,6 +94,7 @@ public:
     const std::string& device() const { return device_; }
 
 private:
+    void done(const BusJobDone& d);
     void note(IoError e);
     void report_faults(std::size_t i);
 
@@ -81,6 +103,7 @@ private:
     I2cDev i2c_;
     MuxTracker mux_;
     std::vector<std::unique_ptr<ThrusterDriver>> thrusters_;
+    BusWorker worker_;
     std::vector<int32_t> ordered_;
     std::vector<FaultSet> faults_;
     OrderSchedule schedule_;
@@ -88,6 +111,8 @@ private:
     BusTelemetry tm_;
     bool recovering_ = false;
     Listener* listener_ = nullptr;
+    std::function<void(const BusJob&)> on_done_;
+    std::vector<std::function<void()>> when_idle_;
 };
 
 } // namespace caracara

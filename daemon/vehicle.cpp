@@ -49,10 +49,14 @@ void Vehicle::handle(const SafetyAction& a) {
     // A kill reaches the kill output first: it is one GPIO write, and the zero orders behind it
     // are bus transfers that a hung device can delay. Releasing it (arming) waits for the zeros.
     const bool assert_first = a.state_changed && safety_.kill_output_asserted();
-    if (assert_first)
+    if (assert_first) {
+        bus_.hold_orders();
         lines_.set_kill_output(true);
+    }
     if (a.zero_outputs) {
-        bus_.zero_all();
+        // A kill's zeros go before anything queued; a timeout's or a departed client's go
+        // behind what that client had sent.
+        bus_.zero_all(safety_.kill_output_asserted() ? ThrusterBus::ZeroOrder::First : ThrusterBus::ZeroOrder::Behind);
         // The wheels are motors too. A kill or power-off stops them itself, and tells a
         // running turn why.
         if (!safety_.kill_output_asserted())
@@ -255,8 +259,9 @@ Result Vehicle::power_off(std::string_view confirmation) {
         return {Status::PoweredOff, a.message};
     handle(a);
     bus_.zero_all(); // thrusters first, whatever handle() decided
-    lines_.assert_power_off();
-    log_warning("POWER-OFF confirmed: thrusters zeroed%s", lines_.has_power_off() ? ", power-off line asserted" : "");
+    log_warning("POWER-OFF confirmed: thrusters to zero%s", lines_.has_power_off() ? ", then the power-off line" : "");
+    // The power-off line once the zeros are on the wire (the bus worker's thread).
+    bus_.when_idle([this] { lines_.assert_power_off(); });
     teensy_.stop_motion();
     teensy_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};

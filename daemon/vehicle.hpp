@@ -53,6 +53,8 @@ public:
     Result state_error() const override;
     bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
     Result accept_command(std::string_view client) override;
+    // A line or device went away under the daemon (SafetyLines, TeensyPort): killed, source fault.
+    void device_lost(std::string_view why) override { kill(KillSource::Device, why); }
 
     // What thruster i is to be ordered now: its applied value while the vehicle may drive.
     int32_t order_value(size_t i) const { return safety_.may_drive() ? demand_.applied()[i] : 0; }

@@ -5,10 +5,10 @@
 
 namespace caracara {
 
-VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config)
+VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, GpioBackend& gpio, DaemonConfig config)
     : event_(event),
       config_(std::move(config)),
-      bus_(io, config_, events_),
+      bus_(bus_io, config_, events_),
       lines_(event, gpio, config_.gpio),
       teensy_(event, io, config_.spi, vehicle_, events_),
       vehicle_(config_, bus_, lines_, teensy_, events_),
@@ -23,8 +23,11 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, GpioBackend& gpio, D
 std::string VehicleDaemon::start() {
     if (int r = bus_.open(); r < 0)
         return "cannot open I2C bus " + config_.i2c.device + ": " + errno_name(-r);
+    if (std::string e = bus_.start(event_, kWorkPriority, [this](const BusJob& j) { loop_.bus_done(j); }); !e.empty())
+        return e;
     // Zero before anything else: a previous instance may have died with orders standing.
     bus_.zero_all();
+    bus_.wait_idle();
     if (std::string e = lines_.open(vehicle_.kill_output_asserted(), &vehicle_); !e.empty())
         return e;
     if (int r = teensy_.open(); r < 0)
@@ -48,6 +51,8 @@ void VehicleDaemon::shutdown() {
     recovery_.stop();
     lines_.close();
     bus_.zero_all();
+    bus_.wait_idle();
+    bus_.stop();
     teensy_.stop_motion();
     teensy_.close();
     bus_.close();

@@ -21,7 +21,8 @@ namespace caracara {
 
 class VehicleDaemon {
 public:
-    VehicleDaemon(sd_event* event, DeviceIo& io, GpioBackend& gpio, DaemonConfig config);
+    // `bus_io` carries the I2C transfers on the bus worker's thread; `io` everything else.
+    VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, GpioBackend& gpio, DaemonConfig config);
     ~VehicleDaemon() { shutdown(); }
     VehicleDaemon(const VehicleDaemon&) = delete;
     VehicleDaemon& operator=(const VehicleDaemon&) = delete;
@@ -44,6 +45,7 @@ public:
     const ControlLoop& loop() const { return loop_; }
     ServiceStatus& status() { return status_; }
     BusRecovery& recovery() { return recovery_; }
+    SafetyLines& lines() { return lines_; }
 
 private:
     sd_event* event_;

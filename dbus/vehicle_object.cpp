@@ -5,6 +5,7 @@
 #include "dbus/vehicle_names.hpp"
 
 #include <cstring>
+#include <memory>
 #include <tuple>
 #include <vector>
 
@@ -26,6 +27,18 @@ int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
     return 0;
 }
 
+// Kill, PowerOff and a killing packet reply once their zero orders are done on the wire (the
+// bus worker's thread): a caller that sees the reply sees the thrusters told zero. The loop
+// does not wait for them; the kill output was asserted before any of them.
+int reply_after_zeros(sd_bus_message* m, void* userdata, const Result& result) {
+    ThrusterBus& bus = static_cast<VehicleDaemon*>(userdata)->bus();
+    if (!result.ok() || bus.idle())
+        return reply(m, result);
+    auto call = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
+    bus.when_idle([call] { reply(call.get(), {}); });
+    return 1;
+}
+
 int m_set_thrust(sd_bus_message* m, void* userdata, sd_bus_error*) {
     std::vector<int32_t> v;
     if (int r = read_ints(m, v); r < 0)
@@ -44,11 +57,15 @@ int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error*) {
     std::vector<int32_t> v;
     if (int r = read_ints(m, v); r < 0)
         return r;
-    return reply(m, ctl(userdata).apply_packet(v, sender(m)));
+    const bool was_killed = ctl(userdata).safety().state() == SafetyState::Killed;
+    const Result r = ctl(userdata).apply_packet(v, sender(m));
+    if (!was_killed && ctl(userdata).safety().state() == SafetyState::Killed)
+        return reply_after_zeros(m, userdata, r);
+    return reply(m, r);
 }
 
 int m_kill(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    return reply(m, ctl(userdata).kill(KillSource::DBus, "Kill() from " + sender(m)));
+    return reply_after_zeros(m, userdata, ctl(userdata).kill(KillSource::DBus, "Kill() from " + sender(m)));
 }
 
 int m_clear_kill(sd_bus_message* m, void* userdata, sd_bus_error*) { return reply(m, ctl(userdata).clear_kill()); }
@@ -57,7 +74,7 @@ int m_power_off(sd_bus_message* m, void* userdata, sd_bus_error*) {
     const char* confirmation = nullptr;
     if (int r = sd_bus_message_read(m, "s", &confirmation); r < 0)
         return r;
-    return reply(m, ctl(userdata).power_off(confirmation));
+    return reply_after_zeros(m, userdata, ctl(userdata).power_off(confirmation));
 }
 
 int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error*) {

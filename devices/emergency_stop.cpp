@@ -66,6 +66,8 @@ std::string EmergencyStop::reopen() {
 }
 
 void EmergencyStop::fire() noexcept {
+    if (GpioLine* line = kill_output_.load())
+        line->set_in_signal_handler(1);
     const int fd = fd_;
     if (fd < 0)
         return;

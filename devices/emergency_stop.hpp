@@ -1,16 +1,19 @@
 // Zero orders for every thruster, prepared in advance on a device connection of their own, so
 // a fatal signal handler can send them without allocating, locking or touching state the
-// crash may have left half-written. Only async-signal-safe calls happen in fire(). The
+// crash may have left half-written. Only async-signal-safe calls happen in fire(). The kill
+// output is asserted first (a run enable: one GPIO write, before any bus transfer); the
 // Teensy's wheels are motors too: a prepared Stop frame goes out after the zero orders.
 #pragma once
 
 #include "platform/device_io.hpp"
 #include "core/config.hpp"
 #include "devices/thruster_driver.hpp"
+#include "platform/gpio_line.hpp"
 #include "platform/spi_dev.hpp"
 #include "protocol/teensy_codec.hpp"
 
 #include <array>
+#include <atomic>
 #include <csignal>
 #include <linux/i2c.h>
 #include <memory>
@@ -26,8 +29,12 @@ public:
     // its wheels (a missing Teensy is not an error). Returns "" or why it could not.
     std::string arm(std::unique_ptr<DeviceIo> io, const std::string& i2c_path, std::span<const ThrusterConfig> thrusters,
                     const SpiSettings& spi);
-    // Sends the zero orders. Async-signal-safe; errors are ignored (there is no one to tell).
+    // Asserts the kill output, then sends the zero orders. Async-signal-safe; errors are ignored
+    // (there is no one to tell).
     void fire() noexcept;
+    // The kill output line as SafetyLines holds it now (null while it has none): set before the
+    // line is made and cleared before it is destroyed, so fire() never sees a dead one.
+    void set_kill_output(GpioLine* line) noexcept { kill_output_.store(line); }
     // Closes the prepared connection while the I2C adapter's driver is unbound and rebound:
     // the kernel's i2c_del_adapter() waits until every open /dev/i2c-N is closed, so a file
     // kept open here would hang the unbinding write (and the daemon) for good. fire() does
@@ -63,6 +70,7 @@ private:
     std::array<uint8_t, teensy::kMaxFrame> stop_reply_{};
     std::string path_;
     volatile int fd_ = -1; // read by fire() in a signal handler
+    std::atomic<GpioLine*> kill_output_{nullptr};
     std::array<Prepared, 8> prepared_{};
     size_t count_ = 0;
 };

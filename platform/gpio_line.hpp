@@ -33,6 +33,12 @@ public:
     // how many, or -errno. -1 for other modes.
     virtual int event_fd() const { return -1; }
     virtual int drain_events() { return 0; }
+    // Sets an output from a fatal-signal handler: async-signal-safe (one ioctl or one send, no
+    // allocation, no lock) where the backend can do it; false where it cannot.
+    virtual bool set_in_signal_handler(int value) noexcept {
+        (void)value;
+        return false;
+    }
 };
 
 } // namespace caracara

@@ -20,8 +20,14 @@ bool make_hardware(const std::string& spec, Hardware& out, std::string& error) {
             error = "cannot connect to caracara-sim at " + spec.substr(4) + ": " + errno_name(-r);
             return false;
         }
+        auto bus_io = std::make_unique<SimDeviceIo>();
+        if (int r = bus_io->connect(spec.substr(4)); r < 0) {
+            error = "cannot connect to caracara-sim at " + spec.substr(4) + ": " + errno_name(-r);
+            return false;
+        }
         out.gpio = make_sim_gpio_backend(*io);
         out.io = std::move(io);
+        out.bus_io_own = std::move(bus_io);
         return true;
     }
     error = "--hardware must be 'linux' or 'sim:SOCKET', got '" + spec + "'";

@@ -41,6 +41,8 @@ struct DeviceOps::Request {
     const DeviceSession::Handle* device(int32_t hnd, SimVehicle::NodeKind kind, int& err) {
         auto it = session.handles.find(hnd);
         err = it == session.handles.end() ? -EBADF : it->second.kind != kind ? -ENOTTY : 0;
+        if (!err && it->second.epoch != ops.vehicle_.node_epoch(kind))
+            err = -ENODEV; // the device vanished after this handle was opened
         return err ? nullptr : &it->second;
     }
 };
@@ -60,9 +62,10 @@ const DeviceOps::Entry DeviceOps::kTable[] = {
 };
 
 size_t DeviceOps::handle(DeviceSession& session, std::span<const uint8_t> req, std::span<uint8_t> reply,
-                         uint64_t& wire_ns) {
+                         uint64_t& wire_ns, bool truncated) {
     Request q{*this, session, simproto::Reader(req), simproto::Writer(reply), {}, Op::Open, reply};
     wire_ns = 0;
+    held_ns_ = 0;
     if (!q.r.header(q.h) || (q.h.op & simproto::kReplyBit)) {
         // Not even a header we understand: answer with a bare error so the client is not left hanging.
         q.op = static_cast<Op>(q.h.op & ~simproto::kReplyBit);
@@ -70,6 +73,10 @@ size_t DeviceOps::handle(DeviceSession& session, std::span<const uint8_t> req, s
         return q.w.size();
     }
     q.op = static_cast<Op>(q.h.op);
+    if (truncated) {
+        q.bad(-EMSGSIZE);
+        return q.w.size();
+    }
     Handler handler = nullptr;
     for (const Entry& e : kTable)
         if (e.op == q.op)
@@ -102,7 +109,7 @@ uint64_t DeviceOps::open(Request& q) {
     if (kind == SimVehicle::NodeKind::None)
         return q.bad(-ENOENT);
     int hnd = q.session.next_handle++;
-    q.session.handles[hnd] = {kind, std::string(path)};
+    q.session.handles[hnd] = {kind, std::string(path), vehicle_.node_epoch(kind)};
     q.begin(hnd);
     return 0;
 }
@@ -147,6 +154,7 @@ uint64_t DeviceOps::i2c_rdwr(Request& q) {
         return q.bad(-EBADMSG);
     const uint64_t start = vehicle_.wire_start(monotonic_ns());
     auto res = vehicle_.i2c().transfer(msgs, start);
+    held_ns_ = res.held_ns;
     q.begin(res.ret);
     if (res.ret >= 0)
         for (auto& m : msgs)
@@ -213,7 +221,11 @@ uint64_t DeviceOps::ioctl(Request& q) {
     } else if (it->second.kind == SimVehicle::NodeKind::I2c) {
         switch (request) {
         case I2C_FUNCS: out = kI2cFuncs; break;
-        case I2C_TIMEOUT: vehicle_.i2c_timeout = static_cast<int64_t>(value); break;
+        case I2C_TIMEOUT:
+            // Units of 10 ms, as i2c-dev takes it.
+            vehicle_.i2c_timeout = static_cast<int64_t>(value);
+            vehicle_.i2c().set_timeout_ns(value * 10'000'000ull);
+            break;
         case I2C_RETRIES: vehicle_.i2c_retries = static_cast<int64_t>(value); break;
         case I2C_SLAVE:
         case I2C_SLAVE_FORCE: break;

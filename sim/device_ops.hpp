@@ -19,8 +19,14 @@ public:
     // Serves one request of `session` and writes its reply into `reply`; returns the reply's
     // length and, in `wire_ns`, the wire time the request occupied. Every request gets exactly
     // one reply: a malformed one -EBADMSG, one whose reply would not fit -EMSGSIZE.
-    size_t handle(DeviceSession& session, std::span<const uint8_t> req, std::span<uint8_t> reply, uint64_t& wire_ns);
+    // `truncated`: the request was longer than kMaxMessage (only its start is in `req`); it is
+    // refused whole with -EMSGSIZE, never served cut short.
+    size_t handle(DeviceSession& session, std::span<const uint8_t> req, std::span<uint8_t> reply, uint64_t& wire_ns,
+                  bool truncated = false);
     uint64_t bad_requests() const { return bad_requests_; }
+    // Of the last request's wire time, how long a slave held the clock (a hung device): the
+    // reply waits that long even when the wire's own timing is not simulated.
+    uint64_t last_held_ns() const { return held_ns_; }
     // A client that went away releases its GPIO lines, as the kernel does for a process.
     void release(DeviceSession& session);
 
@@ -45,6 +51,7 @@ private:
 
     SimVehicle& vehicle_;
     uint64_t bad_requests_ = 0;
+    uint64_t held_ns_ = 0;
 };
 
 } // namespace caracara::sim

@@ -118,7 +118,8 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
     auto* c = static_cast<Client*>(userdata);
     DeviceServer* self = c->server;
     uint8_t buf[simproto::kMaxMessage];
-    ssize_t n = ::recv(fd, buf, sizeof buf, MSG_DONTWAIT);
+    // MSG_TRUNC: the real length of a longer message, whose rest the socket discards.
+    ssize_t n = ::recv(fd, buf, sizeof buf, MSG_DONTWAIT | MSG_TRUNC);
     if (n < 0 && (errno == EAGAIN || errno == EINTR))
         return 0;
     if (n <= 0 || (revents & (EPOLLHUP | EPOLLERR) && n <= 0)) {
@@ -126,25 +127,34 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
         return 0;
     }
     uint64_t wire_ns = 0;
-    c->reply_len = self->ops_.handle(c->session, {buf, static_cast<size_t>(n)}, c->reply, wire_ns);
-    if (!self->vehicle_.realistic_timing() || wire_ns == 0) {
+    const bool truncated = static_cast<size_t>(n) > sizeof buf;
+    c->reply_len = self->ops_.handle(c->session, {buf, truncated ? sizeof buf : static_cast<size_t>(n)}, c->reply,
+                                     wire_ns, truncated);
+    uint64_t due_ns = 0;
+    if (self->vehicle_.realistic_timing() && wire_ns > 0) {
+        // Realistic timing: the reply leaves when the transaction is over on the wire, and the
+        // wire is shared, so a transaction waits for the one before it.
+        uint64_t& free_at = self->vehicle_.bus_free_at();
+        free_at = self->vehicle_.wire_start(monotonic_ns()) + wire_ns;
+        due_ns = free_at;
+    } else if (const uint64_t held = self->ops_.last_held_ns(); held > 0) {
+        due_ns = monotonic_ns() + held; // a hung device holds the transfer in any timing mode
+    } else {
         self->send_reply(*c);
         return 0;
     }
-    // Realistic timing: the reply leaves when the transaction is over on the wire, and the
-    // wire is shared, so a transaction waits for the one before it.
-    uint64_t& free_at = self->vehicle_.bus_free_at();
-    free_at = self->vehicle_.wire_start(monotonic_ns()) + wire_ns;
-    if (free_at - monotonic_ns() <= kSpinLimitNs) {
+    // Other clients (the GPIO lines' connection) are served meanwhile, as the kernel serves
+    // other file descriptors while one I2C transfer waits.
+    if (due_ns <= monotonic_ns() + kSpinLimitNs) {
         // Short waits block the simulator right here: an event-loop timer would add its own
         // wake-up lateness to every order.
-        wait_until(free_at);
+        wait_until(due_ns);
         self->send_reply(*c);
         return 0;
     }
     sd_event_source_set_enabled(c->io.get(), SD_EVENT_OFF);
     sd_event_source* t = nullptr;
-    if (sd_event_add_time(self->event_, &t, CLOCK_MONOTONIC, free_at / 1000, 1, on_reply_due, c) < 0) {
+    if (sd_event_add_time(self->event_, &t, CLOCK_MONOTONIC, due_ns / 1000, 1, on_reply_due, c) < 0) {
         self->send_reply(*c);
         sd_event_source_set_enabled(c->io.get(), SD_EVENT_ON);
         return 0;

@@ -13,6 +13,7 @@ struct DeviceSession {
     struct Handle {
         SimVehicle::NodeKind kind;
         std::string path;
+        uint32_t epoch = 0; // the node's epoch at open: an older one vanished under it
     };
     std::map<int, Handle> handles;
     std::map<int, int> gpio_lines; // handle -> line index in the GPIO model

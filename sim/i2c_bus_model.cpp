@@ -1,5 +1,7 @@
 #include "sim/i2c_bus_model.hpp"
 
+#include <algorithm>
+
 #include <cerrno>
 #include <linux/i2c.h>
 
@@ -76,6 +78,19 @@ I2cBusModel::Result I2cBusModel::transfer(std::vector<I2cMessage>& msgs, uint64_
             log_.append(std::move(e));
             res.ret = -EREMOTEIO;
             break;
+        }
+        if (const uint64_t hold = s->stretch_ns(); hold > 0) {
+            // The slave holds SCL low; the controller waits up to its timeout.
+            const uint64_t waited = std::min(hold, timeout_ns_);
+            t += waited;
+            res.held_ns += waited;
+            if (hold >= timeout_ns_) {
+                e.result = "timeout";
+                e.time_ns = t;
+                log_.append(std::move(e));
+                res.ret = -ETIMEDOUT;
+                break;
+            }
         }
         t += 9 * bit * m.data.size();
         if (read)

@@ -31,6 +31,7 @@ public:
     struct Result {
         int ret = 0;          // number of messages, or -errno as i2c-dev would return
         uint64_t wire_ns = 0; // time the transaction occupies the wire
+        uint64_t held_ns = 0; // of which a slave held the clock (a hung device)
     };
     // `start_ns` is when the transaction begins on the wire; log entries are stamped with
     // the end of each message.
@@ -56,6 +57,11 @@ public:
     void restore_i2c_function() { i2c_function_ = true; }
     bool i2c_function() const { return i2c_function_; }
 
+    // How long the controller waits for a stretched clock before it gives up with ETIMEDOUT:
+    // the adapter's timeout, which I2C_TIMEOUT sets (i2c-bcm2835's default is one second).
+    void set_timeout_ns(uint64_t ns) { timeout_ns_ = ns; }
+    uint64_t timeout_ns() const { return timeout_ns_; }
+
     uint32_t clock_hz() const { return clock_hz_; }
     void set_clock_hz(uint32_t hz) { clock_hz_ = hz; }
     uint64_t transactions() const { return transactions_; }
@@ -72,6 +78,7 @@ private:
     uint32_t hang_pulses_needed_ = 0;
     uint32_t hang_pulses_seen_ = 0;
     bool i2c_function_ = true;
+    uint64_t timeout_ns_ = 1'000'000'000ull;
     uint64_t wire_time_ns_ = 0;
     std::map<uint16_t, std::unique_ptr<Pca9544>> muxes_;
     struct Attached {

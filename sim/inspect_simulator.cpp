@@ -43,6 +43,18 @@ int m_hang_bus(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     return sd_bus_reply_method_return(m, "");
 }
 
+int m_vanish(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    const char* device = nullptr;
+    uint32_t ms = 0;
+    if (int r = sd_bus_message_read(m, "su", &device, &ms); r < 0)
+        return r;
+    const std::string d = device;
+    if (d != "i2c" && d != "spi")
+        return sd_bus_error_setf(err, kInspectInvalid, "the device to vanish is 'i2c' or 'spi', got '%s'", device);
+    vehicle(userdata).vanish(d == "i2c" ? SimVehicle::NodeKind::I2c : SimVehicle::NodeKind::Spi, ms, monotonic_ns());
+    return sd_bus_reply_method_return(m, "");
+}
+
 int m_hold_scl(sd_bus_message* m, void* userdata, sd_bus_error*) {
     vehicle(userdata).i2c().hang_scl();
     return sd_bus_reply_method_return(m, "");
@@ -122,6 +134,7 @@ constexpr dbus::Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("SetClock", SD_BUS_ARGS("u", hz), SD_BUS_NO_RESULT, m_set_clock, kUnpriv)),
     property<[](I i) { return gpio(i).kill_switch_engaged(); }>("KillSwitch"),
     property<[](I) { return GpioModel::kKillSwitch; }>("KillSwitchLine", kConst),
+    property<[](I) { return GpioModel::kKillOut; }>("KillOutputLine", kConst),
     property<[](I i) { return gpio(i).kill_switch_active_low(); }>("KillSwitchActiveLow", kConst),
     property<[](I i) { return gpio(i).level(GpioModel::kKillOut); }>("KillOutput"),
     property<[](I i) { return gpio(i).level(GpioModel::kPowerOff); }>("PowerOffOutput"),
@@ -140,6 +153,7 @@ constexpr dbus::Member kMembers[] = {
     property<[](I i) { return gpio(i).stops(); }>("Stops"),
     property<[](I i) { return gpio(i).min_scl_period_ns(); }>("MinSclPeriodNs"),
     member(SD_BUS_METHOD_WITH_ARGS("SetKillSwitch", SD_BUS_ARGS("b", engaged), SD_BUS_NO_RESULT, m_set_kill_switch, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("Vanish", SD_BUS_ARGS("s", device, "u", ms), SD_BUS_NO_RESULT, m_vanish, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("HangBus", SD_BUS_ARGS("u", pulses), SD_BUS_NO_RESULT, m_hang_bus, kUnpriv)),
     member(SD_BUS_METHOD("HoldScl", "", "", m_hold_scl, kUnpriv)),
     member(SD_BUS_METHOD("ReleaseBus", "", "", m_release_bus, kUnpriv)),

@@ -51,6 +51,14 @@ int m_corrupt(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     return sd_bus_reply_method_return(m, "");
 }
 
+int m_set_hang(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    uint32_t ms = 0;
+    if (int r = sd_bus_message_read(m, "u", &ms); r < 0)
+        return r;
+    thruster(userdata).set_hang_ms(ms);
+    return sd_bus_reply_method_return(m, "");
+}
+
 int m_power_cycle(sd_bus_message* m, void* userdata, sd_bus_error*) {
     thruster(userdata).power_cycle();
     return sd_bus_reply_method_return(m, "");
@@ -72,6 +80,7 @@ constexpr dbus::Member kMembers[] = {
     property<&ThrusterModel::temperature_c>("Temperature"),
     property<[](T t) { return fault_names(t.faults()); }>("Faults"),
     property<&ThrusterModel::nack>("Nack"),
+    property<&ThrusterModel::hang_ms>("HangMs"),
     property<&ThrusterModel::orders_received>("OrdersReceived"),
     property<&ThrusterModel::orders_rejected>("OrdersRejected"),
     property<&ThrusterModel::zero_orders>("ZeroOrders"),
@@ -79,6 +88,7 @@ constexpr dbus::Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("SetFault", SD_BUS_ARGS("s", fault, "b", on), SD_BUS_NO_RESULT, m_set_fault, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetNack", SD_BUS_ARGS("b", on), SD_BUS_NO_RESULT, m_set_nack, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("CorruptReplies", SD_BUS_ARGS("u", count, "s", how), SD_BUS_NO_RESULT, m_corrupt, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetHang", SD_BUS_ARGS("u", ms), SD_BUS_NO_RESULT, m_set_hang, kUnpriv)),
     member(SD_BUS_METHOD("PowerCycle", "", "", m_power_cycle, kUnpriv)),
 };
 constexpr auto kVtable = dbus::vtable(kMembers);

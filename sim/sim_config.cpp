@@ -64,6 +64,8 @@ bool parse_sim_config(const std::string& text, SimConfig& out, std::string& erro
             c.driver_id = *v;
         if (!get_int<uint32_t>(*sim, "rebind_delay_ms", "sim.", 0, 60000, c.rebind_delay_ms, error))
             return false;
+        if (!get_int<uint32_t>(*sim, "wire_log_entries", "sim.", 1, 10000000, c.wire_log_entries, error))
+            return false;
         if (auto v = (*sim)["kill_switch_active_low"].value<bool>())
             c.kill_switch_active_low = *v;
     }

@@ -21,6 +21,8 @@ struct SimConfig {
     std::string driver_id = "fe804000.i2c";
     uint32_t rebind_delay_ms = 20; // udev recreating /dev/i2c-N after a bind
     bool kill_switch_active_low = false;
+    // The wire log keeps this many entries, oldest dropped first: a long soak stays bounded.
+    uint32_t wire_log_entries = 200000;
 };
 
 SimConfig default_sim_config();

@@ -47,6 +47,11 @@ public:
     // Fault injection.
     void set_fault(uint8_t bit, bool on);
     void set_nack(bool on) { nack_ = on; }
+    // Every transfer to this thruster hangs for `ms` (its controller stretches the clock):
+    // up to the adapter's I2C_TIMEOUT, after which the transfer fails with ETIMEDOUT.
+    void set_hang_ms(uint32_t ms) { hang_ms_ = ms; }
+    uint32_t hang_ms() const { return hang_ms_; }
+    uint64_t stretch_ns() const override { return uint64_t(hang_ms_) * 1'000'000ull; }
     enum class Corrupt { Checksum, FirstByte };
     void corrupt_replies(uint32_t count, Corrupt how) { corrupt_count_ = count; corrupt_how_ = how; }
     void power_cycle();
@@ -85,6 +90,7 @@ private:
     uint8_t faults_ = 0;           // live fault bits
     uint8_t injected_ = 0;         // bits forced by fault injection
     bool nack_ = false;
+    uint32_t hang_ms_ = 0;
     uint32_t corrupt_count_ = 0;
     Corrupt corrupt_how_ = Corrupt::Checksum;
     std::vector<uint8_t> last_order_raw_;

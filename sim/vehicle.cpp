@@ -36,8 +36,23 @@ SimVehicle::NodeKind SimVehicle::node_kind(const std::string& path, uint64_t now
     if (path == cfg_.bind_path)
         return NodeKind::Bind;
     if (spi_.count(path))
-        return NodeKind::Spi;
+        return vanished(NodeKind::Spi, now_ns) ? NodeKind::None : NodeKind::Spi;
     return NodeKind::None;
+}
+
+void SimVehicle::vanish(NodeKind kind, uint32_t ms, uint64_t now_ns) {
+    const uint64_t until = now_ns + 1'000'000ull * ms;
+    if (kind == NodeKind::Spi) {
+        spi_gone_until_ = until;
+        ++spi_epoch_;
+    } else {
+        i2c_gone_until_ = until;
+        ++i2c_epoch_;
+    }
+}
+
+bool SimVehicle::vanished(NodeKind kind, uint64_t now_ns) const {
+    return now_ns < (kind == NodeKind::Spi ? spi_gone_until_ : i2c_gone_until_);
 }
 
 SpiPort* SimVehicle::spi_port(const std::string& path) {

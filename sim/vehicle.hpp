@@ -51,10 +51,17 @@ public:
     enum class NodeKind { None, I2c, Spi, Unbind, Bind };
     NodeKind node_kind(const std::string& path, uint64_t now_ns) const;
     // The I2C adapter exists (driver bound and its device node recreated).
-    bool i2c_present(uint64_t now_ns) const { return bound_ && now_ns >= node_back_at_; }
+    bool i2c_present(uint64_t now_ns) const { return bound_ && now_ns >= node_back_at_ && now_ns >= i2c_gone_until_; }
     // A write to the driver's sysfs bind/unbind attribute. Bytes consumed or -errno.
     int sysfs_write(NodeKind which, std::string_view data, uint64_t now_ns);
     bool driver_bound() const { return bound_; }
+    // A device node that vanishes (hot unplug, its driver gone) for `ms` and then returns: the
+    // handles opened before stay dead (ENODEV, as the kernel's do), opening it fails with
+    // ENOENT until it is back. kind: I2c (the adapter) or Spi (every SPI device).
+    void vanish(NodeKind kind, uint32_t ms, uint64_t now_ns);
+    bool vanished(NodeKind kind, uint64_t now_ns) const;
+    // Bumped at each vanish: a handle remembers the epoch it was opened in.
+    uint32_t node_epoch(NodeKind kind) const { return kind == NodeKind::Spi ? spi_epoch_ : i2c_epoch_; }
     uint64_t unbinds() const { return unbinds_; }
     uint64_t binds() const { return binds_; }
     GpioModel& gpio() { return gpio_; }
@@ -88,7 +95,7 @@ public:
 
 private:
     SimConfig cfg_;
-    WireLog log_;
+    WireLog log_{cfg_.wire_log_entries};
     I2cBusModel i2c_;
     std::vector<std::unique_ptr<ThrusterModel>> thrusters_;
     std::map<std::string, SpiPort> spi_;
@@ -98,6 +105,10 @@ private:
     GpioModel gpio_;
     bool bound_ = true;
     uint64_t node_back_at_ = 0;
+    uint64_t i2c_gone_until_ = 0;
+    uint64_t spi_gone_until_ = 0;
+    uint32_t i2c_epoch_ = 0;
+    uint32_t spi_epoch_ = 0;
     uint64_t unbinds_ = 0;
     uint64_t binds_ = 0;
     bool realistic_ = false;

@@ -14,7 +14,8 @@ namespace caracara::sim {
 
 // The kinds of entry, by bus (consumers filter on it):
 //   "i2c"        one I2C message: addr = 7-bit address, read, data = the bytes after the
-//                address byte; result "ack", "nack", "pins-not-i2c", "sda-held-low", "scl-held-low"
+//                address byte; result "ack", "nack", "pins-not-i2c", "sda-held-low", "scl-held-low",
+//                "timeout" (the slave held the clock past the adapter's timeout)
 //   "spi"        one SPI message: addr = chip select (0), data = MOSI, miso = MISO;
 //                result "ok", "no-device", "mode-mismatch"
 //   "i2c-lines"  SCL/SDA driven as GPIO (bus recovery): result "scl-pulse", "start", "stop"
@@ -42,6 +43,8 @@ public:
     std::vector<const WireEntry*> since(uint64_t since_index) const;
     uint64_t next_index() const { return next_; }
     void clear() { entries_.clear(); }
+    size_t size() const { return entries_.size(); }
+    size_t capacity() const { return capacity_; }
 
 private:
     size_t capacity_;

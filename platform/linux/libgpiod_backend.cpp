@@ -1,6 +1,8 @@
 // GpioBackend on libgpiod's v1 C++ binding (gpiod.hpp, Debian 12). Only this file knows it.
 #include "platform/linux/libgpiod_backend.hpp"
 
+#include "platform/linux/libgpiod_output_line.hpp"
+
 #include <cerrno>
 #include <gpiod.hpp>
 #include <system_error>
@@ -76,6 +78,8 @@ class LibgpiodBackend final : public GpioBackend {
 public:
     explicit LibgpiodBackend(std::string consumer) : consumer_(std::move(consumer)) {}
     std::unique_ptr<GpioLine> request(const GpioLineSpec& spec, GpioMode mode, int initial, std::string& error) override {
+        if (mode == GpioMode::Output || mode == GpioMode::OpenDrain)
+            return LibgpiodOutputLine::request(spec, mode, initial, consumer_, error);
         try {
             gpiod::chip chip(spec.chip, gpiod::chip::OPEN_LOOKUP);
             gpiod::line line = spec.offset ? chip.get_line(*spec.offset) : chip.find_line(spec.name);

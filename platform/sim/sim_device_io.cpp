@@ -55,15 +55,21 @@ int SimDeviceIo::roundtrip(size_t len, Op op, Reader& payload) {
     do {
         n = ::send(sock_, tx_.data(), len, MSG_NOSIGNAL);
     } while (n < 0 && errno == EINTR);
-    if (n < 0)
-        return errno == EPIPE || errno == ECONNRESET ? -ENODEV : -errno;
+    if (n < 0) {
+        if (errno != EPIPE && errno != ECONNRESET)
+            return -errno;
+        drop_connection();
+        return -ENODEV;
+    }
     const uint32_t want_seq = seq_;
     for (;;) {
         do {
             n = ::recv(sock_, rx_.data(), rx_.size(), 0);
         } while (n < 0 && errno == EINTR);
-        if (n == 0)
-            return -ENODEV; // the simulator went away: the adapter is gone
+        if (n == 0 || (n < 0 && errno == ECONNRESET)) {
+            drop_connection(); // the simulator went away: the adapter is gone
+            return -ENODEV;
+        }
         if (n < 0)
             return errno == EAGAIN || errno == EWOULDBLOCK ? -ETIMEDOUT : -errno;
         rx_len_ = static_cast<size_t>(n);
@@ -83,7 +89,39 @@ int SimDeviceIo::roundtrip(size_t len, Op op, Reader& payload) {
     }
 }
 
+void SimDeviceIo::drop_connection() {
+    if (sock_ >= 0)
+        ::close(sock_);
+    sock_ = -1;
+}
+
+int SimDeviceIo::reconnect_if_gone() {
+    if (sock_ >= 0)
+        return 0;
+    if (path_.empty())
+        return -ENODEV;
+    if (connect(path_) < 0)
+        return -ENODEV;
+    // Handles of the old connection name nothing on the new one.
+    generation_ = generation_ % kMaxGeneration + 1;
+    return 0;
+}
+
+int SimDeviceIo::wire_handle(int fd) const {
+    if (fd < 0 || (fd >> kGenerationShift) != generation_)
+        return -1;
+    return fd & ((1 << kGenerationShift) - 1);
+}
+
+int SimDeviceIo::tagged(int handle) const {
+    if (handle < 0 || handle >= (1 << kGenerationShift))
+        return handle < 0 ? handle : -EMFILE;
+    return (generation_ << kGenerationShift) | handle;
+}
+
 int SimDeviceIo::open(const char* path, int flags) {
+    if (reconnect_if_gone() < 0)
+        return -ENODEV;
     Writer w(tx_);
     w.header(Op::Open, ++seq_);
     w.str(path);
@@ -91,21 +129,27 @@ int SimDeviceIo::open(const char* path, int flags) {
     if (!w.ok())
         return -ENAMETOOLONG;
     Reader r({});
-    return roundtrip(w.size(), Op::Open, r);
+    return tagged(roundtrip(w.size(), Op::Open, r));
 }
 
 int SimDeviceIo::close(int fd) {
+    const int h = wire_handle(fd);
+    if (h < 0)
+        return -ENODEV; // made on a connection that is gone
     Writer w(tx_);
     w.header(Op::Close, ++seq_);
-    w.i32(fd);
+    w.i32(h);
     Reader r({});
     return roundtrip(w.size(), Op::Close, r);
 }
 
 int SimDeviceIo::write(int fd, const void* buf, size_t len) {
+    const int h = wire_handle(fd);
+    if (h < 0)
+        return -ENODEV; // made on a connection that is gone
     Writer w(tx_);
     w.header(Op::Write, ++seq_);
-    w.i32(fd);
+    w.i32(h);
     w.u32(static_cast<uint32_t>(len));
     w.bytes(buf, len);
     if (!w.ok())
@@ -116,6 +160,8 @@ int SimDeviceIo::write(int fd, const void* buf, size_t len) {
 
 int SimDeviceIo::gpio_request(const std::string& chip, const std::string& name, int offset, simproto::GpioMode mode,
                               bool active_low, int initial) {
+    if (reconnect_if_gone() < 0)
+        return -ENODEV;
     Writer w(tx_);
     w.header(Op::GpioRequest, ++seq_);
     w.str(chip);
@@ -127,17 +173,35 @@ int SimDeviceIo::gpio_request(const std::string& chip, const std::string& name, 
     if (!w.ok())
         return -ENAMETOOLONG;
     Reader r({});
-    return roundtrip(w.size(), Op::GpioRequest, r);
+    return tagged(roundtrip(w.size(), Op::GpioRequest, r));
 }
 
 int SimDeviceIo::simple(Op op, int32_t a, int32_t b) {
+    const int h = wire_handle(a);
+    if (h < 0)
+        return -ENODEV;
     Writer w(tx_);
     w.header(op, ++seq_);
-    w.i32(a);
+    w.i32(h);
     if (op == Op::GpioSet)
         w.u8(b ? 1 : 0);
     Reader r({});
     return roundtrip(w.size(), op, r);
+}
+
+bool SimDeviceIo::gpio_set_in_signal_handler(int line, int value) noexcept {
+    const int h = wire_handle(line);
+    if (h < 0 || sock_ < 0)
+        return false;
+    std::array<uint8_t, 32> buf{};
+    Writer w(buf);
+    w.header(Op::GpioSet, 0);
+    w.i32(h);
+    w.u8(value ? 1 : 0);
+    const int saved = errno;
+    const bool ok = w.ok() && ::send(sock_, buf.data(), w.size(), MSG_NOSIGNAL | MSG_DONTWAIT) > 0;
+    errno = saved;
+    return ok;
 }
 
 int SimDeviceIo::gpio_get(int line) { return simple(Op::GpioGet, line); }
@@ -145,6 +209,9 @@ int SimDeviceIo::gpio_set(int line, int value) { return simple(Op::GpioSet, line
 int SimDeviceIo::gpio_release(int line) { return simple(Op::GpioRelease, line); }
 
 int SimDeviceIo::ioctl(int fd, unsigned long request, void* arg) {
+    fd = wire_handle(fd);
+    if (fd < 0)
+        return -ENODEV; // made on a connection that is gone
     if (request == I2C_RDWR)
         return i2c_rdwr(fd, arg);
     if (_IOC_TYPE(request) == SPI_IOC_MAGIC && _IOC_NR(request) == 0 && _IOC_DIR(request) == _IOC_WRITE)

@@ -1,5 +1,7 @@
 // DeviceIo that hands each open/ioctl/close to caracara-sim over its Unix socket and copies
-// the replies and errno back exactly as the kernel would. No allocation per call.
+// the replies and errno back exactly as the kernel would. No allocation per call. When the
+// simulator goes away every call fails with ENODEV (the adapter is gone); the next open or
+// line request connects again, so a restarted simulator is picked up by whoever reopens.
 #pragma once
 
 #include "platform/device_io.hpp"
@@ -30,6 +32,9 @@ public:
     int gpio_get(int line);
     int gpio_set(int line, int value);
     int gpio_release(int line);
+    // GpioSet from a fatal-signal handler: one send of a message built on the stack, the reply
+    // left unread (its sequence number 0 is never awaited, so roundtrip() skips it).
+    bool gpio_set_in_signal_handler(int line, int value) noexcept;
     const std::string& socket_path() const { return path_; }
 
 private:
@@ -41,6 +46,16 @@ private:
     int small_ioctl(int fd, unsigned long request, void* arg);
 
     int simple(simproto::Op op, int32_t a, int32_t b = -1); // ops carrying one or two i32
+    void drop_connection();
+    int reconnect_if_gone(); // 0 or -ENODEV
+    // Handles carry the connection they were made on (the bits from kGenerationShift up), so
+    // one made before the simulator restarted is refused, never taken for a new handle that
+    // happens to have the same number (another line, another device).
+    static constexpr int kGenerationShift = 20;
+    static constexpr int kMaxGeneration = 1000;
+    int wire_handle(int fd) const; // the simulator's handle, or -1 if stale
+    int tagged(int handle) const;
+    int generation_ = 1;
     int sock_ = -1;
     std::string path_;
     uint32_t seq_ = 0;

@@ -69,6 +69,7 @@ public:
     }
     int get() override { return io_.gpio_get(handle_); }
     int set(int value) override { return io_.gpio_set(handle_, value); }
+    bool set_in_signal_handler(int value) noexcept override { return io_.gpio_set_in_signal_handler(handle_, value); }
     int event_fd() const override { return watch_fd_; }
     int drain_events() override {
         if (watch_fd_ < 0)

@@ -379,16 +379,20 @@ class Rig:
              self.START_TIMEOUT, message="dbus-daemon did not print its address")
         self._check_alive("dbus-daemon")
         self.conn = dbus.bus.BusConnection(self.address, mainloop=dbus.mainloop.glib.DBusGMainLoop())
-        self._spawn("caracara-sim", [binary("caracara-sim"), "--socket", self.sim_socket,
-                                     "--bus-address", self.address])
-        poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,
-             message="caracara-sim did not take its name")
-        self._check_alive("caracara-sim")
+        self.start_sim()
         with open(self.config_path, "w") as f:
             f.write(self.config_text())
         if daemon:
             self.start_daemon()
         return self
+
+    def start_sim(self):
+        """Starts caracara-sim (again, after a test ended it: the daemon is to pick it up)."""
+        self._spawn("caracara-sim", [binary("caracara-sim"), "--socket", self.sim_socket,
+                                     "--bus-address", self.address])
+        poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,
+             message="caracara-sim did not take its name")
+        self._check_alive("caracara-sim")
 
     def start_daemon(self):
         self.daemon_exit = None

@@ -84,9 +84,13 @@ class KillOutputFirstTest(VehicleTestCase):
         self.rig.wait_sim_speeds([speed_byte(2500)] * 8)
 
     def check_order(self, since, what):
+        def zeros_of(log):
+            return [e.index for e in log if e.bus == "i2c" and not e.read and len(e.data) == 3 and e.data[0] == ZERO]
+        # The zeros follow on the bus worker's thread: wait for them (bounded), then judge.
+        poll(lambda: len(zeros_of(self.rig.wire_log(since)[1])) >= MOTORS, 5)
         log = self.rig.wire_log(since)[1]
         kill_edge = [e.index for e in log if e.bus == "gpio" and e.addr == KILL_OUT and e.data == b"\x01"]
-        zeros = [e.index for e in log if e.bus == "i2c" and not e.read and len(e.data) == 3 and e.data[0] == ZERO]
+        zeros = zeros_of(log)
         self.assertTrue(kill_edge, "%s: no kill output edge" % what)
         self.assertGreaterEqual(len(zeros), MOTORS, "%s: not every thruster got its zero" % what)
         print("\n%s: kill output at entry %d, zero orders at %d..%d" % (what, kill_edge[0], zeros[0], zeros[MOTORS - 1]))
@@ -361,11 +365,12 @@ class AdapterLimitsTest(unittest.TestCase):
         self.assertEqual(int(rig.sim_get("I2cTimeout")), 3)  # 10 ms units, rounded up
         self.assertEqual(int(rig.sim_get("I2cRetries")), 2)
 
-    def test_unset_limits_leave_the_kernel_defaults(self):
+    def test_default_timeout_is_short_and_retries_the_kernels(self):
+        # 20 ms, not i2c-bcm2835's one second: what a hung thruster may hold the others up.
         rig = Rig(control={"arming_delay_ms": 300})
         self.addCleanup(rig.stop_checked)
         rig.start()
-        self.assertEqual(int(rig.sim_get("I2cTimeout")), -1)
+        self.assertEqual(int(rig.sim_get("I2cTimeout")), 2)
         self.assertEqual(int(rig.sim_get("I2cRetries")), -1)
 
 

@@ -264,9 +264,23 @@ TEST_CASE("a confirmed power-off asserts the power-off line after zeroing the th
     REQUIRE(d.set_thrust({1000, 1000, 0, 0, 0, 0, 0, 0}) == "");
     CHECK(d.call("PowerOff", "s", "yes") == "org.caracara.Vehicle1.Error.ConfirmationRequired");
     CHECK_FALSE(f.root_bool("PowerOffOutput"));
+    REQUIRE(f.call(kSim, kSimIface, "ClearWireLog", "") == "");
     REQUIRE(d.call("PowerOff", "s", "power-off") == "");
-    CHECK(f.root_bool("PowerOffOutput"));
+    // The zero orders are on the wire before the power-off line moves (judged by the order
+    // of the wire log's entries, not their stamps).
+    REQUIRE(d.wait_for([&] { return f.root_bool("PowerOffOutput"); }));
     CHECK(all_at(f, std::vector<int32_t>(8, 0)));
+    const auto log = f.wire_log();
+    uint64_t last_zero = 0, power_off_edge = 0;
+    for (const auto& e : log) {
+        if (e.bus == "i2c" && !e.read && e.result == "ack" && e.data.size() == 3 && e.data[0] == speed_byte(0))
+            last_zero = e.index;
+        if (e.bus == "gpio" && power_off_edge == 0 && last_zero != 0)
+            power_off_edge = e.index; // the first line edge after the zeros (the kill output's is before)
+    }
+    INFO("last zero order #" << last_zero << ", then line edge #" << power_off_edge);
+    CHECK(last_zero > 0);
+    CHECK(power_off_edge > last_zero);
     CHECK(d.vehicle_string("State") == "powered-off");
     // Clean exits: a sanitizer report or a crash would show here.
     CHECK(d.daemon.terminate() == 0);
@@ -280,6 +294,7 @@ TEST_CASE("a crashing daemon, or one ended by a stray signal, zeroes the thruste
         DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"));
         const std::vector<int32_t> v = {2000, 2000, 2000, 2000, 2000, 2000, 2000, 2000};
         drive(d, f, v);
+        REQUIRE(f.call(kSim, kSimIface, "ClearWireLog", "") == "");
         kill(d.daemon.pid(), sig);
         const int status = d.daemon.wait_exit(10000);
         // Died of that signal, as it would have without the handler (ASan may turn SIGSEGV into
@@ -289,6 +304,17 @@ TEST_CASE("a crashing daemon, or one ended by a stray signal, zeroes the thruste
         else
             CHECK(status == 128 + sig);
         CHECK(all_at(f, std::vector<int32_t>(8, 0)));
+        // The handler asserted the kill output before its first zero order (wire-log order).
+        uint64_t kill_edge = 0, first_zero = 0;
+        for (const auto& e : f.wire_log()) {
+            if (e.bus == "gpio" && e.addr == 27 && kill_edge == 0)
+                kill_edge = e.index;
+            if (e.bus == "i2c" && !e.read && e.data.size() == 3 && e.data[0] == speed_byte(0) && first_zero == 0)
+                first_zero = e.index;
+        }
+        INFO("kill output edge #" << kill_edge << ", first zero order #" << first_zero);
+        CHECK(kill_edge > 0);
+        CHECK(kill_edge < first_zero);
         CHECK(f.sim.terminate() == 0);
     }
 }

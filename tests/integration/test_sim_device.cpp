@@ -143,6 +143,38 @@ int32_t reply_result(int s) {
 }
 } // namespace
 
+// A request longer than the protocol's kMaxMessage is refused whole with EMSGSIZE, never read
+// cut short (SEQPACKET would drop its tail silently) and served.
+TEST_CASE("a request longer than the protocol allows is refused with EMSGSIZE") {
+    SimFixture f;
+    int s = raw_connect(f.socket());
+    uint8_t open_req[64];
+    simproto::Writer open(open_req);
+    open.header(simproto::Op::Open, 1);
+    open.str("/dev/i2c-1");
+    open.i32(O_RDWR);
+    REQUIRE(send(s, open_req, open.size(), 0) == static_cast<ssize_t>(open.size()));
+    REQUIRE(reply_result(s) == 3);
+    const uint64_t bad_before = f.root_u64("BadRequests");
+    const uint32_t big = static_cast<uint32_t>(simproto::kMaxMessage) + 100;
+    std::vector<uint8_t> buf(simproto::kMaxMessage + 1000);
+    simproto::Writer w(buf);
+    w.header(simproto::Op::Write, 4);
+    w.i32(3);
+    w.u32(big);
+    std::vector<uint8_t> junk(big, 'x');
+    w.bytes(junk.data(), junk.size());
+    REQUIRE(w.ok());
+    REQUIRE(send(s, buf.data(), w.size(), 0) == static_cast<ssize_t>(w.size()));
+    CHECK(reply_result(s) == -EMSGSIZE);
+    CHECK(f.root_u64("BadRequests") == bad_before + 1);
+    // Still serving, on this connection and a new one.
+    REQUIRE(send(s, open_req, open.size(), 0) == static_cast<ssize_t>(open.size()));
+    CHECK(reply_result(s) == 4);
+    close(s);
+    CHECK(f.sim.running());
+}
+
 TEST_CASE("malformed requests get an error reply and the simulator keeps serving") {
     SimFixture f;
     int s = raw_connect(f.socket());

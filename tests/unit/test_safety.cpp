@@ -113,6 +113,7 @@ TEST_CASE("a kill zeroes at once, drops commands and latches") {
     CHECK(kill_source_name(KillSource::Switch) == "switch");
     CHECK(kill_source_name(KillSource::Packet) == "packet");
     CHECK(kill_source_name(KillSource::Fault) == "bus");
+    CHECK(kill_source_name(KillSource::Device) == "device");
 }
 
 TEST_CASE("a second kill keeps the first source and still asks for zero") {

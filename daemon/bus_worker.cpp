@@ -1,0 +1,174 @@
+#include "daemon/bus_worker.hpp"
+
+#include <cerrno>
+#include <cstdint>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+namespace caracara {
+
+namespace {
+IoError execute(ThrusterDriver& d, const BusJob& job) {
+    return job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
+}
+} // namespace
+
+BusWorker::BusWorker(std::vector<std::unique_ptr<ThrusterDriver>>& drivers) : drivers_(drivers) {
+    for (const auto& d : drivers_) {
+        views_.push_back(*d);
+        published_.push_back(*d);
+    }
+}
+
+std::string BusWorker::start(sd_event* event, int64_t priority, DoneFn done) {
+    on_done_ = std::move(done);
+    if (running())
+        return {};
+    efd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    if (efd_ < 0)
+        return "eventfd: " + errno_name(errno);
+    sd_event_source* s = nullptr;
+    if (int r = sd_event_add_io(event, &s, efd_, EPOLLIN, on_done, this); r < 0) {
+        ::close(efd_);
+        efd_ = -1;
+        return "sd_event_add_io: " + errno_name(-r);
+    }
+    source_.reset(s);
+    sd_event_source_set_priority(s, priority);
+    stopping_ = false;
+    // Signals stay blocked in this thread as in the one that made it (main blocks them before
+    // the daemon starts): the loop's signal sources must see them.
+    thread_ = std::thread([this] { run(); });
+    return {};
+}
+
+void BusWorker::stop() {
+    if (running()) {
+        {
+            std::lock_guard lk(mu_);
+            stopping_ = true;
+        }
+        wake_.notify_all();
+        thread_.join();
+    }
+    std::lock_guard lk(mu_);
+    queue_.clear();
+    done_.clear();
+    outstanding_ = 0;
+    for (std::size_t i = 0; i < views_.size(); ++i)
+        views_[i] = published_[i];
+    source_.reset();
+    if (efd_ >= 0) {
+        ::close(efd_);
+        efd_ = -1;
+    }
+}
+
+void BusWorker::submit(const BusJob& in) {
+    BusJob job = in;
+    job.epoch = epoch_.load();
+    if (!running()) {
+        // Before the thread starts or after it stopped: on the caller's thread.
+        const BusJobDone d{job, execute(*drivers_[job.index], job)};
+        views_[job.index] = published_[job.index] = *drivers_[job.index];
+        if (on_done_)
+            on_done_(d);
+        return;
+    }
+    ++outstanding_;
+    {
+        std::lock_guard lk(mu_);
+        queue_.push_back(job);
+    }
+    wake_.notify_one();
+}
+
+void BusWorker::submit_first(std::span<const BusJob> jobs) {
+    if (!running()) {
+        for (const BusJob& j : jobs)
+            submit(j);
+        return;
+    }
+    {
+        std::lock_guard lk(mu_);
+        outstanding_ -= queue_.size();
+        queue_.clear();
+        for (BusJob j : jobs) {
+            j.epoch = epoch_.load();
+            queue_.push_back(j);
+        }
+    }
+    outstanding_ += jobs.size();
+    wake_.notify_one();
+}
+
+void BusWorker::drop_queued() {
+    std::lock_guard lk(mu_);
+    outstanding_ -= queue_.size();
+    queue_.clear();
+}
+
+void BusWorker::run() {
+    std::unique_lock lk(mu_);
+    for (;;) {
+        wake_.wait(lk, [this] { return stopping_ || !queue_.empty(); });
+        if (stopping_)
+            return;
+        const BusJob job = queue_.front();
+        queue_.pop_front();
+        busy_ = true;
+        lk.unlock();
+        // A non-zero order from before the last kill is dropped here, at the last moment.
+        const bool skip = job.kind == BusJobKind::Order && job.value != 0 && job.epoch != epoch_.load();
+        const IoError e = skip ? IoError::None : execute(*drivers_[job.index], job); // nothing held
+        lk.lock();
+        published_[job.index] = *drivers_[job.index];
+        done_.push_back({job, e, skip});
+        busy_ = false;
+        finished_.notify_all();
+        const uint64_t one = 1;
+        // A full counter (never, at 2^64 - 1) would only merge wake-ups.
+        [[maybe_unused]] const ssize_t n = ::write(efd_, &one, sizeof one);
+    }
+}
+
+int BusWorker::on_done(sd_event_source*, int fd, uint32_t, void* userdata) {
+    uint64_t count = 0;
+    [[maybe_unused]] const ssize_t n = ::read(fd, &count, sizeof count);
+    static_cast<BusWorker*>(userdata)->deliver();
+    return 0;
+}
+
+void BusWorker::deliver() {
+    delivering_.clear();
+    {
+        std::lock_guard lk(mu_);
+        delivering_.swap(done_);
+        for (const BusJobDone& d : delivering_)
+            views_[d.job.index] = published_[d.job.index];
+    }
+    for (const BusJobDone& d : delivering_) {
+        --outstanding_;
+        if (on_done_)
+            on_done_(d);
+    }
+}
+
+void BusWorker::wait_idle() {
+    while (running() && outstanding_ > 0) {
+        {
+            std::unique_lock lk(mu_);
+            finished_.wait(lk, [this] { return !done_.empty() || (queue_.empty() && !busy_); });
+        }
+        const std::size_t before = outstanding_;
+        deliver();
+        if (outstanding_ == before && before > 0) {
+            // Nothing was finished and nothing is queued: the count is off; do not hang.
+            std::lock_guard lk(mu_);
+            if (queue_.empty() && !busy_ && done_.empty())
+                outstanding_ = 0;
+        }
+    }
+}
+
+} // namespace caracara

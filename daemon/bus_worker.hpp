@@ -1,0 +1,102 @@
+// The thread that carries the I2C transfers, so that the event loop never waits on the bus:
+// a hung thruster holds a transfer for up to the adapter's timeout, and a Kill, a kill switch
+// edge, D-Bus and the watchdog must not queue behind it. The loop hands over one job at a
+// time (an order or a status read); a kill puts its zero orders in front of whatever is
+// queued. Only this thread touches the drivers, the mux state and the adapter's descriptor
+// while a job is out; the loop reads each driver through the copy made after its last job.
+// Finished jobs come back through an eventfd that the worker owns as an event source.
+#pragma once
+
+#include "devices/thruster_driver.hpp"
+#include "platform/event_loop.hpp"
+#include "platform/io_error.hpp"
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace caracara {
+
+enum class BusJobKind : uint8_t { Order, Status };
+
+struct BusJob {
+    BusJobKind kind = BusJobKind::Order;
+    uint32_t index = 0;
+    int32_t value = 0;  // the motor value of an order
+    uint64_t epoch = 0; // hold_orders() count when it was handed over (set by submit)
+};
+
+struct BusJobDone {
+    BusJob job;
+    IoError error = IoError::None;
+    bool skipped = false; // a non-zero order that a kill overtook: never sent
+};
+
+class BusWorker {
+public:
+    using DoneFn = std::function<void(const BusJobDone&)>;
+
+    explicit BusWorker(std::vector<std::unique_ptr<ThrusterDriver>>& drivers);
+    ~BusWorker() { stop(); }
+    BusWorker(const BusWorker&) = delete;
+    BusWorker& operator=(const BusWorker&) = delete;
+
+    // Starts the thread; `done` runs on the loop thread for each finished job, at `priority`.
+    std::string start(sd_event* event, int64_t priority, DoneFn done);
+    // Joins the thread once the job on the wire is over; queued jobs are dropped.
+    void stop();
+    bool running() const { return thread_.joinable(); }
+
+    void submit(const BusJob& job);
+    // `jobs` go before everything queued, which is dropped (a kill's zero orders).
+    void submit_first(std::span<const BusJob> jobs);
+    // Drops what is queued but not yet on the wire (the bus is closed for recovery).
+    void drop_queued();
+    // From now on, a non-zero order handed over before this call is not sent: a kill calls it
+    // before it writes the kill output, so no such order can follow the kill output onto the
+    // wire once the worker has seen it (at most the one whose transfer had already begun).
+    void hold_orders() { epoch_.fetch_add(1); }
+    // Nothing queued, on the wire, or finished but not yet handed to `done`.
+    bool idle() const { return outstanding_ == 0; }
+    // Blocks until idle, handing the finished jobs to `done`: start-up and shutdown only,
+    // where the zero orders must be on the wire before the daemon goes on.
+    void wait_idle();
+
+    // Thruster i as of its last finished job.
+    const ThrusterDriver& view(std::size_t i) const { return views_[i]; }
+
+private:
+    static int on_done(sd_event_source*, int fd, uint32_t, void* userdata);
+    void run();
+    void deliver();
+
+    std::vector<std::unique_ptr<ThrusterDriver>>& drivers_;
+    std::vector<ThrusterDriver> views_;     // loop thread
+    std::vector<ThrusterDriver> published_; // under mu_: the worker's copy after each job
+    std::size_t outstanding_ = 0;           // loop thread
+    std::atomic<uint64_t> epoch_{0};
+
+    mutable std::mutex mu_;
+    std::condition_variable wake_;      // the worker: a job or stop
+    std::condition_variable finished_;  // wait_idle: a job finished
+    std::deque<BusJob> queue_;
+    std::vector<BusJobDone> done_;
+    std::vector<BusJobDone> delivering_; // loop thread; reused
+    bool stopping_ = false;
+    bool busy_ = false; // a job is on the wire
+
+    int efd_ = -1;
+    SourcePtr source_;
+    DoneFn on_done_;
+    std::thread thread_;
+};
+
+} // namespace caracara

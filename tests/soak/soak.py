@@ -1,0 +1,374 @@
+"""Fault soak: caracarad against caracara-sim under a steady 50 Hz SetThrust stream with client
+churn, while faults are injected at random through the simulator; at the end the books are
+checked from the simulator's wire log (the vehicle's side), the daemon's fds and RSS.
+
+    soak.py [--seconds S] [--transactions N] [--seed K] [--loop-rate HZ]
+
+Stops after S seconds or once the daemon's bus has carried N transactions, whichever is first.
+Exit status 0 when every check holds. Needs what the e2e tests need (tests/e2e/harness.py).
+
+The books:
+  * lost commands: an accepted SetThrust whose orders did not all reach the wire before the
+    next command (+ a grace of two loop periods), unless a fault, a kill or a bus outage
+    overlapped it. Target 0.
+  * killed orders: a non-zero order to a thruster after the kill output's asserting edge and
+    after that thruster's zero order, before the output was released. Target 0. (A non-zero
+    order already on its way when the kill came is counted apart, as in flight.)
+  * timed-out orders: a non-zero order later than the command timeout (+ a grace) after the
+    stream paused, before it resumed. Target 0.
+  * the daemon's pid unchanged, its fds and RSS flat (start vs end).
+"""
+import argparse
+import os
+import random
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "e2e"))
+import dbus  # noqa: E402
+
+from harness import MOTORS, SIM, SIM_GPIO, Rig, binary, poll, speed_byte  # noqa: E402
+
+KILL_OUT = 27
+TIMEOUT_MS = 300
+PERIOD = 0.02
+GRACE = 0.06
+GPIO = dict(SIM_GPIO, scl={"chip": "gpiochip0", "line": "GPIO3"}, sda={"chip": "gpiochip0", "line": "GPIO2"})
+RECOVERY = {"enabled": True, "driver_id": "fe804000.i2c", "attempts": 3, "backoff_ms": 50}
+VEHICLE = "org.caracara.Vehicle1"
+PATH = "/org/caracara/Vehicle1"
+
+
+class SoakRig(Rig):
+    """The simulator with a wire log large enough for the soak's drains to keep up."""
+
+    def start_sim(self):
+        conf = os.path.join(self.dir, "sim.toml")
+        with open(conf, "w") as f:
+            f.write("[sim]\nwire_log_entries = 2000000\n")
+        self._spawn("caracara-sim", [binary("caracara-sim"), "--socket", self.sim_socket,
+                                     "--bus-address", self.address, "--config", conf])
+        poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,
+             message="caracara-sim did not take its name")
+        self._check_alive("caracara-sim")
+
+
+def rss_kib(pid):
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1])
+    return 0
+
+
+def fds(pid):
+    return len(os.listdir("/proc/%d/fd" % pid))
+
+
+class Soak:
+    def __init__(self, args):
+        self.args = args
+        self.rng = random.Random(args.seed)
+        self.rig = SoakRig(control={"arming_delay_ms": 100, "command_timeout_ms": TIMEOUT_MS, "loop_rate_hz": args.loop_rate},
+                       gpio=False, extra_config={"gpio": GPIO, "recovery": RECOVERY})
+        self.commands = []   # (t_sent, speeds) of accepted SetThrust calls
+        self.excused = []    # (t0, t1, thruster or None): faults during which orders may not arrive
+        self.pauses = []     # (t_pause, t_resume)
+        self.wire = []       # (time_ns, index, kind, addr, data0, result) of orders and kill output edges
+        self.since = 0
+        self.faults = {}
+        self.sim_restarts = 0
+        self.wire_gaps = 0
+        self.calls = 0
+        self.refused = 0
+        self.churn = 0
+
+    # --- the vehicle's side -------------------------------------------------------------------
+    def drain_wire(self):
+        nxt, entries = self.rig.sim_call("GetWireLog", dbus.UInt64(self.since), signature="t")
+        if entries and self.since and int(entries[0][0]) > self.since:
+            # The ring dropped entries before this drain read them: what happened then is unknown,
+            # so no command of that stretch is judged (counted, and excused).
+            self.wire_gaps += 1
+            last = self.wire[-1][0] / 1e9 if self.wire else 0
+            self.excused.append((last, int(entries[0][1]) / 1e9, None))
+        for e in entries:
+            idx, t, _txn, bus, addr, read, data, _miso, result = e
+            if bus == "i2c" and not read and len(data) == 3:
+                self.wire.append((int(t), int(idx), "order", int(addr), int(data[0]), str(result)))
+            elif bus == "gpio" and int(addr) == KILL_OUT and len(data) == 1:
+                self.wire.append((int(t), int(idx), "kill", 0, int(data[0]), "edge"))
+        if int(nxt) > self.since:
+            self.since = int(nxt)
+
+    # --- faults -------------------------------------------------------------------------------
+    def inject(self, now):
+        rig, rng = self.rig, self.rng
+        kind = rng.choice(["nack", "corrupt", "fault-bit", "hang-sda", "hold-scl", "teensy-busy", "teensy-garbage",
+                           "hang", "kill-switch", "sim-restart" if rng.random() < 0.15 else "nack"])
+        self.faults[kind] = self.faults.get(kind, 0) + 1
+        i = rng.randrange(MOTORS)
+        dur = rng.uniform(0.1, 0.6)
+        if kind == "nack":
+            rig.sim_thruster_call(i, "SetNack", True, signature="b")
+            time.sleep(dur)
+            rig.sim_thruster_call(i, "SetNack", False, signature="b")
+            self.excused.append((now, time.monotonic(), i))
+        elif kind == "corrupt":
+            rig.sim_thruster_call(i, "CorruptReplies", dbus.UInt32(rng.randint(1, 5)),
+                                  rng.choice(["checksum", "first-byte"]), signature="us")
+        elif kind == "fault-bit":
+            f = rng.choice(["overtemp", "stall", "hall", "ground-fault", "water-detect"])
+            rig.sim_thruster_call(i, "SetFault", f, True, signature="sb")
+            time.sleep(dur)
+            rig.sim_thruster_call(i, "SetFault", f, False, signature="sb")
+        elif kind == "hang-sda":
+            rig.sim_call("HangBus", dbus.UInt32(rng.randint(1, 9)), signature="u")
+            time.sleep(0.3)
+            self.excused.append((now, time.monotonic() + 0.3, None))
+        elif kind == "hold-scl":
+            rig.sim_call("HoldScl")
+            time.sleep(dur)
+            rig.sim_call("ReleaseBus")
+            self.excused.append((now, time.monotonic() + 1.5, None))
+        elif kind in ("teensy-busy", "teensy-garbage"):
+            rig.sim_teensy_call("InjectFault", "busy" if kind == "teensy-busy" else "garbage-ack",
+                                dbus.UInt32(rng.randint(1, 10)), signature="su")
+        elif kind == "hang":
+            rig.sim_thruster_call(i, "SetHang", dbus.UInt32(rng.choice([5, 30, 1000])), signature="u")
+            time.sleep(dur)
+            rig.sim_thruster_call(i, "SetHang", dbus.UInt32(0), signature="u")
+            self.excused.append((now, time.monotonic() + 0.1, None))
+        elif kind == "kill-switch":
+            rig.sim_call("SetKillSwitch", True, signature="b")
+            time.sleep(dur)
+            rig.sim_call("SetKillSwitch", False, signature="b")
+        elif kind == "sim-restart":
+            # The wire log starts again with the new simulator: the books so far are closed, and
+            # the commands just before the restart are excused (their orders may never go out).
+            self.excused.append((now - 0.3, now + 60, None))
+            self.drain_wire()
+            self.check_books()
+            self.wire, self.commands, self.excused, self.pauses, self.since = [], [], [], [], 0
+            sim = self.rig.procs.pop("caracara-sim")
+            sim.kill()
+            sim.wait(10)
+            time.sleep(dur)
+            self.rig.start_sim()
+            self.sim_restarts += 1
+        return kind
+
+    # --- the books ----------------------------------------------------------------------------
+    def check_books(self, cutoff=None):
+        b = self.books
+        orders = [w for w in self.wire if w[2] == "order"]
+        addr_of = self.addrs
+        # Killed: between an asserting and a releasing kill output edge.
+        killed_from = None
+        zeroed = set()
+        for t, idx, kind, addr, d0, res in self.wire:
+            if kind == "kill":
+                if d0 == self.kill_level:
+                    killed_from, zeroed = idx, set()
+                else:
+                    killed_from = None
+                continue
+            if killed_from is None:
+                continue
+            if d0 == 0x80:
+                zeroed.add(addr)
+            elif addr in zeroed:
+                b["killed_orders"] += 1
+            else:
+                b["in_flight_at_kill"] += 1
+        # Timed out: the stream paused.
+        for t0, t1 in self.pauses:
+            if cutoff is not None and t1 >= cutoff:
+                continue
+            lo, hi = int((t0 + TIMEOUT_MS / 1000 + GRACE) * 1e9), int(t1 * 1e9)
+            b["timed_out_orders"] += sum(1 for w in orders if lo < w[0] < hi and w[4] != 0x80)
+        # Lost: each accepted command's eight orders reach the wire before the next (+ grace).
+        kills = [w[0] for w in self.wire if w[2] == "kill"]
+        by_addr = {}
+        for w in orders:
+            by_addr.setdefault(w[3], []).append(w[0])
+        for k, (t, speeds) in enumerate(self.commands):
+            if cutoff is not None and t >= cutoff:
+                break
+            end = self.commands[k + 1][0] if k + 1 < len(self.commands) else t + 0.2
+            lo, hi = int(t * 1e9), int((end + GRACE) * 1e9)
+            if any(lo <= kt <= hi for kt in kills):
+                b["superseded_by_kill"] += 1
+                continue
+            missing = [i for i in range(MOTORS) if not self.reached(i, speeds[i], lo, hi, orders)]
+            if not missing:
+                b["reached"] += 1
+                continue
+            # Superseded: the thruster got a newer command's value instead (the stream moved on
+            # before this one's turn on the bus came).
+            later = self.commands[k + 1:k + 6]
+            if all(any(lo < wt <= hi and any(sp == c[1][i] for c in later) for wt, sp in self.orders_of(i, orders))
+                   for i in missing):
+                b["superseded"] += 1
+                continue
+            if all(any(a - 0.05 <= t <= c + 0.05 and (th is None or th == i) for a, c, th in self.excused)
+                   for i in missing):
+                b["excused"] += 1
+            else:
+                b["lost"] += 1
+                if b["lost"] <= 5:
+                    print("soak: LOST command at %.3f..%.3f (thrusters %s, wanted %s)" %
+                          (t, end, missing, [hex(speeds[i]) for i in missing]), flush=True)
+                    for i in missing:
+                        near = [(round(wt / 1e9 - t, 4), hex(sp)) for wt, sp in self.orders_of(i, orders)
+                                if t - 0.1 <= wt / 1e9 <= end + 0.3]
+                        print("soak:   thruster %d orders around it (s from the call, speed): %s" % (i, near))
+                    print("soak:   faults around it: %s" % [(round(a0 - t, 3), round(c - t, 3), th)
+                                                           for a0, c, th in self.excused if a0 - 1 < t < c + 1])
+
+    def reached(self, i, want, lo, hi, orders):
+        """The thruster stood at `want` at some moment of [lo, hi]: an order of it in the window,
+        or the order standing when the window opened (an unchanged value is not sent again at once)."""
+        standing = None
+        for wt, sp in self.orders_of(i, orders):
+            if wt < lo:
+                standing = sp
+            elif wt <= hi:
+                if sp == want:
+                    return True
+            else:
+                break
+        return standing == want
+
+    def orders_of(self, i, orders):
+        a = self.addrs[i]
+        return [(w[0], w[4]) for w in orders if w[3] == a]
+
+    # --- the run ------------------------------------------------------------------------------
+    def run(self):
+        a, rig, rng = self.args, self.rig, self.rng
+        rig.start()
+        self.addrs = [int(rig.sim_thruster(i, "Address")) >> 1 for i in range(MOTORS)]
+        self.kill_level = None
+        rig.arm()
+        pid = rig.procs["caracarad"].pid
+        time.sleep(1)
+        fd0, rss0 = fds(pid), rss_kib(pid)
+        self.books = dict(reached=0, superseded=0, superseded_by_kill=0, excused=0, lost=0, killed_orders=0, in_flight_at_kill=0,
+                          timed_out_orders=0)
+        # The level the kill output takes when asserted: what it shows while the vehicle is killed.
+        rig.vcall("Kill")
+        self.drain_wire()
+        self.kill_level = next(w[4] for w in reversed(self.wire) if w[2] == "kill")
+        rig.vcall("ClearKill")
+        rig.wait_state("ready")
+        self.wire = []
+        client = dbus.bus.BusConnection(rig.address)
+        t_start = time.monotonic()
+        next_cmd = next_fault = next_drain = next_churn = t_start
+        paused_until = 0
+        tx0 = int(rig.vget("Transactions", path=PATH + "/bus", iface=VEHICLE + ".Bus"))
+        last_report = t_start
+        tx, next_tx = 0, t_start
+        while True:
+            now = time.monotonic()
+            if now >= next_tx:
+                tx = int(rig.vget("Transactions", path=PATH + "/bus", iface=VEHICLE + ".Bus")) - tx0
+                next_tx = now + 1
+            if now - t_start >= a.seconds or (a.transactions and tx >= a.transactions):
+                break
+            if now >= next_drain:
+                self.drain_wire()
+                next_drain = now + 0.2
+                if len(self.wire) > 200000:
+                    # Close the books up to a second ago; keep the rest for the next check.
+                    cutoff = now - 1.0
+                    self.check_books(cutoff)
+                    self.commands = [c for c in self.commands if c[0] >= cutoff]
+                    self.wire = [w for w in self.wire if w[0] >= int((cutoff - 2) * 1e9)]
+                    self.pauses = [p for p in self.pauses if p[1] >= cutoff - 2]
+            if now >= next_fault:
+                self.inject(now)
+                next_fault = time.monotonic() + rng.uniform(0.3, 1.5)
+            if now >= next_churn:
+                client.close()
+                client = dbus.bus.BusConnection(rig.address)  # the old client left: the daemon zeroes
+                self.churn += 1
+                next_churn = now + rng.uniform(1, 4)
+                if rng.random() < 0.3:  # a silent stream, past the command timeout
+                    paused_until = now + TIMEOUT_MS / 1000 + rng.uniform(0.1, 0.5)
+                    self.pauses.append((now, paused_until))
+            if now >= next_cmd and now >= paused_until:
+                vals = [rng.randrange(-500, 501) for _ in range(MOTORS)]
+                t = time.monotonic()
+                try:
+                    client.call_blocking(VEHICLE, PATH, VEHICLE, "SetThrust", "ai", ([dbus.Int32(v) for v in vals],))
+                    self.commands.append((t, [speed_byte(v) for v in vals]))
+                except dbus.DBusException as e:
+                    self.refused += 1
+                    name = e.get_dbus_name() or ""
+                    if name.endswith(".Killed"):
+                        try:
+                            client.call_blocking(VEHICLE, PATH, VEHICLE, "ClearKill", "", ())
+                        except dbus.DBusException:
+                            pass
+                self.calls += 1
+                next_cmd += PERIOD
+                if next_cmd < now:
+                    next_cmd = now + PERIOD  # after a stall the stream goes on at its rate, no burst
+            if now - last_report > 30:
+                print("soak: %.0f s, %d transactions, %d calls" % (now - t_start, tx, self.calls), flush=True)
+                last_report = now
+            time.sleep(0.002)
+        time.sleep(0.3)
+        self.drain_wire()
+        self.check_books()
+        client.close()
+        elapsed = time.monotonic() - t_start
+        tx = int(rig.vget("Transactions", path=PATH + "/bus", iface=VEHICLE + ".Bus")) - tx0
+        time.sleep(1)
+        fd1, rss1 = fds(pid), rss_kib(pid)
+        same_pid = rig.procs["caracarad"].poll() is None and rig.procs["caracarad"].pid == pid
+        recov = int(rig.vget("Recoveries", path=PATH + "/bus", iface=VEHICLE + ".Bus"))
+        b = self.books
+        print("soak: %.0f s, %d bus transactions, %d SetThrust calls (%d refused), %d client changes, "
+              "%d simulator restarts, %d recoveries" % (elapsed, tx, self.calls, self.refused, self.churn,
+                                                         self.sim_restarts, recov))
+        print("soak: faults injected: " + ", ".join("%s %d" % kv for kv in sorted(self.faults.items())))
+        print("soak: commands reached the wire %d, superseded by a newer one %d, by a kill %d, excused by a "
+              "fault %d, LOST %d" % (b["reached"], b["superseded"], b["superseded_by_kill"], b["excused"], b["lost"]))
+        print("soak: non-zero orders after a kill's zero %d (in flight at the kill %d), after a timeout %d" %
+              (b["killed_orders"], b["in_flight_at_kill"], b["timed_out_orders"]))
+        print("soak: wire log stretches dropped before they were read: %d" % self.wire_gaps)
+        print("soak: daemon pid unchanged %s; fds %d -> %d; RSS %d -> %d KiB" % (same_pid, fd0, fd1, rss0, rss1))
+        ok = (b["lost"] == 0 and b["killed_orders"] == 0 and b["timed_out_orders"] == 0 and same_pid
+              and fd1 <= fd0 + 2 and rss1 <= rss0 + 2048 and b["reached"] > 0)
+        rig.stop_checked()
+        return ok
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--seconds", type=float, default=60)
+    ap.add_argument("--transactions", type=int, default=0)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--loop-rate", type=int, default=50,
+                    help="the daemon's loop_rate_hz (0: the bus flat out, for a million transactions in minutes)")
+    args = ap.parse_args()
+    soak = Soak(args)
+    try:
+        ok = soak.run()
+    except Exception:
+        for name in ("caracara-sim", "caracarad"):
+            try:
+                print("---- %s log (last 20 lines)\n%s" % (name, "\n".join(soak.rig.log(name).splitlines()[-20:])))
+            except Exception:  # noqa: BLE001 - the log may be gone with the rig
+                pass
+        soak.rig.stop()
+        raise
+    print("soak: %s" % ("PASS" if ok else "FAIL"))
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
