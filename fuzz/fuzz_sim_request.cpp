@@ -7,7 +7,8 @@
 // request changes nothing the client holds and carries no payload; an accepted one carries
 // exactly the bytes the protocol says (read payloads, rx bytes, an ioctl value).
 //
-// Input: requests, each [u16 length][that many bytes], to the end.
+// Input: requests, each [u16 length][that many bytes], to the end; the length's top bit marks
+// a request the server received truncated.
 #include "fuzz/byte_source.hpp"
 #include "fuzz/check.hpp"
 #include "protocol/sim_protocol.hpp"
@@ -163,11 +164,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     DeviceSession session;
     static std::vector<uint8_t> reply(simproto::kMaxMessage);
     while (!in.empty()) {
-        const auto req = in.bytes(in.u16());
+        // The length's top bit: the server's recv() saw MSG_TRUNC (the request was longer than
+        // kMaxMessage and only its start arrived).
+        const uint16_t len = in.u16();
+        const bool truncated = (len & 0x8000) != 0;
+        const auto req = in.bytes(len & 0x7FFF);
         const Held before = held(session);
         const uint64_t bad_before = ops.bad_requests();
         uint64_t wire_ns = 1;
-        const std::size_t n = ops.handle(session, req, reply, wire_ns);
+        const std::size_t n = ops.handle(session, req, reply, wire_ns, truncated);
 
         // Exactly one reply: the header echoes the request's op (as far as it could be read)
         // with the reply bit, and its seq.
@@ -187,15 +192,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                          n);
 
         const bool header_ok = req.size() >= 12 && le32(req.data()) == simproto::kMagic && !(op & simproto::kReplyBit);
-        const Shape shape = header_ok ? shape_of(op, req) : Shape{};
+        const Shape shape = header_ok && !truncated ? shape_of(op, req) : Shape{};
+        if (truncated)
+            FUZZ_CHECK(result == (header_ok ? -EMSGSIZE : -EBADMSG), "a truncated request answered %d", result);
         if (!shape.well_formed)
             FUZZ_CHECK(result < 0, "malformed request (op %#x, %zu bytes) answered %d", op, req.size(), result);
         if (result < 0) {
-            // Refused: no payload, no wire time, nothing the client holds has changed.
+            // Refused: no payload, nothing the client holds has changed.
             FUZZ_CHECK(n == 16, "refusal %d with %zu payload bytes", result, n - 16);
             FUZZ_CHECK(held(session) == before, "refused op %#x changed the session", op);
             if (result == -EBADMSG)
-                FUZZ_CHECK(ops.bad_requests() == bad_before + 1, "a malformed request not counted");
+                FUZZ_CHECK(ops.bad_requests() == bad_before + 1 && wire_ns == 0,
+                           "a malformed request not counted, or it took the wire");
             continue;
         }
         FUZZ_CHECK(shape.well_formed, "accepted a malformed op %#x", op);
