@@ -379,6 +379,10 @@ void parse_recovery(Checker& c, const toml::table& t, RecoverySettings& out) {
 ConfigResult parse_config_string(std::string_view text, std::string_view source) {
     ConfigResult r;
     const std::string prefix = source.empty() ? std::string() : std::string(source) + ": ";
+    if (std::string e = non_ascii_outside_comments(text); !e.empty()) {
+        r.errors.push_back(prefix + e);
+        return r;
+    }
     toml::table root;
     try {
         root = toml::parse(text, source);

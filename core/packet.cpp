@@ -70,19 +70,25 @@ PacketResult decode_packet(std::span<const int32_t> words) {
     return r;
 }
 
+namespace {
+int32_t le_word(std::span<const uint8_t> bytes, std::size_t i) {
+    return static_cast<int32_t>(uint32_t{bytes[4 * i]} | uint32_t{bytes[4 * i + 1]} << 8 |
+                                uint32_t{bytes[4 * i + 2]} << 16 | uint32_t{bytes[4 * i + 3]} << 24);
+}
+} // namespace
+
 PacketResult decode_packet_bytes(std::span<const uint8_t> bytes) {
     if (bytes.size() != kPacketBytes) {
         PacketResult r;
         r.error = PacketError::WrongLength;
         r.message = "packet must be " + std::to_string(kPacketBytes) + " bytes, got " + std::to_string(bytes.size());
+        // As decode_packet: a torn packet that still carries killState keeps its kill.
+        r.kill_requested = bytes.size() >= 4 * (kPacketKill + 1) && le_word(bytes, kPacketKill) != 0;
         return r;
     }
     std::array<int32_t, kPacketWords> words{};
-    for (std::size_t i = 0; i < kPacketWords; ++i) {
-        const uint32_t u = uint32_t{bytes[4 * i]} | uint32_t{bytes[4 * i + 1]} << 8 |
-                           uint32_t{bytes[4 * i + 2]} << 16 | uint32_t{bytes[4 * i + 3]} << 24;
-        words[i] = static_cast<int32_t>(u);
-    }
+    for (std::size_t i = 0; i < kPacketWords; ++i)
+        words[i] = le_word(bytes, i);
     return decode_packet(words);
 }
 

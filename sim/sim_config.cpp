@@ -1,5 +1,7 @@
 #include "sim/sim_config.hpp"
 
+#include "core/toml_checker.hpp"
+
 #include <fstream>
 #include <sstream>
 #include <toml++/toml.h>
@@ -23,17 +25,25 @@ bool get_int(const toml::table& t, const char* key, const std::string& where, T 
     auto node = t.get(key);
     if (!node)
         return true;
-    auto v = node->value<int64_t>();
-    if (!v || *v < lo || *v > hi) {
+    // Integers only, as caracarad's checker takes them: node::value<int64_t>() would also take a
+    // float, truncating 1.5 to 1, and toml++ 3.3 casts one beyond int64 before checking its
+    // range (undefined behaviour; found by fuzz_config).
+    const auto* v = node->as_integer();
+    if (!v || v->get() < lo || v->get() > hi) {
         err = where + key + ": must be an integer between " + std::to_string(lo) + " and " + std::to_string(hi);
         return false;
     }
-    out = static_cast<T>(*v);
+    out = static_cast<T>(v->get());
     return true;
 }
 } // namespace
 
 bool parse_sim_config(const std::string& text, SimConfig& out, std::string& error) {
+    // The same guard as caracarad's reader of this file (core/toml_checker.hpp says why).
+    if (std::string e = non_ascii_outside_comments(text); !e.empty()) {
+        error = e;
+        return false;
+    }
     toml::table root;
     try {
         root = toml::parse(text);

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """The layering rules, checked on the sources: each folder includes only the folders before it
-(core <- protocol <- platform <- devices <- daemon <- dbus), every project include is written
-from the repository root, no product source file (all but bench/ and tests/) is over 600 lines,
+(core <- protocol <- platform <- devices <- daemon <- dbus), the fuzz harnesses (fuzz/) may use
+any layer but nothing includes them, every project include is written
+from the repository root, no product source file (all but bench/, tests/ and fuzz/) is over 600 lines,
 and CMake lists sources (no GLOB).
 Prints each violation; exit 1 when there is one."""
 import os
@@ -11,7 +12,7 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ORDER = ["core", "protocol", "platform", "devices", "daemon", "dbus"]
 # What sits on top may use any layer; main.cpp is the composition root.
-TOP = {"sim", "tools", "bench", "tests"}
+TOP = {"sim", "tools", "bench", "tests", "fuzz"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 problems = []
@@ -23,11 +24,14 @@ for top in ORDER + sorted(TOP):
             path = os.path.join(dirpath, name)
             rel = os.path.relpath(path, ROOT)
             text = open(path, encoding="utf-8", errors="replace").read()
-            if top not in ("bench", "tests") and text.count("\n") > 600:
+            if top not in ("bench", "tests", "fuzz") and text.count("\n") > 600:
                 problems.append("%s: %d lines (at most 600)" % (rel, text.count("\n")))
             for inc in INCLUDE.findall(text):
                 if not os.path.exists(os.path.join(ROOT, inc)):
                     problems.append("%s: #include \"%s\" is not a path from the repository root" % (rel, inc))
+                    continue
+                if inc.split("/")[0] == "fuzz" and top != "fuzz":
+                    problems.append("%s: includes %s; nothing outside fuzz/ may" % (rel, inc))
                     continue
                 if top in TOP or rel == "daemon/main.cpp":
                     continue

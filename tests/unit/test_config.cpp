@@ -463,3 +463,26 @@ TEST_CASE("mutated values: a refused file names each bad key and line, nothing i
     CHECK(accepted > 20);
     CHECK(refused > 1000);
 }
+
+TEST_CASE("non-ASCII text is refused outside comments, before toml++ sees it (fuzz_config regression)") {
+    // toml++ 3.3 hit __builtin_unreachable on these: a key, a value's tail, the line after a
+    // line-ending backslash in a multi-line string.
+    CHECK(errors_of("\xd0\xbb") == "line 1, column 1: non-ASCII byte 0xd0 outside a comment (keys and values in this "
+                                   "file are ASCII)");
+    CHECK_THAT(errors_of("[control]\nloop_rate_hz = 50\xc2\xb0\n"), Catch::Contains("line 2, column 18: non-ASCII"));
+    CHECK_THAT(errors_of("[spi]\ndevice = \"\"\"\\\n\xc2\xa7/dev/spidev0.0\"\"\"\n"), Catch::Contains("line 3, column 1"));
+    // Strings hide neither a '#' nor an escaped quote from the guard.
+    CHECK_THAT(errors_of("[spi]\ndevice = \"/dev/x#\xc3\xa9\"\n"), Catch::Contains("line 2, column 18"));
+    CHECK_THAT(errors_of("[spi]\ndevice = \"/dev/\\\"#\" \xc3\xa9\n"), Catch::Contains("line 2, column 21"));
+    CHECK_THAT(errors_of("[spi]\ndevice = '/dev/#'\xc3\xa9\n"), Catch::Contains("line 2, column 18"));
+    CHECK(parse_config_string("[spi]\ndevice = '''/dev/#\n\xc3\xa9'''\n").error().find("line 3, column 1") !=
+          std::string::npos);
+    // Comments may say anything, also after strings with quotes just inside their delimiters.
+    const ConfigResult r = parse_config_string("# 20 \xc2\xb0" "C, \xc2\xb5s, \xd0\xbb\n[recovery]  # \xc3\xa9\n"
+                                               "driver_id = \"\"\"x\"\"\"\"\"  # \xc2\xa7\n"
+                                               "unbind_path = '''/a''''' # \xc2\xa7\n");
+    INFO(r.error());
+    REQUIRE(r.ok());
+    CHECK(r.config->recovery.driver_id == "x\"\"");
+    CHECK(r.config->recovery.unbind_path == "/a''");
+}

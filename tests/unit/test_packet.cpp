@@ -146,3 +146,17 @@ TEST_CASE("a kill in a packet is seen even when another field is refused") {
     w[kPacketKill] = 0;
     CHECK_FALSE(decode_packet(w).kill_requested);
 }
+
+TEST_CASE("a torn byte packet that carries killState keeps its kill (fuzz_packet regression)") {
+    std::vector<uint8_t> b(36, 0);
+    b[32] = 0x05;  // killState = 5, the packet cut after word 8
+    PacketResult r = decode_packet_bytes(b);
+    CHECK(r.error == PacketError::WrongLength);
+    CHECK(r.kill_requested);
+    b.push_back(0);  // 37 bytes: not whole words, the kill is still there
+    CHECK(decode_packet_bytes(b).kill_requested);
+    b.resize(35);  // killState cut short: nothing to read
+    CHECK_FALSE(decode_packet_bytes(b).kill_requested);
+    b.assign(36, 0);
+    CHECK_FALSE(decode_packet_bytes(b).kill_requested);
+}

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Runs the libFuzzer harnesses (fuzz/) for longer than CI does, growing a corpus outside the
+# repository, and prints executions and coverage (libFuzzer's cov:/ft: and its final stats).
+#   scripts/fuzz.sh                      every harness, 10 minutes each
+#   scripts/fuzz.sh seabotix 3600        one harness for an hour
+#   scripts/fuzz.sh config -runs=10000000
+# Harnesses: packet seabotix teensy config sim_request (or "all").
+# The grown corpus and any crash-*/leak-*/timeout-* input stay in
+# ${CARACARA_FUZZ_DIR:-/var/tmp/caracara-fuzz}/<harness>/; a crash input belongs in
+# fuzz/regressions/<harness>/ once its cause is fixed. Builds build-fuzz/ with clang-14 first.
+set -euo pipefail
+top=$(cd "$(dirname "$0")/.." && pwd)
+harnesses=(packet seabotix teensy config sim_request)
+which=${1:-all}
+limit=${2:-600}
+store=${CARACARA_FUZZ_DIR:-/var/tmp/caracara-fuzz}
+build=${CARACARA_FUZZ_BUILD:-$top/build-fuzz}
+
+if [ "$which" != all ]; then
+  [[ " ${harnesses[*]} " == *" $which "* ]] || { echo "fuzz.sh: no harness '$which' (${harnesses[*]})" >&2; exit 2; }
+  harnesses=("$which")
+fi
+case $limit in
+  -runs=*) stop=("$limit") ;;
+  *[!0-9]*|'') echo "fuzz.sh: '$limit' is neither seconds nor -runs=N" >&2; exit 2 ;;
+  *) stop=(-max_total_time="$limit") ;;
+esac
+
+cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
+  -DCARACARA_FUZZ=ON -DCARACARA_WERROR=ON >/dev/null
+cmake --build "$build" -j"$(nproc)" --target fuzzers >/dev/null
+
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+failed=()
+summary=()
+for h in "${harnesses[@]}"; do
+  out="$store/$h"
+  mkdir -p "$out/corpus"
+  dirs=("$out/corpus" "$top/fuzz/corpus/$h")
+  [ -d "$top/fuzz/regressions/$h" ] && dirs+=("$top/fuzz/regressions/$h")
+  opts=("${stop[@]}" -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 -print_pcs=0 -artifact_prefix="$out/")
+  [ -f "$top/fuzz/$h.dict" ] && opts+=(-dict="$top/fuzz/$h.dict")
+  echo "== fuzz $h (${stop[*]}), corpus $out/corpus"
+  status=0
+  start=$(date +%s)
+  "$build/fuzz/fuzz_$h" "${opts[@]}" "${dirs[@]}" 2>"$out/log" || status=$?
+  secs=$(( $(date +%s) - start ))
+  grep -E '^#[0-9]+[[:space:]]+(INITED|DONE)|^stat::' "$out/log" || true
+  done_line=$(grep -E '^#[0-9]+[[:space:]]+DONE' "$out/log" | tail -n1 || true)
+  execs=$(grep -E '^stat::number_of_executed_units' "$out/log" | awk '{print $2}')
+  summary+=("$(printf '%-12s %12s execs %6ss  %s' "$h" "${execs:-?}" "$secs" \
+    "$(sed -E 's/^#[0-9]+[[:space:]]+DONE +//; s/ lim:.*exec\/s/ exec\/s/; s/ rss:.*//' <<<"$done_line")")")
+  if [ "$status" -ne 0 ]; then
+    failed+=("$h")
+    echo "fuzz $h: FAILED (exit $status); input: $(ls "$out" | grep -E '^(crash|leak|timeout|oom)-' | tr '\n' ' ')"
+    grep -E 'ERROR|invariant failed|runtime error|SUMMARY' "$out/log" | head -n 5
+  fi
+done
+echo "== summary"
+printf '%s\n' "${summary[@]}"
+if ((${#failed[@]})); then
+  echo "fuzz.sh: failed: ${failed[*]} (logs in $store/<harness>/log)"
+  exit 1
+fi
