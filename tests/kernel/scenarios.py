@@ -369,6 +369,25 @@ def sc_sigterm(rig):
     check(zeros == set(range(MOTORS)), "zero orders on the way out only to %s" % sorted(zeros))
 
 
+def sc_fatal_signal(rig):
+    """A crash (SIGABRT): the emergency stop in the signal handler sets the kill output through
+    the real GPIO chip (GpioLine::set_in_signal_handler: one ioctl) before its zero orders."""
+    values = [3000, 3000, -3000, -3000, 0, 0, 0, 0]
+    rig.thrust(values)
+    rig.wait_sim_speeds([speed_byte(v) for v in values], 20)
+    since = rig.wire_next()
+    proc = rig.procs["caracarad"]
+    proc.send_signal(signal.SIGABRT)
+    code = proc.wait(60)
+    check(code == -signal.SIGABRT, "caracarad ended with %s, not of SIGABRT" % code)
+    check(rig.sim_speeds() == [ZERO] * MOTORS, "not zeroed after the crash: %s" % rig.sim_speeds())
+    _, entries = rig.wire_log(since)
+    edge = next((e.index for e in entries if e.bus == "gpio" and e.addr == 27 and list(e.data) == [1]), None)
+    zeros = [e.index for i, d, e in rig.orders(since) if d[0] == ZERO]
+    check(edge is not None, "the kill output was not set by the signal handler")
+    check(zeros and edge < zeros[0], "the kill output (#%s) after the first zero order (#%s)" % (edge, zeros[:1]))
+
+
 def sc_i2ctransfer(rig):
     """i2c-tools as a reference client, with no daemon running: the bytes of one of the
     daemon's own orders, sent by i2ctransfer through the same kernel adapter, land in the
@@ -537,6 +556,8 @@ SCENARIOS = [
     ("per_byte_spi_and_active_low_output", sc_per_byte_spi_active_low),
     ("unwired_gpio_line_refused", sc_unwired_line),
     ("gpio_chip_by_number_label_path_line_by_offset", sc_gpio_lookup),
+    # Restarted by the loop below (it died).
+    ("fatal_signal_kill_output_first", sc_fatal_signal),
     ("sigterm", sc_sigterm),
     # With no daemon: i2c-tools alone on the adapter; it leaves thruster 1 running.
     ("i2ctransfer_reference", sc_i2ctransfer),
