@@ -1,5 +1,7 @@
 #include "platform/sim/sim_device_io.hpp"
 
+#include <poll.h>
+
 #include <cerrno>
 #include <cstring>
 #include <linux/i2c-dev.h>
@@ -199,7 +201,21 @@ bool SimDeviceIo::gpio_set_in_signal_handler(int line, int value) noexcept {
     w.i32(h);
     w.u8(value ? 1 : 0);
     const int saved = errno;
-    const bool ok = w.ok() && ::send(sock_, buf.data(), w.size(), MSG_NOSIGNAL | MSG_DONTWAIT) > 0;
+    bool ok = w.ok() && ::send(sock_, buf.data(), w.size(), MSG_NOSIGNAL | MSG_DONTWAIT) > 0;
+    // Wait (at most 50 ms) for its reply: the simulator has then set the line, before anything
+    // the caller sends next on another connection (the emergency stop's zero orders). Another
+    // thread may take the reply first; then the bound ends the wait.
+    for (int waited_ms = 0; ok && waited_ms < 50; ++waited_ms) {
+        pollfd p{sock_, POLLIN, 0};
+        if (::poll(&p, 1, 1) <= 0)
+            continue;
+        std::array<uint8_t, 64> rx{};
+        const ssize_t n = ::recv(sock_, rx.data(), rx.size(), MSG_DONTWAIT);
+        Reader r({rx.data(), n > 0 ? static_cast<size_t>(n) : 0});
+        simproto::Header reply;
+        if (n > 0 && r.header(reply) && reply.seq == 0)
+            break;
+    }
     errno = saved;
     return ok;
 }

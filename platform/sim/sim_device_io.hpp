@@ -32,8 +32,8 @@ public:
     int gpio_get(int line);
     int gpio_set(int line, int value);
     int gpio_release(int line);
-    // GpioSet from a fatal-signal handler: one send of a message built on the stack, the reply
-    // left unread (its sequence number 0 is never awaited, so roundtrip() skips it).
+    // GpioSet from a fatal-signal handler: one send of a message built on the stack, then a
+    // bounded wait (50 ms) for its reply, sequence number 0 (roundtrip() skips it if it gets it).
     bool gpio_set_in_signal_handler(int line, int value) noexcept;
     const std::string& socket_path() const { return path_; }
 
