@@ -6,7 +6,7 @@ if(NOT CARACARA_SANITIZE)
   add_test(NAME soak_short
            COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/soak.py --seconds 60 --seed 1)
   set_tests_properties(soak_short PROPERTIES
-                       ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1"
+                       ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
                        TIMEOUT 300
                        LABELS soak)
 endif()
