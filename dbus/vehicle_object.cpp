@@ -31,11 +31,12 @@ int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
 // bus worker's thread): a caller that sees the reply sees the thrusters told zero. The loop
 // does not wait for them; the kill output was asserted before any of them.
 int reply_after_zeros(sd_bus_message* m, void* userdata, const Result& result) {
+    // An error too: a refused packet that carried a kill still killed, and its zeros go first.
     ThrusterBus& bus = static_cast<VehicleDaemon*>(userdata)->bus();
-    if (!result.ok() || bus.idle())
+    if (bus.idle())
         return reply(m, result);
     auto call = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
-    bus.when_idle([call] { reply(call.get(), {}); });
+    bus.when_idle([call, result] { reply(call.get(), result); });
     return 1;
 }
 
