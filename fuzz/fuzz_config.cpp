@@ -89,12 +89,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const long lines = std::count(text.begin(), text.end(), '\n') + 1;
     for (const std::string& e : r.errors) {
         FUZZ_CHECK(e.starts_with("fuzz.toml: ") && e.size() > 11, "message without its source: %s", e.c_str());
-        // "(line N)" and "line N, column M" point into the text.
-        for (std::string_view tag : {"(line ", ": line "}) {
-            const auto at = e.find(tag);
-            if (at == std::string::npos)
-                continue;
-            const long n = std::strtol(e.c_str() + at + tag.size(), nullptr, 10);
+        // A trailing "(line N)" and a leading "line N, column M" point into the text (the
+        // message between may quote the user's text, "(line " included).
+        std::size_t at = std::string::npos;
+        if (e.ends_with(")") && (at = e.rfind("(line ")) != std::string::npos)
+            at += 6;
+        else if (e.starts_with("fuzz.toml: line "))
+            at = 16;
+        if (at != std::string::npos) {
+            const long n = std::strtol(e.c_str() + at, nullptr, 10);
             FUZZ_CHECK(n >= 1 && n <= lines, "line %ld of a %ld-line text: %s", n, lines, e.c_str());
         }
     }

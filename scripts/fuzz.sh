@@ -47,10 +47,11 @@ for h in "${harnesses[@]}"; do
   "$build/fuzz/fuzz_$h" "${opts[@]}" "${dirs[@]}" 2>"$out/log" || status=$?
   secs=$(( $(date +%s) - start ))
   grep -E '^#[0-9]+[[:space:]]+(INITED|DONE)|^stat::' "$out/log" || true
-  done_line=$(grep -E '^#[0-9]+[[:space:]]+DONE' "$out/log" | tail -n1 || true)
+  # DONE, or after a crash the last progress line.
+  done_line=$(grep -E '^#[0-9]+[[:space:]]+[A-Z]+ +cov:' "$out/log" | tail -n1 || true)
   execs=$(grep -E '^stat::number_of_executed_units' "$out/log" | awk '{print $2}')
   summary+=("$(printf '%-12s %12s execs %6ss  %s' "$h" "${execs:-?}" "$secs" \
-    "$(sed -E 's/^#[0-9]+[[:space:]]+DONE +//; s/ lim:.*exec\/s/ exec\/s/; s/ rss:.*//' <<<"$done_line")")")
+    "$(sed -E 's/^#[0-9]+[[:space:]]+[A-Z]+ +//; s/ lim:.*exec\/s/ exec\/s/; s/ rss:.*//' <<<"$done_line")")")
   if [ "$status" -ne 0 ]; then
     failed+=("$h")
     echo "fuzz $h: FAILED (exit $status); input: $(ls "$out" | grep -E '^(crash|leak|timeout|oom)-' | tr '\n' ' ')"
