@@ -64,7 +64,12 @@ fi
 # Named apart from run.sh's roots ($suite-$arch-KEY.tar), which run.sh prunes by that pattern.
 mkdir -p "$cache_dir"
 exec {lock}>"$cache_dir/.$suite-build.lock"
-flock "$lock"
+if ! flock -n "$lock"; then
+  say "waiting for another Debian 13 run to finish"
+  flock "$lock"
+  say "waited $(($(date +%s) - t0)) s"
+  t0=$(date +%s)
+fi
 key=$(printf '%s\n' "$suite" "$arch" minbase "$recipe" "${packages[@]}" | sha256sum | cut -c1-16)
 cache=$cache_dir/$suite-build-$arch-$key.tar
 if [ ! -f "$cache" ]; then
