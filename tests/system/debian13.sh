@@ -95,9 +95,12 @@ if [ ! -f "$cache" ]; then
   mv "$tmp/root.tar" "$cache"
   rm -rf --one-file-system "$tmp"
   trap - EXIT
-  find "$cache_dir" -maxdepth 1 -name "$suite-build-$arch-*.tar" ! -path "$cache" -delete
   say "build root made in $(($(date +%s) - t0)) s"
 fi
+# Roots of another package list go once unused for a week (not at once: two branches with
+# different lists would otherwise rebuild theirs on every run).
+touch "$cache"
+find "$cache_dir" -maxdepth 1 -name "$suite-build-$arch-*.tar" ! -path "$cache" -mtime +7 -delete
 
 # The build tree survives the run, so a rerun rebuilds only what changed: one per source
 # directory (make trusts timestamps) and per root (another compiler makes everything stale).
