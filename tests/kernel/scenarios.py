@@ -372,7 +372,8 @@ def sc_sigterm(rig):
 def sc_fatal_signal(rig):
     """A crash (SIGABRT): the emergency stop in the signal handler sets the kill output through
     the real GPIO chip (GpioLine::set_in_signal_handler: one ioctl) before its zero orders."""
-    values = [3000, 3000, -3000, -3000, 0, 0, 0, 0]
+    # All eight running: the loop's own refreshes to idle thrusters would be zero orders too.
+    values = [2000, -2000] * 4
     rig.thrust(values)
     rig.wait_sim_speeds([speed_byte(v) for v in values], 20)
     since = rig.wire_next()

@@ -12,9 +12,11 @@
 #    read-only and a build tree (kept between runs under the cache directory, one per source
 #    directory) bound writable, both at their host paths: scripts/build.sh with warnings as
 #    errors (-j2), then ctest without the tests labelled system or kernel (they boot a
-#    container or a VM of their own; both are run next, from the host).
-# 3. tests/system/run.sh with CARACARA_SYSTEST_SUITE=trixie: the system test's checks
-#    (check.sh) in a booted Debian 13 container with this build installed.
+#    container or a VM of their own; both are run next, from the host), then the Debian
+#    packages with scripts/package.sh (nocheck, lintian) into a directory beside the build.
+# 3. tests/system/run.sh --debs with CARACARA_SYSTEST_SUITE=trixie: the system test's checks
+#    (check.sh, check-debs.sh) in a booted Debian 13 container that installs those packages
+#    with apt-get, upgrades them while the thrusters run, and purges them.
 # 4. tests/kernel/run.sh with CARACARA_KERNEL_ROOT set to the Debian 13 root: the kernel test's
 #    scenarios under QEMU, caracarad's libgpiod 2 backend on the test module's GPIO chip.
 #    CARACARA_DEBIAN13_KERNEL=0 leaves this step out.
@@ -29,12 +31,13 @@ suite=trixie
 arch=$(dpkg --print-architecture)
 cache_dir=${CARACARA_SYSTEST_CACHE:-/var/cache/caracara-systest}
 build_timeout_s=${CARACARA_DEBIAN13_BUILD_TIMEOUT:-1500}
-# Build and test dependencies (scripts/deps.sh's, by their Debian 13 names), and what the kernel
-# test's guest runs in this root: insmod, i2c-tools.
+# Build and test dependencies (scripts/deps.sh's, by their Debian 13 names), scripts/package.sh's
+# tools, and what the kernel test's guest runs in this root: insmod, i2c-tools.
 packages=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev libcatch2-dev
-          libtomlplusplus-dev dbus python3 python3-dbus python3-gi systemd kmod i2c-tools)
+          libtomlplusplus-dev dbus python3 python3-dbus python3-gi systemd dpkg-dev debhelper lintian
+          kmod i2c-tools)
 # Bump when the way the cached root is made changes.
-recipe=1
+recipe=2
 
 say() { echo "debian13: $*"; }
 die() { echo "debian13: FAIL: $*" >&2; exit 1; }
@@ -61,7 +64,12 @@ fi
 # Named apart from run.sh's roots ($suite-$arch-KEY.tar), which run.sh prunes by that pattern.
 mkdir -p "$cache_dir"
 exec {lock}>"$cache_dir/.$suite-build.lock"
-flock "$lock"
+if ! flock -n "$lock"; then
+  say "waiting for another Debian 13 run to finish"
+  flock "$lock"
+  say "waited $(($(date +%s) - t0)) s"
+  t0=$(date +%s)
+fi
 key=$(printf '%s\n' "$suite" "$arch" minbase "$recipe" "${packages[@]}" | sha256sum | cut -c1-16)
 cache=$cache_dir/$suite-build-$arch-$key.tar
 if [ ! -f "$cache" ]; then
@@ -70,10 +78,16 @@ if [ ! -f "$cache" ]; then
   say "building the $suite build root with debootstrap from $mirror (cached in $cache)"
   tmp=$(mktemp -d "$cache_dir/debootstrap.XXXXXX")
   trap 'rm -rf --one-file-system "$tmp"' EXIT
-  if ! debootstrap --variant=minbase --components=main --include="$(IFS=,; echo "${packages[*]}")" \
-      "$suite" "$tmp/root" "$mirror" >"$tmp/debootstrap.log" 2>&1; then
+  if ! debootstrap --variant=minbase --components=main "$suite" "$tmp/root" "$mirror" >"$tmp/debootstrap.log" 2>&1; then
     tail -n 30 "$tmp/debootstrap.log" >&2
     die "debootstrap failed"
+  fi
+  # apt's resolver, not debootstrap's --include: lintian's Perl dependencies (virtual packages,
+  # alternatives) are more than debootstrap resolves.
+  if ! systemd-nspawn --quiet --keep-unit --register=no --directory="$tmp/root" --setenv=DEBIAN_FRONTEND=noninteractive \
+      sh -c "apt-get update -qq && apt-get install -y -qq --no-install-recommends ${packages[*]}" >"$tmp/apt.log" 2>&1; then
+    tail -n 30 "$tmp/apt.log" >&2
+    die "apt-get install in the new root failed"
   fi
   chroot "$tmp/root" apt-get clean
   rm -rf "$tmp/root/var/lib/apt/lists/"* "$tmp/root/var/log/"*.log
@@ -81,9 +95,12 @@ if [ ! -f "$cache" ]; then
   mv "$tmp/root.tar" "$cache"
   rm -rf --one-file-system "$tmp"
   trap - EXIT
-  find "$cache_dir" -maxdepth 1 -name "$suite-build-$arch-*.tar" ! -path "$cache" -delete
   say "build root made in $(($(date +%s) - t0)) s"
 fi
+# Roots of another package list go once unused for a week (not at once: two branches with
+# different lists would otherwise rebuild theirs on every run).
+touch "$cache"
+find "$cache_dir" -maxdepth 1 -name "$suite-build-$arch-*.tar" ! -path "$cache" -mtime +7 -delete
 
 # The build tree survives the run, so a rerun rebuilds only what changed: one per source
 # directory (make trusts timestamps) and per root (another compiler makes everything stale).
@@ -92,8 +109,8 @@ build=$builds/$(basename "$cache" .tar)-$(printf '%s' "$src" | sha256sum | cut -
 mkdir -p "$build"
 touch "$build"
 # About 200 MB each: the three used last are kept (a CI clone at a new path each time makes one).
-for old in $(ls -1dt "$builds"/*/ | sed 's#/$##' | grep -v -- '-kernel$' | tail -n +4); do
-  rm -rf --one-file-system "$old" "$old-kernel"
+for old in $(ls -1dt "$builds"/*/ | sed 's#/$##' | grep -v -- '-kernel$' | grep -v -- '-debs$' | tail -n +4); do
+  rm -rf --one-file-system "$old" "$old-kernel" "$old-debs"
 done
 
 # --- this run's root ---------------------------------------------------------------------------
@@ -138,31 +155,36 @@ echo "== build (scripts/build.sh, CARACARA_WERROR=ON)"
 grep -E '^(GPIODCXX_VERSION|Catch2_DIR|TOMLPP_VERSION|SYSTEMD_VERSION)' "$BUILD/CMakeCache.txt" | sed 's/^/   /'
 echo "== ctest (all but the tests labelled system or kernel)"
 CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel'
+echo "== Debian packages (scripts/package.sh, nocheck: the suite just ran)"
+DEB_BUILD_OPTIONS=nocheck "$SRC/scripts/package.sh" native "$DEBS"
 SCRIPT
 chmod 0755 "$root/usr/local/bin/caracara-build-and-test"
 
-say "building and testing $src in the Debian 13 root (at most ${build_timeout_s} s)"
+debs=$build-debs
+mkdir -p "$debs"
+say "building, testing and packaging $src in the Debian 13 root (at most ${build_timeout_s} s)"
 t1=$(date +%s)
 rc=0
 timeout --kill-after=20 "$build_timeout_s" \
   systemd-nspawn --quiet --keep-unit --register=no --directory="$root" --private-network \
-    --bind-ro="$src" --bind="$build" --setenv=HOME=/root --setenv=SRC="$src" --setenv=BUILD="$build" \
+    --bind-ro="$src" --bind="$build" --bind="$debs" --setenv=HOME=/root --setenv=SRC="$src" \
+    --setenv=BUILD="$build" --setenv=DEBS="$debs" \
     /usr/local/bin/caracara-build-and-test >"$work/build.log" 2>&1 || rc=$?
-grep -E '^== |^   |tests passed|tests failed|Total Test time|\*\*\*|Failed|error:|warning:' "$work/build.log" | head -n 60
+grep -E '^== |^   |^package: |tests passed|tests failed|Total Test time|\*\*\*|Failed|error:|warning:' "$work/build.log" | head -n 60
 build_s=$(($(date +%s) - t1))
-say "build and ctest: $build_s s (exit status $rc)"
+say "build, ctest and packages: $build_s s (exit status $rc)"
 if [ "$rc" -ne 0 ]; then
   echo "---- build and test log (last 150 lines) ----"
   tail -n 150 "$work/build.log"
-  die "the build or ctest failed in the Debian 13 root"
+  die "the build, ctest or the package build failed in the Debian 13 root"
 fi
 ctest_line=$(sed 's/\x1b\[[0-9;]*m//g' "$work/build.log" | grep -E 'tests passed, [0-9]+ tests failed out of' | tail -n 1 || true)
 
 failed=0
-say "system test in a booted Debian 13 container (tests/system/run.sh, CARACARA_SYSTEST_SUITE=trixie)"
+say "system test in a booted Debian 13 container, installed from the Debian 13 packages (run.sh --debs)"
 t2=$(date +%s)
 system_rc=0
-CARACARA_SYSTEST_SUITE=$suite "$here/run.sh" "$build" || system_rc=$?
+CARACARA_SYSTEST_SUITE=$suite "$here/run.sh" --debs "$debs" || system_rc=$?
 system_s=$(($(date +%s) - t2))
 [ "$system_rc" -eq 0 ] || failed=1
 
