@@ -72,7 +72,7 @@ void BusWorker::submit(const BusJob& in, bool replace) {
     job.epoch = epoch_.load();
     if (!running()) {
         // Before the thread starts or after it stopped: on the caller's thread.
-        const BusJobDone d{job, execute(*drivers_[job.index], job)};
+        const BusJobDone d = transfer(job);
         views_[job.index] = published_[job.index] = *drivers_[job.index];
         if (on_done_)
             on_done_(d);
@@ -134,12 +134,10 @@ void BusWorker::run() {
         queue_.pop_front();
         busy_ = true;
         lk.unlock();
-        // A non-zero order from before the last kill is dropped here, at the last moment.
-        const bool skip = job.kind == BusJobKind::Order && job.value != 0 && job.epoch != epoch_.load();
-        const IoError e = skip ? IoError::None : execute(*drivers_[job.index], job); // nothing held
+        const BusJobDone d = transfer(job); // nothing held
         lk.lock();
         published_[job.index] = *drivers_[job.index];
-        done_.push_back({job, e, skip});
+        done_.push_back(d);
         busy_ = false;
         finished_.notify_all();
         // One wake-up of the loop per batch (the queue ran dry), or every kWakeEvery jobs so the
@@ -151,6 +149,19 @@ void BusWorker::run() {
             [[maybe_unused]] const ssize_t n = ::write(efd_, &one, sizeof one);
         }
     }
+}
+
+BusJobDone BusWorker::transfer(const BusJob& job) {
+    // A non-zero order from before the last kill is dropped here, at the last moment.
+    if (job.kind == BusJobKind::Order && job.value != 0 && job.epoch != epoch_.load())
+        return {job, IoError::None, true};
+    BusGate* gate = gate_.load();
+    if (gate && !gate->enter(::gettid()))
+        return {job, IoError::None, true}; // the crash handler has the bus; the process is ending
+    const IoError e = execute(*drivers_[job.index], job);
+    if (gate)
+        gate->leave();
+    return {job, e, false};
 }
 
 int BusWorker::on_done(sd_event_source*, int fd, uint32_t, void* userdata) {

@@ -7,6 +7,7 @@
 // Finished jobs come back through an eventfd that the worker owns as an event source.
 #pragma once
 
+#include "devices/bus_gate.hpp"
 #include "devices/thruster_driver.hpp"
 #include "platform/event_loop.hpp"
 #include "platform/io_error.hpp"
@@ -66,6 +67,9 @@ public:
     // before it writes the kill output, so no such order can follow the kill output onto the
     // wire once the worker has seen it (at most the one whose transfer had already begun).
     void hold_orders() { epoch_.fetch_add(1); }
+    // Every transfer enters `gate` (the emergency stop's), so a crash handler on another thread
+    // can keep this one off the wire while it sends its zeros. Null: no gate.
+    void set_gate(BusGate* gate) { gate_.store(gate); }
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
     bool idle() const { return outstanding_ == 0; }
     // Blocks until idle, handing the finished jobs to `done`: start-up and shutdown only,
@@ -79,12 +83,15 @@ private:
     static int on_done(sd_event_source*, int fd, uint32_t, void* userdata);
     void run();
     void deliver();
+    // The job's transfer, unless a kill overtook it (`skipped`) or the gate is closed.
+    BusJobDone transfer(const BusJob& job);
 
     std::vector<std::unique_ptr<ThrusterDriver>>& drivers_;
     std::vector<ThrusterDriver> views_;     // loop thread
     std::vector<ThrusterDriver> published_; // under mu_: the worker's copy after each job
     std::size_t outstanding_ = 0;           // loop thread
     std::atomic<uint64_t> epoch_{0};
+    std::atomic<BusGate*> gate_{nullptr};
 
     mutable std::mutex mu_;
     std::condition_variable wake_;      // the worker: a job or stop

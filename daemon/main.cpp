@@ -163,6 +163,7 @@ int main(int argc, char** argv) {
         else if (std::string e = estop.arm(std::move(panic_hw.io), cr.config->i2c.device, cr.config->thrusters, cr.config->spi); !e.empty())
             log_warning("emergency stop not armed: %s", e.c_str());
         else {
+            daemon.bus().set_crash_gate(&estop.bus_gate());
             EmergencyStop::install_fatal_handlers(&estop);
             daemon.lines().set_kill_output_watcher([&estop](GpioLine* line) { estop.set_kill_output(line); });
             daemon.recovery().set_node_holders([&estop] { estop.release(); },

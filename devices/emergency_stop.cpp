@@ -66,11 +66,13 @@ std::string EmergencyStop::reopen() {
 }
 
 void EmergencyStop::fire() noexcept {
+    gate_.close();
     if (GpioLine* line = kill_output_.load())
         line->set_in_signal_handler(1);
     const int fd = fd_;
     if (fd < 0)
         return;
+    gate_.wait_clear(kGateWaitMs);
     for (size_t i = 0; i < count_; ++i) {
         Prepared& p = prepared_[i];
         if (p.has_mux) {

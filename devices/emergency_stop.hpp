@@ -7,6 +7,7 @@
 
 #include "platform/device_io.hpp"
 #include "core/config.hpp"
+#include "devices/bus_gate.hpp"
 #include "devices/thruster_driver.hpp"
 #include "platform/gpio_line.hpp"
 #include "platform/spi_dev.hpp"
@@ -43,6 +44,12 @@ public:
     // Opens the node again after the rebind; "" or why not (then it stays released).
     std::string reopen();
     bool armed() const { return fd_ >= 0; }
+    // The daemon's bus worker enters this gate for each transfer; fire() closes it before the
+    // kill output and waits (at most kGateWaitMs) for the transfer on the wire before its zeros.
+    BusGate& bus_gate() noexcept { return gate_; }
+    // Longer than the adapter's timeout (i2c.timeout_ms, 20 by default), so a transfer to a hung
+    // thruster ends first; past it the zeros go anyway.
+    static constexpr int kGateWaitMs = 100;
 
     // Every signal whose default action ends the process and that the daemon does not handle
     // itself (SIGTERM, SIGINT and SIGHUP stop it cleanly through the event loop; SIGPIPE is
@@ -71,6 +78,7 @@ private:
     std::string path_;
     volatile int fd_ = -1; // read by fire() in a signal handler
     std::atomic<GpioLine*> kill_output_{nullptr};
+    BusGate gate_;
     std::array<Prepared, 8> prepared_{};
     size_t count_ = 0;
 };

@@ -195,6 +195,24 @@ class WheelsAreMotorsTest(VehicleTestCase):
         self.assertGreaterEqual(int(self.rig.vget("CommandAgeMs")), 150)
 
 
+# Sends SetThrust with alternating values (never zero) until the daemon is gone.
+STICK_SCRIPT = r"""
+import sys, dbus
+bus = dbus.bus.BusConnection(sys.argv[1])
+vehicle = bus.get_object("org.caracara.Vehicle1", "/org/caracara/Vehicle1", introspect=False)
+n = 0
+try:
+    while True:
+        v = 1500 + 100 * (n % 2)
+        vehicle.SetThrust(dbus.Array([v, -v] * 4, signature="i"), dbus_interface="org.caracara.Vehicle1")
+        if n == 0:
+            print("driving", flush=True)
+        n += 1
+except dbus.DBusException:
+    pass
+"""
+
+
 class WheelsStopAtStartAndExitTest(unittest.TestCase):
 
     def test_start_and_sigterm_send_stop(self):
@@ -224,6 +242,36 @@ class WheelsStopAtStartAndExitTest(unittest.TestCase):
         self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
         self.assertEqual(front_wheels(rig), (0.0, 0.0), "a crash left the wheels turning")
         rig.start_daemon()  # as systemd would; stop_checked wants a clean exit at the end
+
+    def test_a_crash_while_the_bus_is_busy_leaves_no_order_after_the_zeros(self):
+        """A fatal signal stops one thread; the bus worker's goes on. Thruster 7 answers slowly
+        (15 ms, under the adapter's timeout), so the worker is always on the wire with orders
+        queued behind it: none of them may land between or after the crash handler's zeros
+        (the emergency stop closes the worker's gate and waits for its transfer)."""
+        rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
+        self.addCleanup(rig.stop_checked)
+        rig.start()
+        rig.arm()
+        rig.sim_thruster_call(7, "SetHang", 15, signature="u")
+        # A pilot's stick: new values as fast as the daemon takes them, until it is gone.
+        pilot = subprocess.Popen([harness.PYTHON, "-c", STICK_SCRIPT, rig.address], stdout=subprocess.PIPE, text=True)
+        self.assertEqual(pilot.stdout.readline().strip(), "driving")
+        rig.wait_orders_refreshed(count=3)
+        since = rig.wire_next()
+        proc = rig.procs["caracarad"]
+        proc.send_signal(signal.SIGSEGV)
+        proc.wait(30)
+        pilot.wait(30)
+        rig.sim_thruster_call(7, "SetHang", 0, signature="u")
+        self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+        orders = [e for e in rig.wire_log(since)[1] if e.bus == "i2c" and not e.read and len(e.data) == 3]
+        for mt in DEFAULT_MT:
+            mine = [e for e in orders if e.addr == mt >> 1]
+            first_zero = next((e.index for e in mine if e.data[0] == ZERO), None)
+            self.assertIsNotNone(first_zero, "no zero order to 0x%02x after the crash" % mt)
+            late = [e.index for e in mine if e.index > first_zero and e.data[0] != ZERO]
+            self.assertEqual(late, [], "orders to 0x%02x after its zero (#%d)" % (mt, first_zero))
+        rig.start_daemon()
 
 
 RECOVERY_GPIO = dict(harness.SIM_GPIO, scl={"chip": "gpiochip0", "line": "GPIO3"},
