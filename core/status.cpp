@@ -21,6 +21,7 @@ std::string_view status_name(Status s) {
     case Status::Hardware: return "Hardware";
     case Status::UnknownProfile: return "UnknownProfile";
     case Status::BusLost: return "BusLost";
+    case Status::ThrusterUnreachable: return "ThrusterUnreachable";
     }
     return "Hardware";
 }

@@ -26,6 +26,7 @@ enum class Status {
     Hardware,
     UnknownProfile,
     BusLost,
+    ThrusterUnreachable,
 };
 std::string_view status_name(Status s); // "OutOfRange", ...
 

@@ -34,7 +34,9 @@ ThrusterBus::ThrusterBus(DeviceIo& io, const DaemonConfig& config, VehicleEvents
       ordered_(config.thrusters.size(), 0),
       faults_(config.thrusters.size()),
       schedule_(config.thrusters.size()),
-      lockup_(static_cast<uint32_t>(kMotorCount)) {}
+      lockup_(static_cast<uint32_t>(kMotorCount)),
+      failed_in_row_(config.thrusters.size(), 0),
+      unreachable_(config.thrusters.size(), false) {}
 
 std::string ThrusterBus::start(sd_event* event, int64_t priority, std::function<void(const BusJob&)> done) {
     on_done_ = std::move(done);
@@ -78,8 +80,10 @@ void ThrusterBus::when_idle(std::function<void()> fn) {
 }
 
 void ThrusterBus::done(const BusJobDone& d) {
-    if (!d.skipped)
+    if (!d.skipped) {
         note(d.error);
+        track_reach(d.job.index, d.error);
+    }
     if (d.job.kind == BusJobKind::Status && d.error == IoError::None)
         report_faults(d.job.index);
     if (worker_.idle() && !when_idle_.empty()) {
@@ -111,6 +115,41 @@ void ThrusterBus::set_recovering(bool r) {
         worker_.drop_queued(); // the adapter is about to close; what is on the wire finishes
     } else
         lockup_.reset();
+}
+
+void ThrusterBus::track_reach(std::size_t i, IoError e) {
+    if (e == IoError::None || e == IoError::BadReply) {
+        failed_in_row_[i] = 0;
+        if (unreachable_[i]) {
+            unreachable_[i] = false;
+            log_notice("thruster %zu answers again", i);
+        }
+        return;
+    }
+    // A closed adapter (recovery) or a lost bus is the bus's failure, not this thruster's.
+    if (recovering_ || tm_.state != BusState::Ok || unreachable_[i] || ++failed_in_row_[i] < kUnreachableAfter)
+        return;
+    unreachable_[i] = true;
+    if (gate_)
+        gate_->device_lost(unreachable_reason(i));
+}
+
+std::string ThrusterBus::unreachable_reason(std::size_t i) const {
+    return "thruster " + std::to_string(i) + " unreachable (" + std::to_string(kUnreachableAfter) +
+           " transfers in a row failed, last " + std::string(io_error_name(thruster(i).last_error())) + ")";
+}
+
+void ThrusterBus::set_gate(CommandGate* gate) {
+    gate_ = gate;
+    if (const auto i = first_unreachable(); i && gate_)
+        gate_->device_lost(unreachable_reason(*i));
+}
+
+std::optional<std::size_t> ThrusterBus::first_unreachable() const {
+    for (std::size_t i = 0; i < unreachable_.size(); ++i)
+        if (unreachable_[i])
+            return i;
+    return std::nullopt;
 }
 
 bool ThrusterBus::any_online() const {

@@ -8,6 +8,7 @@
 #include "core/lockup_detector.hpp"
 #include "core/order_schedule.hpp"
 #include "daemon/bus_worker.hpp"
+#include "daemon/command_gate.hpp"
 #include "daemon/vehicle_events.hpp"
 #include "devices/mux_tracker.hpp"
 #include "devices/thruster_driver.hpp"
@@ -18,6 +19,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -68,6 +70,15 @@ public:
     void zero_all(ZeroOrder where = ZeroOrder::First);
     // Before a kill's kill output: no non-zero order handed over earlier goes out after it.
     void hold_orders() { worker_.hold_orders(); }
+    // A thruster that fails this many transfers in a row (NACK, timeout, bus error; a garbled
+    // reply still reached it) is unreachable. A SeaBotix controller keeps its last order for as
+    // long as it has power, so the vehicle is killed (source "device") and stays killed until
+    // every thruster answers again. Three: more than a lockup of the whole bus takes to be told
+    // from one thruster (LockupDetector), so a bus recovery comes first.
+    static constexpr uint32_t kUnreachableAfter = 3;
+    // Told (device_lost) when a thruster becomes unreachable; at once if one already is.
+    void set_gate(CommandGate* gate);
+    std::optional<std::size_t> first_unreachable() const;
     // The emergency stop's gate: see BusWorker::set_gate.
     void set_crash_gate(BusGate* gate) { worker_.set_gate(gate); }
     // Blocks until the worker is idle: at start-up and shutdown, where the zeros must be on the
@@ -99,6 +110,8 @@ private:
     void done(const BusJobDone& d);
     void note(IoError e);
     void report_faults(std::size_t i);
+    void track_reach(std::size_t i, IoError e);
+    std::string unreachable_reason(std::size_t i) const;
 
     VehicleEvents& events_;
     std::string device_;
@@ -113,6 +126,9 @@ private:
     BusTelemetry tm_;
     bool recovering_ = false;
     Listener* listener_ = nullptr;
+    CommandGate* gate_ = nullptr;
+    std::vector<uint32_t> failed_in_row_;
+    std::vector<bool> unreachable_;
     std::function<void(const BusJob&)> on_done_;
     std::vector<std::function<void()>> when_idle_;
 };

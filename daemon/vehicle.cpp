@@ -242,6 +242,10 @@ Result Vehicle::kill(KillSource source, std::string_view reason) {
 Result Vehicle::clear_kill() {
     if (bus_.telemetry().state == BusState::Lost && safety_.state() == SafetyState::Killed)
         return {Status::BusLost, "the I2C bus to the thrusters is not back yet; the kill stays"};
+    if (const auto i = bus_.first_unreachable(); i && safety_.state() == SafetyState::Killed)
+        return {Status::ThrusterUnreachable,
+                "thruster " + std::to_string(*i) + " does not answer (last " +
+                    std::string(io_error_name(bus_.thruster(*i).last_error())) + "); the kill stays"};
     SafetyAction a = safety_.clear_kill(monotonic_ns());
     if (!a.ok())
         return {status_of(a.error), a.message};

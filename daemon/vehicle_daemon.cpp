@@ -36,6 +36,7 @@ std::string VehicleDaemon::start() {
     teensy_.stop_motion(); // the wheels too may have been left running by an earlier instance
     if (std::string e = vehicle_.start(event_); !e.empty())
         return e;
+    bus_.set_gate(&vehicle_); // a thruster that stopped answering kills the vehicle
     if (std::string e = loop_.start(); !e.empty())
         return e;
     started_ = true;
@@ -46,6 +47,7 @@ void VehicleDaemon::shutdown() {
     if (!started_)
         return;
     started_ = false;
+    bus_.set_gate(nullptr);
     loop_.stop();
     vehicle_.stop();
     recovery_.stop();

@@ -41,8 +41,11 @@ class HungThrusterTest(unittest.TestCase):
     def drive_hung(self):
         rig = self.rig
         rig.sim_thruster_call(HUNG, "SetHang", 0, signature="u")
-        if rig.state() != "ready":
-            rig.arm()
+        # A transfer hung before that still times out; once one gets through, the thruster is
+        # reachable, and an earlier test may have left the vehicle killed for it.
+        poll(lambda: rig.vget("Online", path="/org/caracara/Vehicle1/thruster/%d" % HUNG,
+                              iface="org.caracara.Vehicle1.Thruster"), 10)
+        rig.reset()
         rig.thrust([1500] * MOTORS)
         rig.wait_sim_speeds([speed_byte(1500)] * MOTORS)
         since = rig.wire_next()
@@ -69,7 +72,7 @@ class HungThrusterTest(unittest.TestCase):
                      if e.bus == "i2c" and not e.read and len(e.data) == 3 and e.data[0] == ZERO]
             self.assertTrue(zeros and edge.index < zeros[0], "the kill output came after a zero order")
             self.rig.sim_thruster_call(HUNG, "SetHang", 0, signature="u")
-            self.rig.vcall("ClearKill")
+            poll(lambda: error_name(self.rig.vcall, "ClearKill") is None, 10)
         print("\nKill() -> kill output with a thruster hanging 1 s: p50 %.2f ms, max %.2f ms" %
               (statistics.median(lat), max(lat)))
         # On the event loop's thread the kill would wait for the transfer on the wire (up to 1 s).
@@ -112,7 +115,9 @@ class HungThrusterTest(unittest.TestCase):
               (len(pings), statistics.median(pings), pct(pings, 0.99), max(pings), len(gets), pct(gets, 0.99),
                max(gets)))
         self.assertLess(max(pings + gets), 500)
-        self.assertEqual(self.rig.state(), "ready")
+        # Three timeouts in a row (3 s here): the thruster is unreachable, and keeps its last order.
+        poll(lambda: self.rig.state() == "killed", 5, message="the hung thruster did not kill")
+        self.assertEqual(self.rig.vget("KillSource"), "device")
 
 
 class HungThrusterDefaultTimeoutTest(unittest.TestCase):
@@ -141,7 +146,55 @@ class HungThrusterDefaultTimeoutTest(unittest.TestCase):
         self.assertGreaterEqual(len(t0), 40)  # a 50 Hz loop, less what the hung transfers take
         self.assertFalse(rig.vget("Online", path="/org/caracara/Vehicle1/thruster/%d" % HUNG,
                                   iface="org.caracara.Vehicle1.Thruster"))
+        self.assertEqual(rig.state(), "killed")  # unreachable; the others' refreshes are zeros
         rig.sim_thruster_call(HUNG, "SetHang", 0, signature="u")
+
+
+class UnreachableThrusterTest(unittest.TestCase):
+    """A thruster the daemon cannot reach keeps its last order (a SeaBotix controller holds it
+    for as long as it has power): three failed transfers in a row kill the vehicle, source
+    "device", kill output first; ClearKill gets ThrusterUnreachable until it answers again, and
+    its answering again does not arm the vehicle."""
+
+    def check_unreachable(self, rig, inject, release, what):
+        rig.arm()
+        rig.thrust([1500] * MOTORS)
+        rig.wait_sim_speeds([speed_byte(1500)] * MOTORS)
+        since = rig.wire_next()
+        mt = rig.sim_thruster(4, "Address")
+        inject()
+        try:
+            poll(lambda: rig.state() == "killed", 10, message="%s: an unreachable thruster did not kill" % what)
+            self.assertEqual(rig.vget("KillSource"), "device")
+            self.assertEqual(error_name(rig.vcall, "ClearKill"), ERR + "ThrusterUnreachable")
+            self.assertEqual(error_name(rig.thrust, [1000] * MOTORS), ERR + "Killed")
+            log = rig.wire_log(since)[1]
+            failed = [e for e in log if e.bus == "i2c" and e.addr == mt >> 1 and e.result != "ack"]
+            edge = next(e for e in log if e.bus == "gpio" and e.addr == KILL_OUT and e.data == b"\x01")
+            self.assertGreaterEqual(len(failed), 3)
+            self.assertLess(failed[2].index, edge.index, "%s: killed before the third failure" % what)
+            others = [i for i in range(MOTORS) if i != 4]
+            poll(lambda: [rig.sim_speeds()[i] for i in others] == [ZERO] * len(others), 5,
+                 message="%s: the reachable thrusters were not zeroed" % what)
+            print("\n%s: first failed transfer to kill output %.1f ms (%d failed transfers)" %
+                  (what, (edge.time_ns - failed[0].time_ns) / 1e6, len(failed)))
+        finally:
+            release()
+        poll(lambda: rig.vget("Online", path="/org/caracara/Vehicle1/thruster/4",
+                              iface="org.caracara.Vehicle1.Thruster"), 10, message="%s: never back" % what)
+        self.assertEqual(rig.state(), "killed")
+        poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10)
+        rig.wait_state("ready")
+        self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)  # nothing sent before the kill comes back
+
+    def test_nacking_and_hung_thruster(self):
+        rig = Rig(control={"arming_delay_ms": 300, "command_timeout_ms": 60000})
+        self.addCleanup(rig.stop_checked)
+        rig.start()
+        self.check_unreachable(rig, lambda: rig.sim_thruster_call(4, "SetNack", True, signature="b"),
+                               lambda: rig.sim_thruster_call(4, "SetNack", False, signature="b"), "NACKing")
+        self.check_unreachable(rig, lambda: rig.sim_thruster_call(4, "SetHang", 1000, signature="u"),
+                               lambda: rig.sim_thruster_call(4, "SetHang", 0, signature="u"), "hung")
 
 
 class VanishTest(unittest.TestCase):

@@ -241,19 +241,24 @@ class ThrusterFaultTest(VehicleTestCase):
         poll(lambda: list(self.rig.vget("Faults", thruster_path(2), THRUSTER_IFACE)) == [], 15)
 
         # A NACKing controller: counted, LastError "nack", Online false; back when it answers.
+        # Not a bus failure, but a thruster the daemon cannot reach keeps its last order: the
+        # vehicle is killed (source "device") and ClearKill is refused until it answers.
         self.rig.sim_thruster_call(5, "SetNack", True, signature="b")
         try:
             poll(lambda: int(self.rig.vget("Nacks", thruster_path(5), THRUSTER_IFACE)) > 0, 10)
             self.assertEqual(self.rig.vget("LastError", thruster_path(5), THRUSTER_IFACE), "nack")
             self.assertFalse(self.rig.vget("Online", thruster_path(5), THRUSTER_IFACE))
             self.assertGreater(int(self.rig.vget("OrderFailures", thruster_path(5), THRUSTER_IFACE)), 0)
+            poll(lambda: self.rig.state() == "killed", 10, message="an unreachable thruster did not kill")
+            self.assertEqual(self.rig.vget("KillSource"), "device")
+            self.assertEqual(error_name(self.rig.vcall, "ClearKill"), ERR + "ThrusterUnreachable")
         finally:
             self.rig.sim_thruster_call(5, "SetNack", False, signature="b")
         poll(lambda: bool(self.rig.vget("Online", thruster_path(5), THRUSTER_IFACE)), 10,
              message="thruster 5 did not come back online")
-        # One thruster NACKing is not a bus failure.
         self.assertEqual(self.rig.vget("State", BUS_PATH, BUS_IFACE), "ok")
-        self.assertEqual(self.rig.state(), "ready")
+        self.assertEqual(self.rig.state(), "killed")  # answering again does not arm it
+        self.rig.reset()
 
         # Corrupted status replies are counted and never believed.
         self.rig.sim_thruster_call(6, "CorruptReplies", dbus.UInt32(2), "checksum", signature="us")

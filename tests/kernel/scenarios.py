@@ -253,6 +253,9 @@ def sc_thruster_faults(rig):
         check(rig.vget("LastError", harness.thruster_path(5), harness.THRUSTER_IFACE) == "nack", "LastError")
         wait_wire(rig, since, lambda e: e.bus == "i2c" and e.result == "nack" and e.addr << 1 == DEFAULT_MT[5], 10,
                   "no NACK of thruster 5 in the wire log")
+        # Unreachable (three failed transfers in a row): it would keep its last order, so killed.
+        poll(lambda: rig.state() == "killed", 10, message="an unreachable thruster did not kill")
+        check(rig.vget("KillSource") == "device", "kill source %s" % rig.vget("KillSource"))
     finally:
         rig.sim_thruster_call(5, "SetNack", False, signature="b")
     poll(lambda: bool(rig.vget("Online", harness.thruster_path(5), harness.THRUSTER_IFACE)), 15,
