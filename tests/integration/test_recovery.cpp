@@ -16,6 +16,9 @@ using namespace caracara::test;
 namespace {
 
 constexpr uint8_t kMt[8] = {0x52, 0x56, 0x58, 0x5A, 0x5C, 0x5E, 0x60, 0x62};
+// Lines of the simulator's gpiochip0 (sim/gpio_model.hpp: KILL_OUT, POWER_OFF).
+constexpr uint16_t kKillOutLine = 27;
+constexpr uint16_t kPowerOffLine = 22;
 
 // The simulator's GPIO chip: I2C1 on GPIO2/3, the kill switch, kill and power-off outputs.
 const std::string kGpioConfig = R"(
@@ -219,7 +222,6 @@ TEST_CASE("the kill switch kills at its edge, not at the next tick, and blocks a
         CHECK(zero > edge);
         CHECK(log[zero].time_ns >= log[edge].time_ns);
     }
-    constexpr uint16_t kKillOutLine = 27; // KILL_OUT on the simulator's gpiochip0 (sim/gpio_model.hpp)
     bool kill_out = false;
     for (size_t i = edge; i < log.size(); ++i)
         if (log[i].bus == "gpio" && log[i].addr == kKillOutLine && log[i].data == std::vector<uint8_t>{1})
@@ -261,7 +263,9 @@ TEST_CASE("a kill switch already set at start: the daemon comes up killed") {
 TEST_CASE("a confirmed power-off asserts the power-off line after zeroing the thrusters") {
     SimFixture f;
     DaemonFixture d(f, config("arming_delay_ms = 200\ncommand_timeout_ms = 60000", "enabled = false"));
-    REQUIRE(d.set_thrust({1000, 1000, 0, 0, 0, 0, 0, 0}) == "");
+    // All eight running: a thruster at zero is refreshed with zero orders, which are not the
+    // power-off's.
+    REQUIRE(d.set_thrust(std::vector<int32_t>(8, 1000)) == "");
     CHECK(d.call("PowerOff", "s", "yes") == "org.caracara.Vehicle1.Error.ConfirmationRequired");
     CHECK_FALSE(f.root_bool("PowerOffOutput"));
     REQUIRE(f.call(kSim, kSimIface, "ClearWireLog", "") == "");
@@ -275,8 +279,8 @@ TEST_CASE("a confirmed power-off asserts the power-off line after zeroing the th
     for (const auto& e : log) {
         if (e.bus == "i2c" && !e.read && e.result == "ack" && e.data.size() == 3 && e.data[0] == speed_byte(0))
             last_zero = e.index;
-        if (e.bus == "gpio" && power_off_edge == 0 && last_zero != 0)
-            power_off_edge = e.index; // the first line edge after the zeros (the kill output's is before)
+        if (e.bus == "gpio" && e.addr == kPowerOffLine && power_off_edge == 0)
+            power_off_edge = e.index;
     }
     INFO("last zero order #" << last_zero << ", then line edge #" << power_off_edge);
     CHECK(last_zero > 0);
