@@ -27,7 +27,7 @@ int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
     return 0;
 }
 
-// Kill, PowerOff and a killing packet reply once their zero orders are done on the wire (the
+// Kill, PowerOff and a packet that kills or powers off reply once their zero orders are done on the wire (the
 // bus worker's thread): a caller that sees the reply sees the thrusters told zero. The loop
 // does not wait for them; the kill output was asserted before any of them.
 int reply_after_zeros(sd_bus_message* m, void* userdata, const Result& result) {
@@ -58,9 +58,11 @@ int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error*) {
     std::vector<int32_t> v;
     if (int r = read_ints(m, v); r < 0)
         return r;
-    const bool was_killed = ctl(userdata).safety().state() == SafetyState::Killed;
+    const SafetyState before = ctl(userdata).safety().state();
     const Result r = ctl(userdata).apply_packet(v, sender(m));
-    if (!was_killed && ctl(userdata).safety().state() == SafetyState::Killed)
+    const SafetyState after = ctl(userdata).safety().state();
+    // A packet that killed or powered off replies as Kill and PowerOff do.
+    if (after != before && (after == SafetyState::Killed || after == SafetyState::PoweredOff))
         return reply_after_zeros(m, userdata, r);
     return reply(m, r);
 }
