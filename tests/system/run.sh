@@ -244,7 +244,8 @@ say "booting the container (systemd-nspawn --boot; at most ${timeout_s} s)"
 t1=$(date +%s)
 timeout --signal=TERM --kill-after=20 "$timeout_s" \
   systemd-nspawn --quiet --boot --keep-unit --register=no --machine="$machine" \
-    --directory="$root" --network-namespace-path="/run/netns/$vehicle_ns" --link-journal=no --resolv-conf=off \
+    --directory="$root" --network-namespace-path="/run/netns/$vehicle_ns" --capability=CAP_NET_ADMIN \
+    --link-journal=no --resolv-conf=off \
     --console=read-only --bind="$out:/systest-out" \
     >"$work/console.log" 2>&1 &
 nspawn_pid=$!
