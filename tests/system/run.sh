@@ -220,8 +220,9 @@ mkdir -p "$top/bin" "$out/topside"
 chmod 0755 "$out/topside"
 if [ -n "$debs" ]; then
   dpkg-deb -x "$(find "$debs" -maxdepth 1 -name "caracarad_*_$arch.deb" | sort -V | tail -n 1)" "$top/pkg"
-  loader=$(find "$root/lib64/" "$root/usr/lib64/" -maxdepth 1 -name 'ld-linux*.so.*' 2>/dev/null | head -n 1)
+  # The loader itself, not a link to it (Debian 12's /lib64 link is absolute: this machine's).
   libs=$root/usr/lib/$(uname -m)-linux-gnu
+  loader=$(find "$libs" -maxdepth 1 -type f -name 'ld-linux*.so.*' | head -n 1)
   printf '#!/bin/sh
 exec %s --library-path %s %s "$@"
 ' "$loader" "$libs" "$top/pkg/usr/bin/caracaractl" \
