@@ -137,9 +137,9 @@ Props to_props(const Value& dict) {
 sd_bus* Client::bus() {
     if (!bus_) {
         const bool remote = choice_.kind == caracara::dbus::BusChoice::Kind::Remote;
-        int r = remote ? ssh_stderr_.capture() : 0;
-        if (r >= 0)
-            r = caracara::dbus::open_bus(choice_, "caracaractl", bus_);
+        if (remote)
+            ssh_stderr_.capture(); // if it cannot, ssh writes to our stderr and failures count as 3
+        const int r = caracara::dbus::open_bus(choice_, "caracaractl", bus_);
         if (remote)
             ssh_stderr_.restore();
         if (r == -EINVAL && remote)
