@@ -22,7 +22,8 @@
 # 4. The host prints the results and exits non-zero on any failure, a missing result or a
 #    timeout. The container, its processes and the temporary root are always removed.
 #
-# Needs root, debootstrap and systemd-container (installed with apt-get when missing). The
+# Needs root, debootstrap, systemd-container, openssh-client and iproute2 (installed with apt-get
+# when missing), and /usr/bin/python3 with python3-dbus for the example mission (scripts/deps.sh). The
 # Debian mirror is the one this machine's apt uses (CARACARA_SYSTEST_MIRROR overrides it).
 # Exit status 77 (skipped) when not run as root.
 set -euo pipefail
@@ -70,6 +71,8 @@ done
 need=()
 command -v debootstrap >/dev/null || need+=(debootstrap)
 command -v systemd-nspawn >/dev/null || need+=(systemd-container)
+command -v ssh-keygen >/dev/null || need+=(openssh-client)  # the topside (topside.sh)
+command -v ip >/dev/null || need+=(iproute2)                 # the tether
 if ((${#need[@]})); then
   say "installing ${need[*]}"
   apt-get update -qq
