@@ -101,10 +101,10 @@ SshStderr::~SshStderr() {
 }
 
 bool SshStderr::refused(const std::string& said) {
-    // OpenSSH's own messages (ssh, sshd's banner for a refused account, nologin).
+    // What the topside sees when the login is refused: ssh's own messages, nologin's, PAM's.
     for (const char* sign : {"Permission denied", "Host key verification failed", "REMOTE HOST IDENTIFICATION HAS CHANGED",
-                             "This account is currently not available", "Too many authentication failures",
-                             "no matching host key type", "Account expired", "not allowed because"})
+                             "Too many authentication failures", "no matching host key type",
+                             "This account is currently not available", "account has expired"})
         if (said.find(sign) != std::string::npos)
             return true;
     return false;
