@@ -48,4 +48,11 @@ topside_checks() {
   # The topside leaves the vehicle killed (its last step is the mission's Kill): arm it again.
   if [ "$(state)" = killed ]; then busctl call $V $VP $V ClearKill; fi
   check "after the topside checks the vehicle is ready again" wait_until 10 state_is ready
+  # Leave the file system as found (check-debs.sh compares it before the install and after the purge).
+  pkill -u skipper; pkill -u visitor
+  userdel --remove skipper 2>/dev/null || userdel --force --remove skipper
+  userdel --remove visitor 2>/dev/null || userdel --force --remove visitor
+  rm -f /etc/ssh/sshd_config.d/caracara.conf /root/.ssh/authorized_keys
+  rmdir /root/.ssh 2>/dev/null
+  systemctl restart ssh
 }
