@@ -170,8 +170,8 @@ arming_delay_ms = 0
         self.stop(self.daemon, timeout=60)
         self.daemon = None
 
-    def client(self, *args, timeout=None):
-        r = subprocess.run([*self.prefix(), self.exe["client"], *map(str, args), "--bus", self.bus],
+    def client(self, *args, timeout=None, bus=None):
+        r = subprocess.run([*self.prefix(), self.exe["client"], *map(str, args), "--bus", bus or self.bus],
                            capture_output=True, text=True,
                            timeout=timeout)
         if r.returncode != 0:
@@ -251,6 +251,22 @@ def phase_dbus(b, p, res):
                                     "--settle-us", 5000)
     b.stop_daemon()
     b.stop_sim()
+
+
+def phase_ssh(b, p, res):
+    log("6. SetThrust round trip over an SSH bridge on loopback vs Peer.Ping over the same bridge")
+    from ssh_bridge import SshBridge
+    bridge = SshBridge(b, log)
+    try:
+        b.start_sim(realistic=False)
+        b.start_daemon(b.daemon_config(50))
+        res["ssh_connect_ms"] = bridge.connect_ms()
+        res["rtt_ssh"] = b.client("rtt", "--calls", max(1, p["rtt_calls"] // 4), "--warmup", p["rtt_warmup"],
+                                  bus=bridge.address)
+        b.stop_daemon()
+        b.stop_sim()
+    finally:
+        bridge.stop()
 
 
 def pstats(v):
@@ -647,6 +663,20 @@ def rows_from(res, p):
                 rs["steady_kib"] < 8192, "KiB")
             row(f"5. RSS growth from {rs['warmup_seconds']:.0f} s to the end", rs["growth_kib"], 0, None,
                 "flat (<= 64 KiB)", rs["growth_kib"] <= 64, "KiB")
+    rs = res.get("rtt_ssh")
+    if rs and rs["setthrust_us"]["n"]:
+        st, pg = rs["setthrust_us"], rs["ping_us"]
+        row("6. SSH bridge: SetThrust round trip p50 (vs Peer.Ping, same bridge)", st["p50"], pg["p50"],
+            st["p50"] / pg["p50"], "info", None, "us")
+        row("6. SSH bridge: SetThrust round trip p99 (vs Peer.Ping, same bridge)", st["p99"], pg["p99"],
+            st["p99"] / pg["p99"], "info", None, "us")
+        if "rtt" in res:
+            lp = res["rtt"]["ping_us"]
+            row("   diagnostic: Peer.Ping p50, SSH bridge vs local", pg["p50"], lp["p50"], pg["p50"] / lp["p50"],
+                "info", None, "us")
+        if "ssh_connect_ms" in res:
+            row("   diagnostic: a whole busctl -H call (login, bridge, Hello, Ping), median", res["ssh_connect_ms"],
+                None, None, "info", None, "ms")
     return rows
 
 
@@ -698,8 +728,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(HERE, "results.json"), help="JSON results (default bench/results.json)")
     ap.add_argument("--quick", action="store_true", help="shorten every phase (smoke run)")
     ap.add_argument("--rss-seconds", type=float, default=None, help="length of the RSS run (default 600, quick 20)")
-    ap.add_argument("--only", default="dbus,wire,faults,loop,cost",
-                    help="comma-separated phases: dbus,wire,faults,loop,cost")
+    ap.add_argument("--only", default="dbus,wire,faults,loop,cost,ssh",
+                    help="comma-separated phases: dbus,wire,faults,loop,cost,ssh")
     ap.add_argument("--keep", action="store_true", help="keep the temporary directory (logs, callgrind files)")
     ap.add_argument("--raw", action="store_true", help="keep every latency sample in the JSON (large)")
     ap.add_argument("--rt", action="store_true",
@@ -730,7 +760,8 @@ def main():
 
     res = {"quick": a.quick, "rt": a.rt, "params": p, "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
            "host": {"nproc": os.cpu_count(), "uname": " ".join(os.uname())}}
-    phases = {"dbus": phase_dbus, "wire": phase_wire, "faults": phase_faults, "loop": phase_loop, "cost": phase_cost}
+    phases = {"dbus": phase_dbus, "wire": phase_wire, "faults": phase_faults, "loop": phase_loop, "cost": phase_cost,
+              "ssh": phase_ssh}
     try:
         b.start_bus()
         for name in a.only.split(","):

@@ -20,10 +20,12 @@ using MessagePtr = std::unique_ptr<sd_bus_message, MessageUnref>;
 using caracara::EventPtr;
 using caracara::SourcePtr;
 
-// Which bus to connect to: the system bus (default), the user's session bus, or an explicit
-// address such as "unix:path=/tmp/bus" (tests run a private dbus-daemon).
+// Which bus to connect to: the system bus (default), the user's session bus, an explicit
+// address such as "unix:path=/tmp/bus" (tests run a private dbus-daemon), or the system bus of
+// another machine over SSH ([USER@]HOST[:PORT] in `address`; sd_bus_open_system_remote runs
+// systemd-stdio-bridge there, as systemctl -H and busctl -H do).
 struct BusChoice {
-    enum class Kind { System, User, Address } kind = Kind::System;
+    enum class Kind { System, User, Address, Remote } kind = Kind::System;
     std::string address;
     std::string describe() const;
 };

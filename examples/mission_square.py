@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Example mission for the Caracara vehicle: drive a square with SetMotion.
 
-    mission_square.py [--system | --user | --bus-address ADDR] [--leg-seconds S] ...
+    mission_square.py [--system | --user | --bus-address ADDR | --host [USER@]HOST[:PORT]] [--leg-seconds S] ...
 
 Waits until caracarad (org.caracara.Vehicle1) is ready (every start of the daemon comes up
 killed, kill source "start": --arm clears that kill, and only that one), then four times: drive forward for
@@ -18,11 +18,24 @@ Try it against the simulator:
     caracarad --hardware=sim:/tmp/sim.sock --user &
     ./mission_square.py --user --arm
 
+From the topside, over SSH (the vehicle's sshd, a key, and a user in the caracara group:
+docs/topside.md):
+    ./mission_square.py --host pilot@vehicle --arm
+
+--host connects libdbus to the address "unixexec:path=ssh,argv1=-xT,...,argv4=systemd-stdio-bridge":
+libdbus runs ssh itself, and ssh runs systemd-stdio-bridge on the vehicle, which connects to the
+vehicle's system bus as the SSH user. That is the address systemctl -H, busctl -H and
+caracaractl -H use (sd_bus_open_system_remote), so the bus policy judges the SSH user, and when
+the link drops, the bridge leaves the bus and caracarad zeroes the thrusters. (A Unix socket
+forwarded with ssh -L does not work for python3-dbus: the bus authenticates the topside's uid,
+sent by libdbus, against the vehicle user sshd runs as, and refuses them when they differ.)
+
 Needs python3-dbus (Debian: apt install python3-dbus).
 """
 
 import argparse
 import math
+import re
 import signal
 import sys
 import time
@@ -189,7 +202,28 @@ def on_sigterm(signum, frame):
     raise KeyboardInterrupt
 
 
+def escape_address_value(text):
+    """A value of a D-Bus address: bytes outside [-0-9A-Za-z_/.*] become %XX (libdbus insists)."""
+    return "".join(chr(b) if re.fullmatch(rb"[-0-9A-Za-z_/.*]", bytes([b])) else "%%%02x" % b
+                   for b in text.encode())
+
+
+def remote_address(host):
+    """The address of a vehicle's system bus over SSH, as sd_bus_open_system_remote() builds it:
+    [USER@]HOST[:PORT] (an IPv6 HOST in brackets)."""
+    m = re.fullmatch(r"(?:([^@\[\]/:]+)@)?(\[[0-9A-Fa-f:.]+\]|[^@\[\]/:]+)(?::([0-9]+))?", host)
+    if not m:
+        raise ValueError("--host needs [USER@]HOST[:PORT], not %r" % host)
+    user, name, port = m.groups()
+    target = (user + "@" if user else "") + name.strip("[]")
+    argv = ["-xT"] + (["-p", port] if port else []) + ["--", target, "systemd-stdio-bridge"]
+    return "unixexec:path=ssh," + ",".join("argv%d=%s" % (i, escape_address_value(a))
+                                              for i, a in enumerate(argv, 1))
+
+
 def connect(args):
+    if args.host:
+        return dbus.bus.BusConnection(remote_address(args.host))
     if args.bus_address:
         return dbus.bus.BusConnection(args.bus_address)
     if args.user:
@@ -203,6 +237,8 @@ def main():
     where.add_argument("--system", action="store_true", help="use the system bus (default)")
     where.add_argument("--user", action="store_true", help="use the session bus")
     where.add_argument("--bus-address", metavar="ADDR", help="use the bus at ADDR, e.g. unix:path=/tmp/bus")
+    where.add_argument("-H", "--host", metavar="[USER@]HOST[:PORT]",
+                       help="use the system bus of HOST over SSH (systemd-stdio-bridge there, as caracaractl -H)")
     p.add_argument("--leg-seconds", type=float, default=3.0, help="forward time per side (default 3)")
     p.add_argument("--speed", type=float, default=0.4, help="forward demand, 0..1 (default 0.4)")
     p.add_argument("--yaw-demand", type=float, default=0.5, help="largest yaw demand, 0..1 (default 0.5)")
@@ -216,6 +252,11 @@ def main():
     args = p.parse_args()
     if not (0 < args.speed <= 1 and 0 < args.yaw_demand <= 1 and args.leg_seconds >= 0):
         p.error("--speed and --yaw-demand must be in (0, 1], --leg-seconds >= 0")
+    if args.host:
+        try:
+            remote_address(args.host)
+        except ValueError as e:
+            p.error(str(e))
 
     # SIGTERM ends the mission like Ctrl-C: stop and kill on the way out.
     signal.signal(signal.SIGTERM, on_sigterm)

@@ -266,6 +266,8 @@ void print_help() {
                  "  --system                         Connect to the system bus (default)\n"
                  "  --user                           Connect to the user's session bus\n"
                  "  --bus-address ADDR               Connect to the bus at ADDR (e.g. unix:path=/tmp/bus)\n"
+                 "  -H --host=[USER@]HOST[:PORT]     Connect to the system bus of HOST over SSH (ssh runs\n"
+                 "                                   systemd-stdio-bridge there, as for systemctl -H)\n"
                  "  --yes-power-off                  Confirm power-off without asking (also after it)\n"
                  "  -h --help                        Show this help\n"
                  "\nCommand options (after the command, before or after its values):\n"
@@ -291,8 +293,11 @@ void print_help() {
                  "  0  success\n"
                  "  1  the daemon refused the request (its D-Bus error is printed)\n"
                  "  2  usage error, or power-off not confirmed; nothing was sent\n"
-                 "  3  caracarad is not running, did not answer, or the bus cannot be reached\n"
-                 "  4  permission denied\n";
+                 "  3  caracarad is not running, did not answer, or the bus cannot be reached (with\n"
+                 "     -H also: the host cannot be reached over SSH, or the link dropped)\n"
+                 "  4  permission denied (with -H also: SSH refused the login)\n"
+                 "\nWith -H the commanding client is the SSH link: when it drops, caracarad zeroes the\n"
+                 "thrusters; a link that stalls is caught by the command timeout (docs/topside.md).\n";
 }
 
 int cmd_help(Client&, const Args&, const Options&) {
@@ -323,6 +328,16 @@ int main(int argc, char** argv) {
                 if (address.empty())
                     usage_error("--bus-address needs an address");
                 choice = {caracara::dbus::BusChoice::Kind::Address, address};
+            } else if (a == "-H" || a == "--host" || a.starts_with("-H") || a.starts_with("--host=")) {
+                // As systemctl and busctl spell it: -H HOST, -HHOST, --host HOST, --host=HOST.
+                std::string host;
+                if (a == "-H" || a == "--host")
+                    host = i + 1 < argc ? argv[++i] : "";
+                else
+                    host = a.starts_with("--host=") ? a.substr(7) : a.substr(2);
+                if (host.empty() || host[0] == '-')
+                    usage_error("-H needs [USER@]HOST[:PORT], not '" + host + "'");
+                choice = {caracara::dbus::BusChoice::Kind::Remote, host};
             } else if (a == "--yes-power-off") {
                 options.yes_power_off = true;
             } else if (a == "-h" || a == "--help") {

@@ -1,6 +1,7 @@
 #include "tools/client.hpp"
 
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 
 namespace caracaractl {
@@ -36,7 +37,21 @@ bool is_one_of(const char* name, std::initializer_list<const char*> names) {
     return false;
 }
 
+// The last non-empty line of what ssh said, for caracaractl's own message.
+std::string last_line(const std::string& text) {
+    const size_t end = text.find_last_not_of("\r\n");
+    if (end == std::string::npos)
+        return {};
+    const size_t start = text.find_last_of('\n', end);
+    return text.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
+}
+
 } // namespace
+
+bool stop_signal_pending() {
+    sigset_t pending;
+    return sigpending(&pending) == 0 && (sigismember(&pending, SIGINT) == 1 || sigismember(&pending, SIGTERM) == 1);
+}
 
 int64_t Value::integer() const {
     switch (kind) {
@@ -121,7 +136,16 @@ Props to_props(const Value& dict) {
 
 sd_bus* Client::bus() {
     if (!bus_) {
-        int r = caracara::dbus::open_bus(choice_, "caracaractl", bus_);
+        const bool remote = choice_.kind == caracara::dbus::BusChoice::Kind::Remote;
+        if (remote)
+            ssh_stderr_.capture(); // if it cannot, ssh writes to our stderr and failures count as 3
+        const int r = caracara::dbus::open_bus(choice_, "caracaractl", bus_);
+        if (remote)
+            ssh_stderr_.restore();
+        if (r == -EINVAL && remote)
+            throw Failure{kExitUsage, "-H needs [USER@]HOST[:PORT], not '" + choice_.address + "'"};
+        if (r < 0 && remote) // ssh ended before the bus was up (refused, unreachable): it said why
+            throw lost_connection(errno_text(r));
         if (r < 0)
             throw Failure{r == -EACCES || r == -EPERM ? kExitDenied : kExitUnavailable,
                           "cannot connect to " + choice_.describe() + ": " + errno_text(r)};
@@ -129,7 +153,18 @@ sd_bus* Client::bus() {
     return bus_.get();
 }
 
-Failure Client::failure_for(const sd_bus_error& error, int r, uint64_t timeout_usec) const {
+Failure Client::lost_connection(const std::string& detail) {
+    if (choice_.kind != caracara::dbus::BusChoice::Kind::Remote)
+        return {kExitUnavailable, "lost the connection to " + choice_.describe() + ": " + detail};
+    // ssh has printed why (copied to our stderr already) and is exiting: wait for its last word.
+    const std::string said = ssh_stderr_.said(std::chrono::seconds(2));
+    const std::string why = last_line(said);
+    if (SshStderr::refused(said))
+        return {kExitDenied, "SSH refused the login to " + choice_.address + (why.empty() ? "" : ": " + why)};
+    return {kExitUnavailable, "the SSH link to " + choice_.address + " ended: " + (why.empty() ? detail : why)};
+}
+
+Failure Client::failure_for(const sd_bus_error& error, int r, uint64_t timeout_usec) {
     const char* name = error.name;
     const std::string message = error.message ? error.message : errno_text(r);
     if (is_one_of(name, {SD_BUS_ERROR_SERVICE_UNKNOWN, SD_BUS_ERROR_NAME_HAS_NO_OWNER}))
@@ -141,7 +176,7 @@ Failure Client::failure_for(const sd_bus_error& error, int r, uint64_t timeout_u
     // Checked before the timeout: sd-bus answers the calls pending on a closed connection with
     // NoReply ("Connection terminated").
     if (bus_ && !sd_bus_is_open(bus_.get()))
-        return {kExitUnavailable, "lost the connection to " + choice_.describe() + ": " + message};
+        return lost_connection(message);
     if (is_one_of(name, {SD_BUS_ERROR_NO_REPLY, SD_BUS_ERROR_TIMEOUT}) || r == -ETIMEDOUT) {
         const uint64_t t = timeout_usec ? timeout_usec : kDefaultTimeoutUsec;
         return {kExitUnavailable, "caracarad did not answer within " + std::to_string(t / 1'000'000) +

@@ -3,11 +3,12 @@
 #pragma once
 
 #include "dbus/sdbus.hpp"
+#include "dbus/vehicle_names.hpp"
+#include "tools/ssh_stderr.hpp"
 
 #include <cstdint>
 #include <functional>
 #include <map>
-#include "dbus/vehicle_names.hpp"
 
 #include <string>
 #include <vector>
@@ -29,8 +30,12 @@ enum Exit : int {
     kExitRefused = 1,     // the daemon answered with an error
     kExitUsage = 2,       // bad command line; nothing was sent
     kExitUnavailable = 3, // caracarad not running, bus unreachable, no reply
-    kExitDenied = 4,      // permission denied
+    kExitDenied = 4,      // permission denied (the bus policy, or SSH refused the login)
 };
+
+// True when SIGINT or SIGTERM waits (blocked, for a signalfd): with -H, ssh is in caracaractl's
+// process group and dies of the same Ctrl-C, so the connection may drop before the signal is read.
+bool stop_signal_pending();
 
 // Thrown for anything that ends the program early; main prints "caracaractl: <message>".
 struct Failure {
@@ -96,10 +101,13 @@ public:
     Objects get_objects();
 
     // The Failure for a failed call or lost connection (shared with the monitor).
-    Failure failure_for(const sd_bus_error& error, int r, uint64_t timeout_usec) const;
+    Failure failure_for(const sd_bus_error& error, int r, uint64_t timeout_usec);
+    // The Failure for a connection that dropped: over SSH, refused (4) or lost (3) as ssh said.
+    Failure lost_connection(const std::string& detail);
 
 private:
     caracara::dbus::BusChoice choice_;
+    SshStderr ssh_stderr_; // -H: ssh's stderr (declared before bus_: ssh ends before the copy stops)
     caracara::dbus::BusPtr bus_;
 };
 

@@ -41,6 +41,11 @@ int on_reply(sd_bus_message* m, void* userdata, sd_bus_error*) {
     auto& h = *static_cast<Hold*>(userdata);
     h.pending.reset(); // sd-bus keeps the slot alive until this callback returns
     if (sd_bus_message_is_method_error(m, nullptr) > 0) {
+        if (stop_signal_pending() && !sd_bus_is_open(h.client.bus())) {
+            h.signal = SIGINT;
+            sd_event_exit(h.event, kExitOk);
+            return 0;
+        }
         const sd_bus_error* error = sd_bus_message_get_error(m);
         fail(h, h.client.failure_for(*error, -sd_bus_message_get_errno(m), kResendTimeoutUsec));
     }
@@ -89,8 +94,13 @@ int on_signal(sd_event_source*, const signalfd_siginfo* info, void* userdata) {
 // sd-bus synthesizes org.freedesktop.DBus.Local.Disconnected when the bus connection drops.
 int on_message(sd_bus_message* m, void* userdata, sd_bus_error*) {
     auto& h = *static_cast<Hold*>(userdata);
-    if (sd_bus_message_is_signal(m, "org.freedesktop.DBus.Local", "Disconnected") > 0)
-        fail(h, Failure{kExitUnavailable, "lost the connection to " + h.client.choice().describe()});
+    if (sd_bus_message_is_signal(m, "org.freedesktop.DBus.Local", "Disconnected") <= 0)
+        return 0;
+    if (stop_signal_pending()) { // Ctrl-C also ended ssh (-H): a release, not a lost link
+        h.signal = SIGINT;
+        return sd_event_exit(h.event, kExitOk);
+    }
+    fail(h, h.client.lost_connection("disconnected"));
     return 0;
 }
 
@@ -149,10 +159,13 @@ int hold_command(Client& client, const char* member, const Client::Appender& app
     sigaddset(&mask, SIGTERM);
     check(sigprocmask(SIG_BLOCK, &mask, nullptr) < 0 ? -errno : 0, "cannot block signals");
     sd_event_source* raw_source = nullptr;
+    // Signals before the bus: with -H the same Ctrl-C ends ssh, and the release must win.
     check(sd_event_add_signal(raw_event, &raw_source, SIGINT, on_signal, &h), "cannot watch SIGINT");
     caracara::dbus::SourcePtr sigint(raw_source);
+    check(sd_event_source_set_priority(raw_source, SD_EVENT_PRIORITY_IMPORTANT), "cannot order SIGINT");
     check(sd_event_add_signal(raw_event, &raw_source, SIGTERM, on_signal, &h), "cannot watch SIGTERM");
     caracara::dbus::SourcePtr sigterm(raw_source);
+    check(sd_event_source_set_priority(raw_source, SD_EVENT_PRIORITY_IMPORTANT), "cannot order SIGTERM");
 
     constexpr uint64_t kAccuracyUsec = 1'000;
     check(sd_event_add_time_relative(raw_event, &raw_source, CLOCK_MONOTONIC, interval, kAccuracyUsec, on_tick, &h),

@@ -97,11 +97,13 @@ int on_name_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
 // sd-bus synthesizes org.freedesktop.DBus.Local.Disconnected when the bus connection drops.
 int on_message(sd_bus_message* m, void* userdata, sd_bus_error*) {
     auto& mon = *static_cast<Monitor*>(userdata);
-    if (sd_bus_message_is_signal(m, "org.freedesktop.DBus.Local", "Disconnected") > 0) {
-        std::cerr << "caracaractl: lost the connection to " << mon.client.choice().describe() << '\n';
-        sd_event_exit(mon.event, kExitUnavailable);
-    }
-    return 0;
+    if (sd_bus_message_is_signal(m, "org.freedesktop.DBus.Local", "Disconnected") <= 0)
+        return 0;
+    if (stop_signal_pending()) // Ctrl-C also ended ssh (-H): the end the user asked for
+        return sd_event_exit(mon.event, kExitOk);
+    const Failure f = mon.client.lost_connection("disconnected");
+    std::cerr << "caracaractl: " << f.message << '\n';
+    return sd_event_exit(mon.event, f.code);
 }
 
 int on_signal(sd_event_source* source, const signalfd_siginfo*, void*) {
@@ -134,8 +136,14 @@ int run_monitor(Client& client, bool all) {
     sigaddset(&mask, SIGINT);
     sigaddset(&mask, SIGTERM);
     check(sigprocmask(SIG_BLOCK, &mask, nullptr) < 0 ? -errno : 0, "cannot block signals");
-    check(sd_event_add_signal(raw_event, nullptr, SIGINT, on_signal, nullptr), "cannot watch SIGINT");
-    check(sd_event_add_signal(raw_event, nullptr, SIGTERM, on_signal, nullptr), "cannot watch SIGTERM");
+    // Signals before the bus: with -H the same Ctrl-C ends ssh, and the plain exit must win.
+    caracara::dbus::SourcePtr signals[2];
+    for (int i = 0; const int sig : {SIGINT, SIGTERM}) {
+        sd_event_source* raw_source = nullptr;
+        check(sd_event_add_signal(raw_event, &raw_source, sig, on_signal, nullptr), "cannot watch a signal");
+        signals[i++].reset(raw_source);
+        check(sd_event_source_set_priority(raw_source, SD_EVENT_PRIORITY_IMPORTANT), "cannot order a signal");
+    }
 
     // Subscribe first (sd_bus_add_match waits for the bus to confirm), then read the current
     // state, so that no change falls between the two.

@@ -3,6 +3,7 @@ hardware, and the documented exit codes (0 ok, 1 refused, 2 usage, 3 unavailable
 
 import os
 import re
+import shutil
 import signal
 import subprocess
 import time
@@ -262,6 +263,35 @@ class CaracaractlUnavailableTest(unittest.TestCase):
             out, err = proc.communicate()
         self.assertEqual(code, UNAVAILABLE, err)
         self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+
+
+@unittest.skipUnless(ctl_available(), "caracaractl is not built")
+class CaracaractlRemoteArgumentsTest(unittest.TestCase):
+    """-H/--host as far as this machine goes: the over-SSH checks against a real sshd are in the
+    system test (tests/system/topside.sh)."""
+
+    def ctl(self, *args):
+        return subprocess.run(command("caracaractl") + list(args), capture_output=True, text=True, timeout=60,
+                              stdin=subprocess.DEVNULL)
+
+    def test_host_that_is_no_host_is_a_usage_error(self):
+        # An option for ssh is never taken as the host; sd_bus_open_system_remote's own check
+        # of [USER@]HOST[:PORT] ends as a usage error too (before ssh runs).
+        for args in (("-H", "-oProxyCommand=touch /tmp/caracara-pwned", "status"), ("--host=a@b@c", "status"),
+                     ("--host=", "status"), ("-Hhost:1:2", "kill"), ("-H",)):
+            with self.subTest(args=args):
+                r = self.ctl(*args)
+                self.assertEqual(r.returncode, USAGE, r.stderr)
+                self.assertIn("[USER@]HOST[:PORT]", r.stderr)
+        self.assertFalse(os.path.exists("/tmp/caracara-pwned"))
+
+    @unittest.skipUnless(shutil.which("ssh"), "no ssh client")
+    def test_host_not_reached_exits_3_with_what_ssh_said(self):
+        # Nothing listens on 127.0.0.1 port 1: ssh says so, exits 255, and caracaractl exits 3.
+        r = self.ctl("-H", "nobody@127.0.0.1:1", "kill")
+        self.assertEqual(r.returncode, UNAVAILABLE, r.stderr)
+        self.assertIn("Connection refused", r.stderr)
+        self.assertIn("caracaractl: the SSH link to nobody@127.0.0.1:1 ended", r.stderr)
 
 
 @unittest.skipUnless(ctl_available(), "caracaractl is not built")

@@ -393,6 +393,10 @@ check "pilot: GetDistance 0 answered" allowed pilot $V $VP/teensy $VT GetDistanc
 check "pilot: SetThrust accepted" allowed pilot $V $VP $V SetThrust ai 8 500 0 0 0 0 0 0 0
 check "pilot: Simulator1.ClearWireLog accepted (the simulator's policy)" allowed pilot $S $SP $S ClearWireLog
 
+# --- 7b. the topside: caracaractl -H, busctl -H and a python3-dbus script over SSH (check-topside.sh)
+. "$(dirname "$0")/check-topside.sh"
+topside_checks
+
 # --- 8. the watchdog is fed ---------------------------------------------------------------------------
 check "WatchdogSec=5s is in force" [ "$(unit caracarad WatchdogUSec)" = 5s ]
 w1=$(unit caracarad WatchdogTimestampMonotonic)

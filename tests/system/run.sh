@@ -14,11 +14,16 @@
 #    at boot by a test-only unit) and boots it with systemd-nspawn.
 # 3. check.sh does everything inside the container (systemctl, busctl, caracaractl as root,
 #    as a user in the caracara group and as an unprivileged user), writes PASS/FAIL lines
-#    to a bind-mounted directory, then powers the container off.
+#    to a bind-mounted directory, then powers the container off. The container sits in a
+#    network namespace of its own, joined by a veth pair (the tether) to a second one, the
+#    topside: there topside.sh runs on this machine, outside the container, and reaches the
+#    container's sshd with caracaractl -H, busctl -H and the python3-dbus example
+#    (check-topside.sh is the container's half).
 # 4. The host prints the results and exits non-zero on any failure, a missing result or a
 #    timeout. The container, its processes and the temporary root are always removed.
 #
-# Needs root, debootstrap and systemd-container (installed with apt-get when missing). The
+# Needs root, debootstrap, systemd-container, openssh-client and iproute2 (installed with apt-get
+# when missing), and /usr/bin/python3 with python3-dbus for the example mission (scripts/deps.sh). The
 # Debian mirror is the one this machine's apt uses (CARACARA_SYSTEST_MIRROR overrides it).
 # Exit status 77 (skipped) when not run as root.
 set -euo pipefail
@@ -43,8 +48,8 @@ timeout_s=${CARACARA_SYSTEST_TIMEOUT:-420}
 # What the container needs besides debootstrap's minbase: an init, the system bus, and the
 # shared libraries of caracarad, caracara-sim and caracaractl (their names differ by release).
 case $suite in
-  bookworm) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod2 libtomlplusplus3) ;;
-  trixie) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod3 libtomlplusplus3t64) ;;
+  bookworm) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod2 libtomlplusplus3 openssh-server) ;;
+  trixie) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod3 libtomlplusplus3t64 openssh-server) ;;
   *) echo "system-test: CARACARA_SYSTEST_SUITE must be bookworm or trixie, not '$suite'" >&2; exit 2 ;;
 esac
 # Bump when the way the cached root is made changes.
@@ -66,6 +71,8 @@ done
 need=()
 command -v debootstrap >/dev/null || need+=(debootstrap)
 command -v systemd-nspawn >/dev/null || need+=(systemd-container)
+command -v ssh-keygen >/dev/null || need+=(openssh-client)  # the topside (topside.sh)
+command -v ip >/dev/null || need+=(iproute2)                 # the tether
 if ((${#need[@]})); then
   say "installing ${need[*]}"
   apt-get update -qq
@@ -96,11 +103,13 @@ if [ ! -f "$cache" ]; then
   tar -C "$boot/root" --numeric-owner -cpf "$boot/root.tar" .
   mv "$boot/root.tar" "$cache"
   rm -rf --one-file-system "$boot"
-  # Roots made for another package list are of no more use.
-  find "$cache_dir" -maxdepth 1 -name "$suite-$arch-*.tar" ! -path "$cache" -delete
   trap - EXIT
   say "root built in $(($(date +%s) - t0)) s"
 fi
+# Roots of another package list go once unused for a week (not at once: two branches with
+# different lists would otherwise rebuild theirs on every run).
+touch "$cache"
+find "$cache_dir" -maxdepth 1 -name "$suite-$arch-*.tar" ! -path "$cache" -mtime +7 -delete
 
 # --- this run's root --------------------------------------------------------------------------
 # A run killed before its cleanup (SIGKILL from a test timeout) leaves its root behind: remove
@@ -123,8 +132,17 @@ work=$(mktemp -d /var/tmp/caracara-systest.XXXXXX)
 echo $$ >"$work/run.pid"
 machine=caracara-systest-$$
 nspawn_pid=
+topside_pid=
+# The tether: two network namespaces (the vehicle's, where the container runs, and the
+# topside's, where topside.sh runs) joined by a veth pair; nothing else on either.
+vehicle_ns=caracara-vehicle-$$
+topside_ns=caracara-topside-$$
 cleanup() {
   local rc=$?
+  if [ -n "$topside_pid" ]; then
+    kill -TERM "$topside_pid" 2>/dev/null || true
+    wait "$topside_pid" 2>/dev/null || true
+  fi
   if [ -n "$nspawn_pid" ] && kill -0 "$nspawn_pid" 2>/dev/null; then
     say "stopping the container"
     kill -TERM "$nspawn_pid" 2>/dev/null || true
@@ -138,6 +156,8 @@ cleanup() {
     umount -l "$m" 2>/dev/null || true
   done
   rm -rf --one-file-system "$work"
+  ip netns delete "$vehicle_ns" 2>/dev/null || true
+  ip netns delete "$topside_ns" 2>/dev/null || true
   exit "$rc"
 }
 trap cleanup EXIT
@@ -174,6 +194,7 @@ fi
 
 # The checks: a test-only unit that runs check.sh once the system is up, then powers off.
 install -D -m 0755 "$here/check.sh" "$root/usr/local/libexec/caracara-systest/check.sh"
+install -D -m 0755 "$here/check-topside.sh" "$root/usr/local/libexec/caracara-systest/check-topside.sh"
 install -D -m 0644 "$here/caracara-systest.service" "$root/etc/systemd/system/caracara-systest.service"
 mkdir -p "$root/etc/systemd/system/multi-user.target.wants"
 ln -sf ../caracara-systest.service "$root/etc/systemd/system/multi-user.target.wants/caracara-systest.service"
@@ -181,11 +202,54 @@ ln -sf ../caracara-systest.service "$root/etc/systemd/system/multi-user.target.w
 ln -sf /dev/null "$root/etc/systemd/system/console-getty.service"
 echo caracara-systest >"$root/etc/hostname"
 
+# --- the tether and the topside (topside.sh) ---------------------------------------------------
+# Namespaces left by a killed run go with their run: only the live ones are kept.
+for ns in $(ip netns list 2>/dev/null | awk '/^caracara-(vehicle|topside)-[0-9]+/ { print $1 }'); do
+  kill -0 "${ns##*-}" 2>/dev/null || ip netns delete "$ns" 2>/dev/null || true
+done
+ip netns add "$vehicle_ns"
+ip netns add "$topside_ns"
+ip link add tether netns "$topside_ns" type veth peer name tether netns "$vehicle_ns"
+ip -n "$vehicle_ns" addr add 10.231.0.1/30 dev tether
+ip -n "$topside_ns" addr add 10.231.0.2/30 dev tether
+for ns in "$vehicle_ns" "$topside_ns"; do
+  ip -n "$ns" link set lo up
+  ip -n "$ns" link set tether up
+done
+# The topside's caracaractl: the build's, or the package's run with the root's own loader and
+# libraries (a Debian 13 binary needs Debian 13's glibc, which this machine may not have).
+top=$work/topside
+mkdir -p "$top/bin" "$out/topside"
+chmod 0755 "$out/topside"
+if [ -n "$debs" ]; then
+  dpkg-deb -x "$(find "$debs" -maxdepth 1 -name "caracarad_*_$arch.deb" | sort -V | tail -n 1)" "$top/pkg"
+  # The loader itself, not a link to it (Debian 12's /lib64 link is absolute: this machine's).
+  libs=$root/usr/lib/$(uname -m)-linux-gnu
+  loader=$(find "$libs" -maxdepth 1 -type f -name 'ld-linux*.so.*' | head -n 1)
+  printf '#!/bin/sh
+exec %s --library-path %s %s "$@"
+' "$loader" "$libs" "$top/pkg/usr/bin/caracaractl" \
+    >"$top/bin/caracaractl"
+else
+  printf '#!/bin/sh
+exec %s "$@"
+' "$build/tools/caracaractl" >"$top/bin/caracaractl"
+fi
+chmod 0755 "$top/bin/caracaractl"
+"$top/bin/caracaractl" --help >/dev/null || die "the topside's caracaractl does not run"
+# The topside's key: the private half stays out of the container, the public half goes in.
+ssh-keygen -q -t ed25519 -N '' -C caracara-topside -f "$top/id_ed25519"
+cp "$top/id_ed25519.pub" "$out/topside/id_ed25519.pub"
+CARACARA_TOPSIDE_OUT=$out CARACARA_TOPSIDE_DIR=$top CARACARA_TOPSIDE_SRC=$(cd "$here/../.." && pwd) \
+  timeout --signal=TERM "$timeout_s" ip netns exec "$topside_ns" "$here/topside.sh" >"$work/topside.log" 2>&1 &
+topside_pid=$!
+
 say "booting the container (systemd-nspawn --boot; at most ${timeout_s} s)"
 t1=$(date +%s)
 timeout --signal=TERM --kill-after=20 "$timeout_s" \
   systemd-nspawn --quiet --boot --keep-unit --register=no --machine="$machine" \
-    --directory="$root" --private-network --link-journal=no --resolv-conf=off \
+    --directory="$root" --network-namespace-path="/run/netns/$vehicle_ns" --capability=CAP_NET_ADMIN \
+    --link-journal=no --resolv-conf=off \
     --console=read-only --bind="$out:/systest-out" \
     >"$work/console.log" 2>&1 &
 nspawn_pid=$!
@@ -197,7 +261,12 @@ set -e
 nspawn_pid=
 say "container ran $(($(date +%s) - t1)) s (systemd-nspawn exit status $nspawn_rc)"
 
+kill -TERM "$topside_pid" 2>/dev/null || true
+wait "$topside_pid" 2>/dev/null || true
+topside_pid=
 [ -f "$out/check.log" ] && cat "$out/check.log"
+echo "---- topside (topside.sh, outside the container) ----"
+cat "$work/topside.log"
 failed=0
 if [ "$nspawn_rc" -eq 124 ] || [ "$nspawn_rc" -eq 137 ]; then
   say "FAIL: the container did not finish within ${timeout_s} s"
