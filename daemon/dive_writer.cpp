@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace caracara {
@@ -88,6 +89,9 @@ void DiveWriter::do_open(const Job& j) {
         current_.clear();
         return;
     }
+    // The unit's UMask=0077 would leave it to the daemon's user alone; the caracara group reads
+    // dives (caracaractl dives, plot), as LogsDirectoryMode=0750 lets it into the directory.
+    ::fchmod(fd_, 0640);
     log_info("dive recorder: recording %s", path.c_str());
     do_append(j.bytes);
 }

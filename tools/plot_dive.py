@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """Plots one dive for `caracaractl plot` (docs/dive-format.md).
 
 caracaractl decodes the dive file (the one decoder, fuzzed) and hands this script the samples
