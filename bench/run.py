@@ -149,6 +149,12 @@ status_reads_per_tick = {reads}
 command_timeout_ms = 500
 arming_delay_ms = 0
 """)
+            # The dive recorder, on by default as in the product; CARACARA_BENCH_RECORDER=off for the
+            # comparison in docs/dive-format.md.
+            dives = os.path.join(self.dir, "dives")
+            os.makedirs(dives, exist_ok=True)
+            on = os.environ.get("CARACARA_BENCH_RECORDER", "on") != "off"
+            f.write(f'[recorder]\nenabled = {"true" if on else "false"}\ndirectory = "{dives}"\n')
             if kill_switch:
                 f.write('[gpio]\nkill_switch = { chip = "gpiochip0", line = "KILL_SWITCH" }\n'
                         'kill_output = { chip = "gpiochip0", line = "KILL_OUT" }\n')

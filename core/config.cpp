@@ -374,6 +374,14 @@ void parse_recovery(Checker& c, const toml::table& t, RecoverySettings& out) {
     c.integer(t, p, "device_wait_ms", 0, 60000, out.device_wait_ms);
 }
 
+void parse_recorder(Checker& c, const toml::table& t, RecorderSettings& out) {
+    const std::string p = "recorder.";
+    c.only_keys(t, p, {"enabled", "directory", "max_total_mb"});
+    c.boolean(t, p, "enabled", out.enabled);
+    c.path(t, p, "directory", out.directory);
+    c.integer(t, p, "max_total_mb", 1, 1048576, out.max_total_mb);
+}
+
 } // namespace
 
 ConfigResult parse_config_string(std::string_view text, std::string_view source) {
@@ -395,7 +403,7 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     Checker c;
     DaemonConfig cfg;
     // [sim] belongs to caracara-sim, which reads the same file; it is not checked here.
-    c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "sim"});
+    c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "recorder", "sim"});
     if (const toml::table* t = c.table(root, "", "i2c"))
         parse_i2c(c, *t, cfg.i2c);
     if (const toml::table* t = c.table(root, "", "spi"))
@@ -411,6 +419,8 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
         parse_recovery(c, *t, cfg.recovery);
     if (const toml::table* t = c.table(root, "", "profiles"))
         parse_profiles(c, *t, cfg.profiles);
+    if (const toml::table* t = c.table(root, "", "recorder"))
+        parse_recorder(c, *t, cfg.recorder);
     c.table(root, "", "sim");
     if (!cfg.profiles.empty() && !find_profile(cfg, cfg.control.profile)) {
         c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + profile_names(cfg),

@@ -86,6 +86,15 @@ struct RecoverySettings {
     uint32_t device_wait_ms = 1000;  // how long to wait for the i2c device node to return
 };
 
+// The dive recorder (docs/dive-format.md): one file per dive, from an arming to the next
+// kill or power-off, in `directory` (caracarad.service's LogsDirectory=); the oldest dives
+// are deleted when the files together pass `max_total_mb`.
+struct RecorderSettings {
+    bool enabled = true;
+    std::string directory = "/var/log/caracara";
+    uint32_t max_total_mb = 256;  // about 7 hours of dives at 50 Hz
+};
+
 // The default vehicle: eight SeaBotix controllers at MT 0x52, 0x56, 0x58, 0x5A, 0x5C,
 // 0x5E, 0x60, 0x62 (distinct even addresses, all on the main bus).
 std::array<ThrusterConfig, kMotorCount> default_thrusters();
@@ -98,6 +107,7 @@ struct DaemonConfig {
     ControlSettings control;
     GpioSettings gpio;
     RecoverySettings recovery;
+    RecorderSettings recorder;
     std::vector<ThrustProfile> profiles{{"water", 1.0}};
 };
 

@@ -37,6 +37,14 @@ std::string VehicleDaemon::start() {
     if (std::string e = vehicle_.start(event_); !e.empty())
         return e;
     bus_.set_gate(&vehicle_); // a thruster that stopped answering kills the vehicle
+    if (config_.recorder.enabled) {
+        dive_writer_ = std::make_unique<DiveWriter>(config_.recorder.directory,
+                                                    uint64_t(config_.recorder.max_total_mb) << 20);
+        dive_writer_->start();
+        recorder_ = std::make_unique<DiveRecorder>(config_, vehicle_, bus_, teensy_, events_, *dive_writer_);
+        events_.attach_recorder(recorder_.get());
+        recorder_->start();
+    }
     if (std::string e = loop_.start(); !e.empty())
         return e;
     started_ = true;
@@ -49,6 +57,11 @@ void VehicleDaemon::shutdown() {
     started_ = false;
     bus_.set_gate(nullptr);
     loop_.stop();
+    if (recorder_) {
+        recorder_->stop(); // the dive ends here, before the zeros of the way out
+        events_.attach_recorder(nullptr);
+        dive_writer_->drain();
+    }
     vehicle_.stop();
     recovery_.stop();
     lines_.close();

@@ -6,6 +6,8 @@
 #include "core/config.hpp"
 #include "daemon/bus_recovery.hpp"
 #include "daemon/control_loop.hpp"
+#include "daemon/dive_recorder.hpp"
+#include "daemon/dive_writer.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/service_status.hpp"
 #include "daemon/teensy_port.hpp"
@@ -15,6 +17,7 @@
 #include "platform/device_io.hpp"
 #include "platform/gpio_backend.hpp"
 
+#include <memory>
 #include <string>
 
 namespace caracara {
@@ -46,6 +49,8 @@ public:
     ServiceStatus& status() { return status_; }
     BusRecovery& recovery() { return recovery_; }
     SafetyLines& lines() { return lines_; }
+    // The dive recorder, or nullptr when recorder.enabled is false.
+    const DiveRecorder* recorder() const { return recorder_.get(); }
 
 private:
     sd_event* event_;
@@ -58,6 +63,8 @@ private:
     ControlLoop loop_;
     BusRecovery recovery_;
     ServiceStatus status_;
+    std::unique_ptr<DiveWriter> dive_writer_;
+    std::unique_ptr<DiveRecorder> recorder_;
     bool started_ = false;
 };
 

@@ -7,6 +7,8 @@ namespace caracara {
 void VehicleEvents::changed(uint32_t changes) {
     if ((changes & (kChangeState | kChangeBus | kChangeProfile | kChangeFaults)) && status_)
         status_->publish();
+    if (changes && recorder_)
+        recorder_->vehicle_changed(changes);
     if (changes && observer_)
         observer_->vehicle_changed(changes);
 }

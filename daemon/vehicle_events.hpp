@@ -1,11 +1,13 @@
 // One place every daemon object reports changes to: it forwards them to the presentation
-// (a VehicleObserver, i.e. D-Bus) and, for state and bus changes, to systemd's STATUS= line.
-// The receivers are attached once main has built them.
+// (a VehicleObserver, i.e. D-Bus), to the dive recorder (a second VehicleObserver) and, for
+// state and bus changes, to systemd's STATUS= line. The receivers are attached once main
+// has built them.
 #pragma once
 
 #include "daemon/vehicle_observer.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace caracara {
@@ -16,24 +18,37 @@ class VehicleEvents {
 public:
     void attach(VehicleObserver* observer) { observer_ = observer; }
     void attach(const ServiceStatus* status) { status_ = status; }
+    void attach_recorder(VehicleObserver* recorder) { recorder_ = recorder; }
+    // Who is calling, while a D-Bus method runs (the presentation layer knows; "" otherwise):
+    // the recorder writes it beside each state change.
+    void set_caller_source(std::function<std::string()> source) { caller_ = std::move(source); }
+    std::string caller() const { return caller_ ? caller_() : std::string(); }
 
     void changed(uint32_t changes);
     void telemetry() {
         if (observer_)
             observer_->telemetry();
     }
+    void cycle(uint64_t now_ns) {
+        if (recorder_)
+            recorder_->cycle(now_ns);
+    }
     void bus_lost(const std::string& reason) {
-        if (observer_)
-            observer_->bus_lost(reason);
+        for (VehicleObserver* o : {recorder_, observer_})
+            if (o)
+                o->bus_lost(reason);
     }
     void bus_restored(uint32_t pulses, double milliseconds) {
-        if (observer_)
-            observer_->bus_restored(pulses, milliseconds);
+        for (VehicleObserver* o : {recorder_, observer_})
+            if (o)
+                o->bus_restored(pulses, milliseconds);
     }
 
 private:
     VehicleObserver* observer_ = nullptr;
+    VehicleObserver* recorder_ = nullptr;
     const ServiceStatus* status_ = nullptr;
+    std::function<std::string()> caller_;
 };
 
 } // namespace caracara

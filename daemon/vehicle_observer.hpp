@@ -27,6 +27,8 @@ public:
     // The I2C bus was found locked up / came back after a recovery.
     virtual void bus_lost(const std::string& reason) = 0;
     virtual void bus_restored(uint32_t pulses, double milliseconds) = 0;
+    // Every control-loop cycle (the dive recorder's samples); most observers ignore it.
+    virtual void cycle(uint64_t /*now_ns*/) {}
 };
 
 } // namespace caracara

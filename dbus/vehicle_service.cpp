@@ -1,5 +1,6 @@
 #include "dbus/vehicle_service.hpp"
 
+#include "dbus/error_reply.hpp"
 #include "dbus/vehicle_names.hpp"
 
 namespace caracara::dbus {
@@ -9,9 +10,17 @@ VehicleService::VehicleService(sd_bus* bus, VehicleDaemon& daemon)
       clients_(bus, daemon.vehicle()), announcer_(bus, [this](uint32_t changes) { announce(changes); }) {
     for (size_t i = 0; i < daemon.bus().size(); ++i)
         thrusters_.push_back(std::make_unique<ThrusterObject>(bus, daemon.bus(), i));
+    // The dive recorder writes who called beside each state change: the sender of the message
+    // being dispatched, if any (a timer or the kill switch has none).
+    events_ = &daemon.events();
+    events_->set_caller_source([bus] {
+        sd_bus_message* m = sd_bus_get_current_message(bus);
+        return m ? sender(m) : std::string();
+    });
 }
 
 VehicleService::~VehicleService() {
+    events_->set_caller_source(nullptr);
     if (bus_)
         sd_bus_release_name(bus_, kBusName);
 }

@@ -34,6 +34,7 @@ private:
     void announce(uint32_t changes);
 
     sd_bus* bus_;
+    VehicleEvents* events_ = nullptr;
     SlotPtr object_manager_;
     VehicleObject vehicle_;
     std::vector<std::unique_ptr<ThrusterObject>> thrusters_;

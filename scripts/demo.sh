@@ -37,7 +37,10 @@ for _ in $(seq 200); do grep -qF "$bus" "$dir/dbus.log" 2>/dev/null && break; sl
 for _ in $(seq 200); do
   busctl --address="$bus" status org.caracara.Simulator1 >/dev/null 2>&1 && break; sleep 0.05
 done
-"$build/daemon/caracarad" --hardware="sim:$dir/sim.sock" --bus-address "$bus" & pids+=($!)
+# The dive recorder writes into the demo's directory instead of /var/log/caracara.
+mkdir -p "$dir/dives"
+printf '[recorder]\ndirectory = "%s"\n' "$dir/dives" >"$dir/caracarad.toml"
+"$build/daemon/caracarad" --hardware="sim:$dir/sim.sock" --bus-address "$bus" --config "$dir/caracarad.toml" & pids+=($!)
 
 ctl() { echo; echo "\$ caracaractl $*"; "$build/tools/caracaractl" --bus-address "$bus" "$@"; }
 sim_speeds() {
@@ -75,3 +78,9 @@ ctl kill
 sim_speeds
 ctl status
 ctl thrust 1000 0 0 0 0 0 0 0 --once || echo "(refused while killed, as it should be)"
+
+echo; echo "== the dive, from ClearKill to the kill, as the recorder wrote it"
+ctl dives --dir "$dir/dives"
+plot=${CARACARA_DEMO_PLOT:-/tmp/caracara-demo-dive.png}
+ctl plot last --dir "$dir/dives" --out "$plot"
+echo "(motor values, currents, temperatures and orientation, the kill marked: $plot)"

@@ -10,7 +10,7 @@
 # fuzz/regressions/<harness>/ once its cause is fixed. Builds build-fuzz/ with clang-14 first.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
-harnesses=(packet seabotix teensy config sim_request)
+harnesses=(packet seabotix teensy config sim_request dive)
 which=${1:-all}
 limit=${2:-600}
 store=${CARACARA_FUZZ_DIR:-/var/tmp/caracara-fuzz}

@@ -1,6 +1,9 @@
 // caracara-sim: plays the Caracara vehicle's hardware for caracarad (device protocol on a
 // Unix socket) and for people and tests (org.caracara.Simulator1 on D-Bus).
+#include "core/dive_format.hpp"
+#include "platform/dive_files.hpp"
 #include "sim/device_server.hpp"
+#include "sim/dive_replay.hpp"
 #include "platform/io_error.hpp"
 #include "sim/inspect.hpp"
 #include "sim/kernel_bridge.hpp"
@@ -11,6 +14,8 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <memory>
+#include <vector>
 #include <string>
 #include <systemd/sd-daemon.h>
 #include <ctime>
@@ -38,6 +43,9 @@ void usage(FILE* f) {
                "  --realistic-timing    really wait the wire time of every transaction\n"
                "  --clock-hz HZ         I2C clock (default 100000)\n"
                "  --physics-hz HZ       model update rate (default 100)\n"
+               "  --replay DIVE         the thrusters and the Teensy answer with a recorded dive's\n"
+               "                        status and orientation, from caracarad's ClearKill on\n"
+               "                        (docs/dive-format.md)\n"
                "  -h, --help            this text\n",
                f);
 }
@@ -70,6 +78,7 @@ int main(int argc, char** argv) {
     int realistic = -1;
     long clock_hz = 0;
     long physics_hz = 100;
+    std::string replay_path;
 
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
@@ -88,6 +97,7 @@ int main(int argc, char** argv) {
         else if (a == "--user") bus_choice = {dbus::BusChoice::Kind::User, {}};
         else if (a == "--bus-address") bus_choice = {dbus::BusChoice::Kind::Address, value("--bus-address")};
         else if (a == "--no-dbus") use_dbus = false;
+        else if (a == "--replay") replay_path = value("--replay");
         else if (a == "--realistic-timing") realistic = 1;
         else if (a == "--clock-hz") clock_hz = std::strtol(value("--clock-hz").c_str(), nullptr, 10);
         else if (a == "--physics-hz") physics_hz = std::strtol(value("--physics-hz").c_str(), nullptr, 10);
@@ -123,6 +133,22 @@ int main(int argc, char** argv) {
     }
 
     SimVehicle vehicle(cfg);
+    std::unique_ptr<DiveReplay> replay;
+    if (!replay_path.empty()) {
+        std::vector<uint8_t> bytes;
+        std::string why;
+        if (!read_whole_file(replay_path, bytes, why)) {
+            std::fprintf(stderr, "caracara-sim: cannot replay %s\n", why.c_str());
+            return 2;
+        }
+        dive::Dive d = dive::decode(bytes);
+        if (!d.ok()) {
+            std::fprintf(stderr, "caracara-sim: cannot replay %s: %s\n", replay_path.c_str(), d.message.c_str());
+            return 2;
+        }
+        replay = std::make_unique<DiveReplay>(vehicle, std::move(d));
+        vehicle.add_stepped(replay.get());
+    }
 
     sd_event* ev_raw = nullptr;
     if (int r = sd_event_default(&ev_raw); r < 0) {

@@ -399,6 +399,8 @@ std::vector<TeensyFrameRecord> TeensyModel::frame_log() const { return {log_.beg
 double TeensyModel::heading() const { return VehicleBody::wrap_angle(attitude_().yaw + heading_offset_); }
 
 BodyAttitude TeensyModel::orientation() const {
+    if (replayed_)
+        return *replayed_;
     BodyAttitude a = attitude_();
     a.yaw = VehicleBody::wrap_angle(a.yaw + heading_offset_);
     return a;

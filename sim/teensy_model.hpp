@@ -49,6 +49,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -169,6 +170,8 @@ public:
     std::array<uint8_t, 3> leds() const { return leds_; }
     // What Get orientation answers: body attitude with the heading offset applied to yaw.
     BodyAttitude orientation() const;
+    // caracara-sim --replay: Get orientation answers this instead (nullopt: the body model).
+    void replay_orientation(const std::optional<BodyAttitude>& a) { replayed_ = a; }
     double heading_offset() const { return heading_offset_; }
     const TeensyConfig& config() const { return cfg_; }
 
@@ -231,6 +234,7 @@ private:
     uint64_t acks_ = 0;
     std::vector<uint8_t> servos_;
     std::vector<uint16_t> distances_;
+    std::optional<BodyAttitude> replayed_;
     std::array<uint8_t, 3> leds_{};
 };
 

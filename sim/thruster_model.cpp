@@ -70,10 +70,13 @@ std::vector<uint8_t> ThrusterModel::status_bytes() const {
         const uint8_t current = static_cast<uint8_t>(std::clamp(std::lround(current_a_ * 10.0), 0L, 255L));
         const uint8_t temp = static_cast<uint8_t>(std::clamp(std::lround(temperature_c_), 0L, 255L));
         s = {mt_read, status, faults_, current, actual_speed_byte(), temp};
+        if (replayed_)
+            s = {mt_read, status, replayed_->faults, replayed_->current_da, replayed_->speed_byte, replayed_->temperature_c};
     } else {
         // Revision code 1 (Aveox brushless, bit 5) reports current in MAX POWER;
         // revision 2 (legacy brushed, bit 6) reports the power set into the motor.
-        uint8_t status = static_cast<uint8_t>((spec_.brushless ? 0x20 : 0x40) | (faults_ & 0x1F));
+        const uint8_t faults = replayed_ ? replayed_->faults : faults_;
+        uint8_t status = static_cast<uint8_t>((spec_.brushless ? 0x20 : 0x40) | (faults & 0x1F));
         uint8_t max_power = spec_.brushless
             ? static_cast<uint8_t>(std::clamp(std::lround(current_a_ * 10.0), 0L, 255L))
             : actual_speed_byte();

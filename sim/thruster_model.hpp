@@ -55,6 +55,14 @@ public:
     enum class Corrupt { Checksum, FirstByte };
     void corrupt_replies(uint32_t count, Corrupt how) { corrupt_count_ = count; corrupt_how_ = how; }
     void power_cycle();
+    // caracara-sim --replay: status replies carry these instead of the model's (nullopt: the model).
+    struct Replayed {
+        uint8_t speed_byte = 0x80;
+        uint8_t current_da = 0;
+        uint8_t temperature_c = 0;
+        uint8_t faults = 0;
+    };
+    void replay(const std::optional<Replayed>& r) { replayed_ = r; }
     void set_water_temperature(double c) { water_temp_c_ = c; }
 
     // Inspection.
@@ -99,6 +107,7 @@ private:
     uint64_t orders_rejected_ = 0;
     uint64_t status_reads_ = 0;
     uint64_t zero_orders_ = 0;
+    std::optional<Replayed> replayed_;
 };
 
 } // namespace caracara::sim

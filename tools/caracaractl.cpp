@@ -2,6 +2,7 @@
 // of timedatectl. Arguments are parsed completely before anything is sent; value ranges are the
 // daemon's business (it answers with named errors), only the D-Bus wire types are checked here.
 #include "tools/client.hpp"
+#include "tools/dives.hpp"
 #include "tools/hold.hpp"
 #include "tools/monitor.hpp"
 #include "tools/render.hpp"
@@ -262,6 +263,7 @@ void print_help() {
             std::cout << '\n' << c.group << ":\n";
         std::cout << strf("  %-32s %s\n", synopsis(c).c_str(), c.help);
     }
+    std::cout << dive_help();
     std::cout << "\nOptions (before the command):\n"
                  "  --system                         Connect to the system bus (default)\n"
                  "  --user                           Connect to the user's session bus\n"
@@ -291,7 +293,8 @@ void print_help() {
                  "Changing the vehicle needs root or membership in the caracara group; reading does not.\n"
                  "\nExit status:\n"
                  "  0  success\n"
-                 "  1  the daemon refused the request (its D-Bus error is printed)\n"
+                 "  1  the daemon refused the request (its D-Bus error is printed), or a dive file\n"
+                 "     cannot be read\n"
                  "  2  usage error, or power-off not confirmed; nothing was sent\n"
                  "  3  caracarad is not running, did not answer, or the bus cannot be reached (with\n"
                  "     -H also: the host cannot be reached over SSH, or the link dropped)\n"
@@ -350,6 +353,8 @@ int main(int argc, char** argv) {
             }
         }
         const std::string name = i < argc ? argv[i++] : "status";
+        if (is_dive_command(name))
+            return run_dive_command(name, Args(argv + i, argv + argc));
         command = find_command(name);
         if (!command)
             usage_error("unknown command '" + name + "'");

@@ -12,3 +12,13 @@ foreach(name vehicle introspection caracaractl mission paths_out faults)
                        TIMEOUT 600
                        LABELS e2e)
 endforeach()
+
+# The dive recorder: a dive listed and plotted, bad dive files refused, and the regression dives
+# of tests/dives replayed against their expected output (tests/dives/test_dives.py).
+add_test(NAME e2e_dives
+         COMMAND /usr/bin/python3 -m unittest -v test_dives
+         WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR}/../dives)
+set_tests_properties(e2e_dives PROPERTIES
+                     ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
+                     TIMEOUT 600
+                     LABELS e2e)

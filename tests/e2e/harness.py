@@ -361,8 +361,16 @@ class Rig:
         sections = {"control": self.control}
         if self.gpio:
             sections["gpio"] = SIM_GPIO
+        # The dive recorder writes into the rig's directory, not the host's /var/log/caracara.
+        sections["recorder"] = {"directory": self.dives_dir}
         sections.update(self.extra_config)
         return toml_dumps(sections) + "\n" + self.extra_toml
+
+    @property
+    def dives_dir(self):
+        path = os.path.join(self.dir, "dives")
+        os.makedirs(path, exist_ok=True)
+        return path
 
     def _spawn(self, name, argv):
         log_path = os.path.join(self.dir, name + ".log")

@@ -1,0 +1,210 @@
+#include "daemon/dive_recorder.hpp"
+
+#include "core/clock.hpp"
+#include "platform/dive_files.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace caracara {
+
+namespace {
+constexpr uint64_t kFlushPeriodNs = 1'000'000'000; // a crash loses at most this much
+constexpr uint64_t kNsPer100us = 100'000;
+
+uint64_t unix_ms() {
+    using namespace std::chrono;
+    return static_cast<uint64_t>(duration_cast<milliseconds>(system_clock::now().time_since_epoch()).count());
+}
+
+int16_t clamp16(int32_t v) { return static_cast<int16_t>(std::clamp<int32_t>(v, INT16_MIN + 1, INT16_MAX)); }
+} // namespace
+
+DiveRecorder::DiveRecorder(const DaemonConfig& config, const Vehicle& vehicle, const ThrusterBus& bus,
+                           const TeensyPort& teensy, const VehicleEvents& events, DiveWriter& writer)
+    : config_(config), vehicle_(vehicle), bus_(bus), teensy_(teensy), events_(events), writer_(writer) {}
+
+void DiveRecorder::start() {
+    started_ = true;
+    const SafetyState s = vehicle_.safety().state();
+    if (s == SafetyState::Arming || s == SafetyState::Ready)
+        begin(monotonic_ns(), "start");
+}
+
+void DiveRecorder::stop() {
+    if (recording_)
+        finish(monotonic_ns(), "stopped");
+    started_ = false;
+}
+
+uint32_t DiveRecorder::since_start(uint64_t now_ns) const {
+    const uint64_t t = now_ns > start_ns_ ? (now_ns - start_ns_) / kNsPer100us : 0;
+    return static_cast<uint32_t>(std::min<uint64_t>(t, UINT32_MAX));
+}
+
+void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
+    recording_ = true;
+    start_ns_ = now_ns;
+    last_flush_ns_ = now_ns;
+    records_.clear();
+    const uint64_t wall = unix_ms();
+    dive::Header h;
+    h.start_unix_ms = wall;
+    h.start_mono_ns = now_ns;
+    h.loop_rate_hz = config_.control.loop_rate_hz;
+    h.profile = vehicle_.profile().name;
+    h.reason = reason;
+    writer_.open(dive_file_name(wall), dive::encode_header(h));
+    for (std::size_t i = 0; i < faults_.size() && i < bus_.size(); ++i)
+        faults_[i] = bus_.faults(i).bits;
+    // The state it starts in, with who asked for it.
+    dive::Event e;
+    e.kind = dive::EventKind::State;
+    e.state = static_cast<uint8_t>(vehicle_.safety().state());
+    e.client = events_.caller();
+    e.text = reason;
+    add_event(std::move(e), now_ns);
+}
+
+void DiveRecorder::finish(uint64_t now_ns, const std::string& reason) {
+    dive::encode_sample(records_, sample(now_ns)); // the zeros the dive ends with
+    dive::encode_end(records_, {since_start(now_ns), reason});
+    flush();
+    writer_.close();
+    recording_ = false;
+}
+
+void DiveRecorder::flush() {
+    if (!records_.empty())
+        writer_.append(dive::seal_block(records_));
+    records_.clear();
+}
+
+void DiveRecorder::add_event(dive::Event e, uint64_t now_ns) {
+    e.t_100us = since_start(now_ns);
+    dive::encode_event(records_, e);
+}
+
+void DiveRecorder::vehicle_changed(uint32_t changes) {
+    if (!started_)
+        return;
+    const uint64_t now = monotonic_ns();
+    const SafetyState s = vehicle_.safety().state();
+    const bool driving = s == SafetyState::Arming || s == SafetyState::Ready;
+    if ((changes & kChangeState) && !recording_ && driving) {
+        begin(now, "clear-kill");
+        return;
+    }
+    if (!recording_)
+        return;
+    if (changes & kChangeState) {
+        dive::Event e;
+        e.kind = dive::EventKind::State;
+        e.state = static_cast<uint8_t>(s);
+        e.kill_source = static_cast<uint8_t>(s == SafetyState::Killed ? vehicle_.safety().kill_source() : KillSource::None);
+        e.text = s == SafetyState::Killed ? vehicle_.safety().kill_reason() : std::string();
+        e.client = events_.caller();
+        add_event(std::move(e), now);
+    }
+    if (changes & kChangeFaults) {
+        for (std::size_t i = 0; i < faults_.size() && i < bus_.size(); ++i) {
+            const uint8_t bits = bus_.faults(i).bits;
+            if (bits == faults_[i])
+                continue;
+            faults_[i] = bits;
+            dive::Event e;
+            e.kind = dive::EventKind::Fault;
+            e.thruster = static_cast<uint8_t>(i);
+            e.value = bits;
+            e.text = format_faults(FaultSet{bits});
+            add_event(std::move(e), now);
+        }
+    }
+    if (changes & kChangeProfile) {
+        dive::Event e;
+        e.kind = dive::EventKind::Profile;
+        e.text = vehicle_.profile().name;
+        e.number = static_cast<float>(vehicle_.profile().factor);
+        e.client = events_.caller();
+        add_event(std::move(e), now);
+    }
+    if ((changes & kChangeState) && !driving)
+        finish(now, s == SafetyState::PoweredOff ? "powered-off"
+                                                 : "killed (" + std::string(vehicle_.kill_source_name()) + ")");
+}
+
+void DiveRecorder::bus_lost(const std::string& reason) {
+    if (!recording_)
+        return;
+    dive::Event e;
+    e.kind = dive::EventKind::BusLost;
+    e.text = reason;
+    add_event(std::move(e), monotonic_ns());
+}
+
+void DiveRecorder::bus_restored(uint32_t pulses, double milliseconds) {
+    if (!recording_)
+        return;
+    dive::Event e;
+    e.kind = dive::EventKind::BusRestored;
+    e.value = pulses;
+    e.number = static_cast<float>(milliseconds);
+    add_event(std::move(e), monotonic_ns());
+}
+
+void DiveRecorder::cycle(uint64_t now_ns) {
+    if (!recording_)
+        return;
+    dive::encode_sample(records_, sample(now_ns));
+    if (now_ns - last_flush_ns_ >= kFlushPeriodNs) {
+        last_flush_ns_ = now_ns;
+        flush();
+    }
+}
+
+dive::Sample DiveRecorder::sample(uint64_t now_ns) const {
+    dive::Sample s;
+    s.t_100us = since_start(now_ns);
+    for (std::size_t i = 0; i < dive::kThrusters; ++i) {
+        s.requested[i] = clamp16(vehicle_.requested_values()[i]);
+        s.applied[i] = clamp16(vehicle_.order_value(i));
+    }
+    s.budget_limit = clamp16(vehicle_.budget_limit());
+    const BusTelemetry& bt = bus_.telemetry();
+    s.flags = static_cast<uint8_t>((vehicle_.saturated() ? dive::kSaturated : 0) |
+                                   (vehicle_.safety().kill_switch_set() ? dive::kKillSwitch : 0) |
+                                   (teensy_.telemetry().online ? dive::kTeensyOnline : 0) |
+                                   (vehicle_.kill_output_asserted() ? dive::kKillOutput : 0) |
+                                   (static_cast<unsigned>(bt.state) << dive::kBusStateShift));
+    for (std::size_t i = 0; i < dive::kThrusters && i < bus_.size(); ++i) {
+        const ThrusterDriver& d = bus_.thruster(i);
+        dive::ThrusterSample& t = s.thrusters[i];
+        t.flags = d.online() ? dive::kOnline : 0;
+        if (const auto& st = d.last_status()) {
+            t.flags |= dive::kStatusKnown;
+            t.faults = st->faults.bits;
+            if (st->current_deciamps) {
+                t.flags |= dive::kCurrentKnown;
+                t.current_da = *st->current_deciamps;
+            }
+            if (st->variant == Variant::SeaBotix) {
+                t.temperature_c = st->seabotix.temperature_c;
+                if (st->seabotix.speed_motor)
+                    t.speed = clamp16(*st->seabotix.speed_motor);
+            }
+        }
+        const ThrusterCounters& c = d.counters();
+        t.nacks = static_cast<uint32_t>(c.nacks);
+        t.bad_replies = static_cast<uint32_t>(c.bad_replies);
+        t.errors = static_cast<uint32_t>(c.order_failures + c.status_failures);
+    }
+    const TeensyTelemetry& tt = teensy_.telemetry();
+    for (std::size_t k = 0; k < 3; ++k)
+        s.orientation[k] = static_cast<float>(tt.orientation[k]);
+    s.distances.assign(tt.distances.begin(), tt.distances.begin() + std::min(tt.distances.size(), dive::kMaxDistances));
+    s.bus_errors = static_cast<uint32_t>(bt.errors);
+    s.bus_recoveries = static_cast<uint32_t>(bt.recoveries);
+    return s;
+}
+
+} // namespace caracara
