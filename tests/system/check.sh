@@ -405,11 +405,22 @@ check "the daemon feeds the watchdog (WATCHDOG=1 seen within 4 s)" wait_until 4 
 
 # --- 9. the status follows the state: Kill as root, then ClearKill ------------------------------------
 c1=$(cursor)
+dbus_dives() { caracaractl dives 2>/dev/null | grep -cE '^dive-.*killed \(dbus\)$'; }
+dives_before=$(dbus_dives)
 check "root: Kill" busctl call $V $VP $V Kill
 stext=$(unit caracarad StatusText)
 info "after Kill: State=$(state) StatusText=$stext"
 status_says_killed() { unit caracarad StatusText | grep -qi killed; }
 check "the status line says killed" wait_until 2 status_says_killed
+# That Kill ended a dive (armed in section 7): the recorder wrote it under the unit's
+# LogsDirectory, as the unit's user, and caracaractl reads it back.
+one_more_dbus_dive() { [ "$(dbus_dives)" -gt "$dives_before" ]; }
+check "the dive that Kill ended is listed by caracaractl dives, ended \"killed (dbus)\"" wait_until 5 one_more_dbus_dive
+info "$(caracaractl dives 2>&1 | tail -n 3)"
+check "/var/log/caracara: caracara's, mode 0750" \
+  bash -c '[ "$(stat -c %U:%a /var/log/caracara)" = caracara:750 ]'
+check "its dive files: caracara's, mode 0640" \
+  bash -c 'f=$(ls -t /var/log/caracara/dive-*.cdive | head -n 1) && [ "$(stat -c %U:%a "$f")" = caracara:640 ]'
 check "root: ClearKill" busctl call $V $VP $V ClearKill
 check "ready again after the arming delay" wait_until 10 state_is ready
 
