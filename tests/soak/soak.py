@@ -27,6 +27,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "e2e"))
 import dbus  # noqa: E402
 
+import harness  # noqa: E402
 from harness import MOTORS, SIM, SIM_GPIO, Rig, command, poll, speed_byte  # noqa: E402
 
 KILL_OUT = 27
@@ -340,9 +341,13 @@ class Soak:
         print("soak: non-zero orders after a kill's zero %d (in flight at the kill %d), after a timeout %d" %
               (b["killed_orders"], b["in_flight_at_kill"], b["timed_out_orders"]))
         print("soak: wire log stretches dropped before they were read: %d" % self.wire_gaps)
-        print("soak: daemon pid unchanged %s; fds %d -> %d; RSS %d -> %d KiB" % (same_pid, fd0, fd1, rss0, rss1))
+        # Under an emulator (the arm64 tests under qemu-user) the RSS is qemu's, whose translation
+        # cache grows with every code path first run: shown, judged only natively.
+        emulated = bool(harness.EMULATOR)
+        print("soak: daemon pid unchanged %s; fds %d -> %d; RSS %d -> %d KiB%s" %
+              (same_pid, fd0, fd1, rss0, rss1, " (qemu's, not judged)" if emulated else ""))
         ok = (b["lost"] == 0 and b["killed_orders"] == 0 and b["timed_out_orders"] == 0 and same_pid
-              and fd1 <= fd0 + 2 and rss1 <= rss0 + 2048 and b["reached"] > 0)
+              and fd1 <= fd0 + 2 and (emulated or rss1 <= rss0 + 2048) and b["reached"] > 0)
         rig.stop_checked()
         return ok
 
