@@ -21,19 +21,24 @@ run_suite() {
   echo "== test $dir"
   ctest --test-dir "$dir" --output-on-failure -j"$jobs" --timeout 900
 }
+# Each step's wall time, so that the 30-minute budget of CI can be read from its log.
+stamp() { echo "== $1 done at $((SECONDS / 60)) min $((SECONDS % 60)) s"; }
 
 if [ "$which" = all ] || [ "$which" = normal ]; then
   run_suite "$top/build"
+  stamp "normal build"
 fi
 if [ "$which" = all ] || [ "$which" = cross ]; then
   "$top/scripts/cross_test.sh" "$top/build-arm64"
   echo "== arm64 packages"
   "$top/scripts/package.sh" arm64 "$top/build-deb"
+  stamp "arm64"
 fi
 if [ "$which" = all ] || [ "$which" = sanitize ]; then
   export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
   run_suite "$top/build-asan" -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
+  stamp "ASan+UBSan build"
 fi
 if [ "$which" = all ] || [ "$which" = fuzz ]; then
   echo "== build $top/build-fuzz (libFuzzer harnesses)"
@@ -42,4 +47,5 @@ if [ "$which" = all ] || [ "$which" = fuzz ]; then
   cmake --build "$top/build-fuzz" -j"$jobs" --target fuzzers
   echo "== fuzz $top/build-fuzz"
   ctest --test-dir "$top/build-fuzz" --output-on-failure -j2 -L fuzz
+  stamp "fuzzers"
 fi
