@@ -387,8 +387,7 @@ def sc_fatal_signal(rig):
     check(rig.sim_speeds() == [ZERO] * MOTORS, "not zeroed after the crash: %s" % rig.sim_speeds())
     _, entries = rig.wire_log(since)
     edge = next((e.index for e in entries if e.bus == "gpio" and e.addr == 27 and list(e.data) == [1]), None)
-    # Thrusters 4-7 were already at zero: their refresh orders (zero) may precede the crash.
-    zeros = [e.index for i, d, e in rig.orders(since) if d[0] == ZERO and values[i] != 0]
+    zeros = [e.index for i, d, e in rig.orders(since) if d[0] == ZERO]
     check(edge is not None, "the kill output was not set by the signal handler")
     check(zeros and edge < zeros[0], "the kill output (#%s) after the first zero order (#%s)" % (edge, zeros[:1]))
 
