@@ -13,8 +13,8 @@
 //
 // Every measuring command prints one JSON object on stdout.
 #include "bench/bench_common.hpp"
-#include "dbus/sdbus.hpp"
-#include "protocol/seabotix.hpp"
+#include "drivers/sdbus/sdbus.hpp"
+#include "drivers/protocol/seabotix.hpp"
 
 #include <array>
 #include <cerrno>

@@ -11,11 +11,11 @@
 // Prints one JSON object: cycles, seconds, rate_hz, cpu_s (CLOCK_PROCESS_CPUTIME_ID).
 #include "bench/bench_common.hpp"
 #include "core/config.hpp"
-#include "platform/i2c_dev.hpp"
-#include "platform/sim/sim_device_io.hpp"
-#include "platform/spi_dev.hpp"
-#include "devices/teensy_link.hpp"
-#include "devices/thruster_driver.hpp"
+#include "drivers/platform/i2c_dev.hpp"
+#include "drivers/platform/sim/sim_device_io.hpp"
+#include "drivers/platform/spi_dev.hpp"
+#include "drivers/devices/teensy_link.hpp"
+#include "drivers/devices/thruster_driver.hpp"
 
 #include <cstdio>
 #include <cstdlib>

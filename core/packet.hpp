@@ -1,4 +1,4 @@
-// The legacy Caracara USB packet (seeds/caracara-usb-packet.txt): 13 x int32
+// The legacy Caracara USB packet ("Caracara USB packet format"): 13 x int32
 //   [0..7]  motor0..motor7    -8850..8850
 //   [8]     killState         0 = all clear, any non-zero value = kill (motors de-energized)
 //   [9]     powerOffState     0 = not powered off, 1 = initiate power off (irreversible)

@@ -1,4 +1,4 @@
-// The safety state machine and the command watchdog (DESIGN.md "Safety semantics").
+// The safety state machine and the command watchdog (docs/architecture.md, "A kill switch edge to the wire"; README "Safety").
 // Pure logic: the owner feeds it events with the monotonic time in nanoseconds and acts on
 // the returned SafetyAction (zero the thrusters now, drop stored commands); it never
 // touches hardware itself, so every rule here is unit-tested.

@@ -1,10 +1,10 @@
 #include "daemon/bus_recovery.hpp"
 
 #include "core/clock.hpp"
-#include "platform/line_spec.hpp"
+#include "drivers/platform/line_spec.hpp"
 #include "daemon/log.hpp"
-#include "devices/i2c_bus_clear.hpp"
-#include "platform/io_error.hpp"
+#include "drivers/devices/i2c_bus_clear.hpp"
+#include "drivers/platform/io_error.hpp"
 
 #include <cerrno>
 

@@ -1,4 +1,4 @@
-// Recovering a locked I2C bus (DESIGN.md, NXP UM10204 "bus clear"): close the adapter, unbind
+// Recovering a locked I2C bus (NXP UM10204 section 3.1.16 "Bus clear"; Linux i2c_generic_scl_recovery): close the adapter, unbind
 // its platform driver, clock SCL through the GPIO lines until SDA is released and send a STOP,
 // rebind, wait for the device node, re-send the current orders (a pending kill first). Bounded
 // attempts with backoff (RecoveryPolicy); when they are used up, or the lockup outlasts the
@@ -11,9 +11,9 @@
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle.hpp"
 #include "daemon/vehicle_events.hpp"
-#include "platform/device_io.hpp"
-#include "platform/event_loop.hpp"
-#include "platform/gpio_backend.hpp"
+#include "drivers/platform/device_io.hpp"
+#include "drivers/platform/event_loop.hpp"
+#include "drivers/platform/gpio_backend.hpp"
 
 #include <cstdint>
 #include <functional>

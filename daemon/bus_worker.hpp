@@ -7,10 +7,10 @@
 // Finished jobs come back through an eventfd that the worker owns as an event source.
 #pragma once
 
-#include "devices/bus_gate.hpp"
-#include "devices/thruster_driver.hpp"
-#include "platform/event_loop.hpp"
-#include "platform/io_error.hpp"
+#include "drivers/devices/bus_gate.hpp"
+#include "drivers/devices/thruster_driver.hpp"
+#include "drivers/platform/event_loop.hpp"
+#include "drivers/platform/io_error.hpp"
 
 #include <atomic>
 #include <condition_variable>

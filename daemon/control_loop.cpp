@@ -1,7 +1,7 @@
 #include "daemon/control_loop.hpp"
 
 #include "core/clock.hpp"
-#include "platform/io_error.hpp"
+#include "drivers/platform/io_error.hpp"
 
 #include <algorithm>
 #include <poll.h>

@@ -14,7 +14,7 @@
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle.hpp"
 #include "daemon/vehicle_events.hpp"
-#include "platform/event_loop.hpp"
+#include "drivers/platform/event_loop.hpp"
 
 #include <cstdint>
 #include <string>

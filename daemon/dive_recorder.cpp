@@ -1,7 +1,7 @@
 #include "daemon/dive_recorder.hpp"
 
 #include "core/clock.hpp"
-#include "platform/dive_files.hpp"
+#include "drivers/platform/dive_files.hpp"
 
 #include <algorithm>
 #include <chrono>

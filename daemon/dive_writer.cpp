@@ -1,7 +1,7 @@
 #include "daemon/dive_writer.hpp"
 
 #include "daemon/log.hpp"
-#include "platform/dive_files.hpp"
+#include "drivers/platform/dive_files.hpp"
 
 #include <cerrno>
 #include <cstring>

@@ -1,8 +1,8 @@
 #include "daemon/safety_lines.hpp"
 
-#include "platform/line_spec.hpp"
+#include "drivers/platform/line_spec.hpp"
 #include "daemon/log.hpp"
-#include "platform/io_error.hpp"
+#include "drivers/platform/io_error.hpp"
 
 #include <sys/epoll.h>
 

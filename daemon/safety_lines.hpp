@@ -5,8 +5,8 @@
 #pragma once
 
 #include "core/config.hpp"
-#include "platform/event_loop.hpp"
-#include "platform/gpio_backend.hpp"
+#include "drivers/platform/event_loop.hpp"
+#include "drivers/platform/gpio_backend.hpp"
 
 #include <functional>
 #include <memory>

@@ -5,7 +5,7 @@
 #include "daemon/control_loop.hpp"
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle.hpp"
-#include "platform/event_loop.hpp"
+#include "drivers/platform/event_loop.hpp"
 
 #include <cstdint>
 #include <string>

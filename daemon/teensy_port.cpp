@@ -2,7 +2,7 @@
 
 #include "core/clock.hpp"
 #include "daemon/log.hpp"
-#include "platform/io_error.hpp"
+#include "drivers/platform/io_error.hpp"
 
 #include <cerrno>
 

@@ -7,11 +7,11 @@
 #include "core/status.hpp"
 #include "daemon/command_gate.hpp"
 #include "daemon/vehicle_events.hpp"
-#include "devices/teensy_link.hpp"
-#include "platform/device_io.hpp"
-#include "platform/event_loop.hpp"
-#include "platform/spi_dev.hpp"
-#include "protocol/teensy_codec.hpp"
+#include "drivers/devices/teensy_link.hpp"
+#include "drivers/platform/device_io.hpp"
+#include "drivers/platform/event_loop.hpp"
+#include "drivers/platform/spi_dev.hpp"
+#include "drivers/protocol/teensy_codec.hpp"
 
 #include <array>
 #include <cstdint>

@@ -10,10 +10,10 @@
 #include "daemon/bus_worker.hpp"
 #include "daemon/command_gate.hpp"
 #include "daemon/vehicle_events.hpp"
-#include "devices/mux_tracker.hpp"
-#include "devices/thruster_driver.hpp"
-#include "platform/device_io.hpp"
-#include "platform/i2c_dev.hpp"
+#include "drivers/devices/mux_tracker.hpp"
+#include "drivers/devices/thruster_driver.hpp"
+#include "drivers/platform/device_io.hpp"
+#include "drivers/platform/i2c_dev.hpp"
 
 #include <cstddef>
 #include <cstdint>

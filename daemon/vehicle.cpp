@@ -6,7 +6,7 @@
 
 #include "daemon/control_loop.hpp"
 #include "daemon/log.hpp"
-#include "platform/io_error.hpp"
+#include "drivers/platform/io_error.hpp"
 
 namespace caracara {
 

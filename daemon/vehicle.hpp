@@ -1,7 +1,7 @@
 // The vehicle as callers see it: the safety state machine, the commands (thrust, motion,
 // packet, kill, clear, power-off, LEDs), requested/applied values with the budget, and who
 // is commanding. Every safety action is carried out here, on the bus, the safety lines and
-// the Teensy, in the order DESIGN.md's safety semantics give.
+// the Teensy, in the order docs/architecture.md gives (kill output first, then the zeros).
 #pragma once
 
 #include "core/budget.hpp"
@@ -15,7 +15,7 @@
 #include "daemon/teensy_port.hpp"
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle_events.hpp"
-#include "platform/event_loop.hpp"
+#include "drivers/platform/event_loop.hpp"
 
 #include <array>
 #include <cstdint>

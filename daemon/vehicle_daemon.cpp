@@ -1,7 +1,7 @@
 #include "daemon/vehicle_daemon.hpp"
 
 #include "daemon/log.hpp"
-#include "platform/io_error.hpp"
+#include "drivers/platform/io_error.hpp"
 
 namespace caracara {
 

@@ -14,8 +14,8 @@
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle.hpp"
 #include "daemon/vehicle_events.hpp"
-#include "platform/device_io.hpp"
-#include "platform/gpio_backend.hpp"
+#include "drivers/platform/device_io.hpp"
+#include "drivers/platform/gpio_backend.hpp"
 
 #include <memory>
 #include <string>

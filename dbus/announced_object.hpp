@@ -2,8 +2,8 @@
 // members that a change announces.
 #pragma once
 
-#include "dbus/property.hpp"
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/property.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 
 #include <span>
 #include <string>

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "daemon/control_loop.hpp" // kAnnouncePriority
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 
 #include <cstdint>
 #include <functional>

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "daemon/vehicle.hpp"
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 
 namespace caracara::dbus {
 

@@ -2,7 +2,7 @@
 
 #include "dbus/announcer.hpp"
 #include "dbus/vehicle_names.hpp"
-#include "protocol/seabotix.hpp"
+#include "drivers/protocol/seabotix.hpp"
 
 #include <string>
 #include <vector>

@@ -6,7 +6,7 @@
 #include "dbus/announcer.hpp"
 #include "dbus/bus_object.hpp"
 #include "dbus/client_tracker.hpp"
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 #include "dbus/teensy_object.hpp"
 #include "dbus/thruster_object.hpp"
 #include "dbus/vehicle_names.hpp"

@@ -7,13 +7,13 @@
 //        [count][per thruster: mt-index, flags, mux, info][8 mux registers] the bus
 //        then operations, [op] + its bytes, to the end (make_seeds.py writes this layout).
 #include "core/thruster_config.hpp"
-#include "devices/mux_tracker.hpp"
-#include "devices/thruster_driver.hpp"
+#include "drivers/devices/mux_tracker.hpp"
+#include "drivers/devices/thruster_driver.hpp"
 #include "fuzz/byte_source.hpp"
 #include "fuzz/check.hpp"
 #include "fuzz/shadow_i2c_bus.hpp"
-#include "platform/i2c_dev.hpp"
-#include "protocol/seabotix.hpp"
+#include "drivers/platform/i2c_dev.hpp"
+#include "drivers/protocol/seabotix.hpp"
 
 #include <algorithm>
 #include <cstdlib>

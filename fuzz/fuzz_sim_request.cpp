@@ -1,4 +1,4 @@
-// The simulator's device-protocol request decoder (protocol/sim_protocol.hpp) as the device
+// The simulator's device-protocol request decoder (drivers/protocol/sim_protocol.hpp) as the device
 // server runs it: DeviceOps::handle against a whole simulated vehicle, fed a sequence of
 // requests from one client, as any local peer of the socket could send them. Each request's
 // layout is worked out again here from the protocol's description, independently of the
@@ -11,7 +11,7 @@
 // a request the server received truncated.
 #include "fuzz/byte_source.hpp"
 #include "fuzz/check.hpp"
-#include "protocol/sim_protocol.hpp"
+#include "drivers/protocol/sim_protocol.hpp"
 #include "sim/device_ops.hpp"
 #include "sim/device_session.hpp"
 #include "sim/sim_config.hpp"

@@ -6,13 +6,13 @@
 // Input: [command][len][reply bytes]                                   the pure reply decoder
 //        [flags][busy retries][servos][sensors]                        the link's configuration
 //        then operations, [op] + its bytes, to the end (make_seeds.py writes this layout).
-#include "devices/teensy_link.hpp"
+#include "drivers/devices/teensy_link.hpp"
 #include "fuzz/byte_source.hpp"
 #include "fuzz/check.hpp"
 #include "fuzz/shadow_spi_bus.hpp"
-#include "platform/spi_dev.hpp"
-#include "protocol/confirm_handshake.hpp"
-#include "protocol/teensy_codec.hpp"
+#include "drivers/platform/spi_dev.hpp"
+#include "drivers/protocol/confirm_handshake.hpp"
+#include "drivers/protocol/teensy_codec.hpp"
 
 #include <algorithm>
 #include <bit>

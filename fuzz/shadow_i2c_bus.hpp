@@ -7,7 +7,7 @@
 #include "core/thruster_config.hpp"
 #include "fuzz/byte_source.hpp"
 #include "fuzz/check.hpp"
-#include "platform/device_io.hpp"
+#include "drivers/platform/device_io.hpp"
 
 #include <array>
 #include <cerrno>

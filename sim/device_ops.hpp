@@ -1,9 +1,9 @@
-// The device protocol's operations (protocol/sim_protocol.hpp), one handler each in a table
+// The device protocol's operations (drivers/protocol/sim_protocol.hpp), one handler each in a table
 // indexed by the request's op, served against the simulated vehicle: what the kernel's
 // i2c-dev, spidev, sysfs and GPIO character device do with the same requests.
 #pragma once
 
-#include "protocol/sim_protocol.hpp"
+#include "drivers/protocol/sim_protocol.hpp"
 #include "sim/device_session.hpp"
 #include "sim/vehicle.hpp"
 

@@ -1,6 +1,6 @@
 #include "sim/device_server.hpp"
 
-#include "protocol/sim_protocol.hpp"
+#include "drivers/protocol/sim_protocol.hpp"
 
 #include <cerrno>
 #include <cstring>

@@ -1,10 +1,10 @@
-// Serves the device protocol (protocol/sim_protocol.hpp) on a Unix SOCK_SEQPACKET socket:
+// Serves the device protocol (drivers/protocol/sim_protocol.hpp) on a Unix SOCK_SEQPACKET socket:
 // the simulator's stand-in for the kernel's i2c-dev and spidev. The socket, its clients and
 // the reply timing live here; what each request does is DeviceOps'.
 #pragma once
 
-#include "dbus/sdbus.hpp"
-#include "protocol/sim_protocol.hpp"
+#include "drivers/sdbus/sdbus.hpp"
+#include "drivers/protocol/sim_protocol.hpp"
 #include "sim/device_ops.hpp"
 #include "sim/device_session.hpp"
 #include "sim/vehicle.hpp"

@@ -9,7 +9,7 @@
 #pragma once
 
 #include "sim/i2c_bus_model.hpp"
-#include "protocol/sim_protocol.hpp"
+#include "drivers/protocol/sim_protocol.hpp"
 #include "sim/wire_log.hpp"
 
 #include <cstdint>

@@ -7,7 +7,7 @@
 // its own sim/inspect_*.cpp.
 #pragma once
 
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 #include "sim/vehicle.hpp"
 
 #include <vector>

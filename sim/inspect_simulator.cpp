@@ -1,7 +1,7 @@
 #include "sim/inspect_simulator.hpp"
 
 #include "core/clock.hpp"
-#include "dbus/property.hpp"
+#include "drivers/sdbus/property.hpp"
 #include "sim/device_server.hpp"
 #include "sim/inspect.hpp"
 

@@ -1,6 +1,6 @@
 #include "sim/inspect_teensy.hpp"
 
-#include "dbus/property.hpp"
+#include "drivers/sdbus/property.hpp"
 #include "sim/inspect.hpp"
 
 #include <string>

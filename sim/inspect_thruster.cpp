@@ -1,6 +1,6 @@
 #include "sim/inspect_thruster.hpp"
 
-#include "dbus/property.hpp"
+#include "drivers/sdbus/property.hpp"
 #include "sim/inspect.hpp"
 #include "sim/thruster_model.hpp"
 

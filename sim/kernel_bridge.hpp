@@ -6,7 +6,7 @@
 // device socket does. Protocol: sim/kernel_bridge_abi.h, docs/kernel-bridge.md.
 #pragma once
 
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 #include "sim/sim_config.hpp"
 #include "sim/vehicle.hpp"
 

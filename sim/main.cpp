@@ -1,13 +1,13 @@
 // caracara-sim: plays the Caracara vehicle's hardware for caracarad (device protocol on a
 // Unix socket) and for people and tests (org.caracara.Simulator1 on D-Bus).
 #include "core/dive_format.hpp"
-#include "platform/dive_files.hpp"
+#include "drivers/platform/dive_files.hpp"
 #include "sim/device_server.hpp"
 #include "sim/dive_replay.hpp"
-#include "platform/io_error.hpp"
+#include "drivers/platform/io_error.hpp"
 #include "sim/inspect.hpp"
 #include "sim/kernel_bridge.hpp"
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 #include "sim/sim_config.hpp"
 #include "sim/vehicle.hpp"
 

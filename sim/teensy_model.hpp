@@ -1,5 +1,5 @@
 // The simulated Teensy I/O microcontroller: an SPI slave speaking the seed protocol
-// (seeds/raspi-teensy-spi-protocol.md) plus this vehicle's extension (0x09 Set LEDs).
+// ("Raspberry Pi - Teensy SPI protocol" documentation) plus this vehicle's extension (0x09 Set LEDs).
 //
 // It works byte by byte, as the Teensy's SPI interrupt does: a frame is
 // [command][data 0-4][answer 0-4][ack]; the command byte alone tells the slave how many data

@@ -2,7 +2,7 @@
 // to exit codes, and a generic decoder for property values.
 #pragma once
 
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 #include "dbus/vehicle_names.hpp"
 #include "tools/ssh_stderr.hpp"
 

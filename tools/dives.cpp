@@ -2,8 +2,8 @@
 
 #include "core/dive_format.hpp"
 #include "core/safety.hpp"
-#include "platform/dive_files.hpp"
-#include "protocol/seabotix.hpp"
+#include "drivers/platform/dive_files.hpp"
+#include "drivers/protocol/seabotix.hpp"
 #include "tools/client.hpp"
 #include "tools/render.hpp"
 

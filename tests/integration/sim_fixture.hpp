@@ -2,7 +2,7 @@
 // small sd-bus helpers to read the simulator's inspection API. Nothing here is mocked.
 #pragma once
 
-#include "dbus/sdbus.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 
 #include <cstdint>
 #include <functional>

@@ -1,9 +1,9 @@
 // The device seam against the real simulator: the i2c-dev marshalling code, the errno the
 // kernel would return, and the simulator's robustness against bad input.
-#include "platform/i2c_dev.hpp"
-#include "platform/sim/sim_device_io.hpp"
+#include "drivers/platform/i2c_dev.hpp"
+#include "drivers/platform/sim/sim_device_io.hpp"
 #include "tests/integration/sim_fixture.hpp"
-#include "protocol/sim_protocol.hpp"
+#include "drivers/protocol/sim_protocol.hpp"
 
 #include "tests/catch.hpp"
 #include <cerrno>

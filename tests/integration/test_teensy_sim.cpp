@@ -1,10 +1,10 @@
 // The Teensy link through the real spidev marshalling code against the simulated Teensy,
 // checked through the simulator's inspection API.
-#include "platform/sim/sim_device_io.hpp"
+#include "drivers/platform/sim/sim_device_io.hpp"
 #include "tests/integration/sim_fixture.hpp"
-#include "platform/spi_dev.hpp"
-#include "protocol/teensy_codec.hpp"
-#include "devices/teensy_link.hpp"
+#include "drivers/platform/spi_dev.hpp"
+#include "drivers/protocol/teensy_codec.hpp"
+#include "drivers/devices/teensy_link.hpp"
 
 #include "tests/catch.hpp"
 #include <cmath>

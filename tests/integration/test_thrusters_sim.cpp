@@ -1,11 +1,11 @@
 // The SeaBotix driver through the real i2c-dev marshalling code against caracara-sim,
 // checked on the simulator's side of the wire.
-#include "platform/i2c_dev.hpp"
-#include "protocol/seabotix.hpp"
-#include "platform/linux/linux_device_io.hpp"
-#include "platform/sim/sim_device_io.hpp"
+#include "drivers/platform/i2c_dev.hpp"
+#include "drivers/protocol/seabotix.hpp"
+#include "drivers/platform/linux/linux_device_io.hpp"
+#include "drivers/platform/sim/sim_device_io.hpp"
 #include "tests/integration/sim_fixture.hpp"
-#include "devices/thruster_driver.hpp"
+#include "drivers/devices/thruster_driver.hpp"
 
 #include "tests/catch.hpp"
 #include <memory>

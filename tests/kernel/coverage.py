@@ -15,7 +15,7 @@ import subprocess
 import sys
 import tempfile
 
-FILES = ["platform/linux/*.cpp", "platform/i2c_dev.cpp", "platform/spi_dev.cpp", "devices/i2c_bus_clear.cpp"]
+FILES = ["drivers/platform/linux/*.cpp", "drivers/platform/i2c_dev.cpp", "drivers/platform/spi_dev.cpp", "drivers/devices/i2c_bus_clear.cpp"]
 
 
 def main():
@@ -28,8 +28,12 @@ def main():
         for src in sources:
             rel = os.path.relpath(src, top)
             name = os.path.basename(src)
-            # CMake's object of platform/linux/x.cpp: <build>/platform/CMakeFiles/<target>.dir/linux/x.cpp.gcno
-            top_dir, rest = rel.split(os.sep, 1)
+            # CMake's object of drivers/platform/linux/x.cpp:
+            # <build>/drivers/platform/CMakeFiles/<target>.dir/linux/x.cpp.gcno (the folder of its CMakeLists.txt)
+            top_dir = os.path.dirname(rel)
+            while not os.path.exists(os.path.join(top, top_dir, "CMakeLists.txt")):
+                top_dir = os.path.dirname(top_dir)
+            rest = os.path.relpath(rel, top_dir)
             cands = [g for g in glob.glob(os.path.join(build, top_dir, "CMakeFiles", "*.dir", rest + ".gcno"))]
             if not cands:
                 print("%-34s no .gcno" % rel)

@@ -3,8 +3,8 @@
 // cannot be found or opened fails the request with the line's description in the error.
 // Requests on a real chip (modes, active-low, edges, lookups, consumer) are covered by the QEMU
 // kernel test: CTest `kernel` for this build, `system_debian13` for the libgpiod 2 build.
-#include "platform/gpio_line.hpp"
-#include "platform/linux/libgpiod_backend.hpp"
+#include "drivers/platform/gpio_line.hpp"
+#include "drivers/platform/linux/libgpiod_backend.hpp"
 #include "tests/catch.hpp"
 
 #include <string>

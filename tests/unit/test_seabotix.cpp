@@ -2,8 +2,8 @@
 // from the IDS (section 8) and the Caracara packet seed; the arithmetic is next to each one.
 // The driver itself runs against caracara-sim in tests/integration/test_thrusters_sim.cpp.
 #include "core/thruster_config.hpp"
-#include "protocol/pca9544a.hpp"
-#include "protocol/seabotix.hpp"
+#include "drivers/protocol/pca9544a.hpp"
+#include "drivers/protocol/seabotix.hpp"
 
 #include "tests/catch.hpp"
 #include <cerrno>

@@ -1,5 +1,5 @@
-#include "platform/io_error.hpp"
-#include "protocol/sim_protocol.hpp"
+#include "drivers/platform/io_error.hpp"
+#include "drivers/protocol/sim_protocol.hpp"
 
 #include "tests/catch.hpp"
 #include <cerrno>

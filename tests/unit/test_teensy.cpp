@@ -1,8 +1,8 @@
 // Teensy SPI link: codec vectors worked by hand, reply classification, the retry decision,
 // the Confirm handshake, and SpiDev / TeensyLink over an in-process fake of the device seam.
-#include "platform/spi_dev.hpp"
-#include "protocol/teensy_codec.hpp"
-#include "devices/teensy_link.hpp"
+#include "drivers/platform/spi_dev.hpp"
+#include "drivers/protocol/teensy_codec.hpp"
+#include "drivers/devices/teensy_link.hpp"
 
 #include <algorithm>
 #include "tests/catch.hpp"
