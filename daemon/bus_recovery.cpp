@@ -17,12 +17,13 @@ constexpr uint64_t kReopenNs = 1'000'000'000;
 } // namespace
 
 BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio,
-                         ThrusterBus& bus, Vehicle& vehicle, VehicleEvents& events)
+                         ThrusterBus& bus, ControlLoop& loop, Vehicle& vehicle, VehicleEvents& events)
     : event_(event),
       config_(config),
       io_(io),
       gpio_(gpio),
       bus_(bus),
+      loop_(loop),
       vehicle_(vehicle),
       events_(events),
       policy_(config.recovery.attempts, config.recovery.backoff_ms) {}
@@ -86,10 +87,9 @@ void BusRecovery::reopen() {
     bus_.mux().invalidate();
     // Quietly: one line when it went, one when it is back (ThrusterBus::note). The emergency
     // stop's connection to the node is renewed with it (a restarted simulator).
-    if (release_node_holders_)
-        release_node_holders_();
-    if (bus_.open() == 0 && reopen_node_holders_)
-        reopen_node_holders_();
+    release_node_holder();
+    if (bus_.open() == 0)
+        reopen_node_holder();
     schedule(kReopenNs);
 }
 
@@ -142,8 +142,8 @@ void BusRecovery::attempt() {
     bus_.close(); // before unbinding: the driver cannot go while the node is open
     bus_.mux().invalidate();
     const bool rebind = !rc.driver_id.empty();
-    if (rebind && release_node_holders_)
-        release_node_holders_(); // nor while anyone else has it open (found on a real kernel)
+    if (rebind)
+        release_node_holder(); // nor while anyone else has it open (found on a real kernel)
     if (rebind) {
         if (int r = sysfs_write(io_, rc.unbind_path, rc.driver_id); r < 0 && r != -ENODEV)
             log_warning("unbinding %s via %s: %s", rc.driver_id.c_str(), rc.unbind_path.c_str(), errno_name(-r).c_str());
@@ -168,8 +168,7 @@ void BusRecovery::attempt() {
 void BusRecovery::wait_node() {
     const int r = bus_.open();
     if (r == 0) {
-        if (reopen_node_holders_)
-            reopen_node_holders_();
+        reopen_node_holder();
         finish();
         return;
     }
@@ -185,8 +184,7 @@ void BusRecovery::finish() {
     // The current orders go out at once (zeros while the vehicle may not drive). Still flagged
     // as recovering, so these transfers decide the outcome (verify) instead of starting a new
     // recovery.
-    for (size_t i = 0; i < bus_.size(); ++i)
-        bus_.send_order(i, vehicle_.order_value(i));
+    loop_.resend_orders();
     phase_ = Phase::Verifying;
     schedule(kIdlePollNs);
 }
@@ -216,6 +214,18 @@ void BusRecovery::verify() {
                tm.last_recovery_ms, policy_.attempt());
     events_.bus_restored(last_pulses_, tm.last_recovery_ms);
     events_.changed(kChangeBus | (was_lost ? kChangeState : 0u));
+}
+
+void BusRecovery::release_node_holder() {
+    if (node_holder_)
+        node_holder_->release();
+}
+
+void BusRecovery::reopen_node_holder() {
+    if (!node_holder_)
+        return;
+    if (std::string why = node_holder_->reopen(); !why.empty())
+        log_warning("emergency stop not re-armed: %s", why.c_str());
 }
 
 void BusRecovery::failed(const std::string& why) {

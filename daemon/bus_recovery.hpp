@@ -8,15 +8,16 @@
 
 #include "core/config.hpp"
 #include "core/recovery_policy.hpp"
+#include "daemon/control_loop.hpp"
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle.hpp"
 #include "daemon/vehicle_events.hpp"
+#include "drivers/devices/i2c_node_holder.hpp"
 #include "drivers/platform/device_io.hpp"
 #include "drivers/platform/event_loop.hpp"
 #include "drivers/platform/gpio_backend.hpp"
 
 #include <cstdint>
-#include <functional>
 #include <string>
 
 namespace caracara {
@@ -24,16 +25,12 @@ namespace caracara {
 class BusRecovery final : public ThrusterBus::Listener {
 public:
     BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio, ThrusterBus& bus,
-                Vehicle& vehicle, VehicleEvents& events);
+                ControlLoop& loop, Vehicle& vehicle, VehicleEvents& events);
 
     void bus_locked_up(const std::string& reason) override;
-    // Other holders of the I2C node (the emergency stop's connection) that must let go of it
-    // while the driver is unbound, and may take it again once it is back: the kernel's
-    // i2c_del_adapter() waits for every open /dev/i2c-N, so the unbind would never return.
-    void set_node_holders(std::function<void()> release, std::function<void()> reopen) {
-        release_node_holders_ = std::move(release);
-        reopen_node_holders_ = std::move(reopen);
-    }
+    // The other holder of the I2C node (the emergency stop's connection), let go of while the
+    // driver is unbound and taken again once it is back. Null: none.
+    void set_node_holder(I2cNodeHolder* holder) { node_holder_ = holder; }
     void stop() {
         timer_.reset();
         lost_timer_.reset();
@@ -49,6 +46,8 @@ private:
     void verify(); // once the re-sent orders are done: did any thruster answer?
     void reopen(); // lost without recovery configured: the adapter's node opened anew
     void failed(const std::string& why);
+    void release_node_holder();
+    void reopen_node_holder();
     // The thrusters cannot be reached: the vehicle is killed (source bus) and stays so.
     void declare_lost(const std::string& why);
     static int on_lost_timer(sd_event_source*, uint64_t usec, void* userdata);
@@ -58,6 +57,7 @@ private:
     DeviceIo& io_;
     GpioBackend& gpio_;
     ThrusterBus& bus_;
+    ControlLoop& loop_; // the orders standing now, re-sent once the bus is back
     Vehicle& vehicle_;
     VehicleEvents& events_;
     RecoveryPolicy policy_;
@@ -66,8 +66,7 @@ private:
     uint32_t last_pulses_ = 0;
     SourcePtr timer_;
     SourcePtr lost_timer_; // a lockup longer than the command timeout is a lost bus
-    std::function<void()> release_node_holders_;
-    std::function<void()> reopen_node_holders_;
+    I2cNodeHolder* node_holder_ = nullptr;
 };
 
 } // namespace caracara

@@ -28,6 +28,10 @@ namespace caracara {
 
 enum class BusJobKind : uint8_t { Order, Status };
 
+// Where zero orders go: in front of everything queued, which is dropped (a kill), or behind
+// it (a command timeout or a client that left: what it had sent goes out first).
+enum class ZeroOrder { First, Behind };
+
 struct BusJob {
     BusJobKind kind = BusJobKind::Order;
     uint32_t index = 0;

@@ -16,7 +16,14 @@ constexpr int kTransactionsPerDispatch = 32;
 
 ControlLoop::ControlLoop(sd_event* event, const ControlSettings& settings, Vehicle& vehicle, ThrusterBus& bus,
                          TeensyPort& teensy, SafetyLines& lines, VehicleEvents& events)
-    : event_(event), settings_(settings), vehicle_(vehicle), bus_(bus), teensy_(teensy), lines_(lines), events_(events) {}
+    : event_(event),
+      settings_(settings),
+      vehicle_(vehicle),
+      bus_(bus),
+      teensy_(teensy),
+      lines_(lines),
+      events_(events),
+      schedule_(bus.size()) {}
 
 std::string ControlLoop::start() {
     sd_event_source* s = nullptr;
@@ -118,7 +125,7 @@ int ControlLoop::on_work(sd_event_source*, void* userdata) {
 void ControlLoop::bus_done(const BusJob& job) {
     if (!started_ || !bus_.idle())
         return; // more of a kill's zeros to come
-    if (job.kind == BusJobKind::Order && !bus_.schedule().any_order_due())
+    if (job.kind == BusJobKind::Order && !schedule_.any_order_due())
         step_aside(); // the orders are out: announce, then the rest
     else
         schedule_work();
@@ -161,16 +168,21 @@ void ControlLoop::cycle() {
     }
     ++cycles_;
     in_cycle_ = true;
-    bus_.schedule().start_cycle(settings_.status_reads_per_tick, teensy_.is_open());
+    schedule_.start_cycle(settings_.status_reads_per_tick, teensy_.is_open());
     schedule_work();
     publish_telemetry_if_due(t);
 }
 
 ControlLoop::Work ControlLoop::work_one() {
-    const OrderSchedule::Item item = bus_.schedule().next(!bus_.recovering());
+    // While the bus is closed for recovery nothing is due on it: the recovery re-sends every
+    // order when it is back (resend_orders), and the next cycle marks the rest again.
+    const bool bus_usable = !bus_.recovering();
+    if (!bus_usable)
+        schedule_.drop_bus_work();
+    const OrderSchedule::Item item = schedule_.next(bus_usable);
     switch (item.kind) {
     case OrderSchedule::Kind::Order:
-        bus_.send_order(item.index, vehicle_.order_value(item.index));
+        bus_.send_order(item.index, orders_[item.index]);
         return Work::Transfer;
     case OrderSchedule::Kind::Status:
         bus_.read_status(item.index);
@@ -182,6 +194,35 @@ ControlLoop::Work ControlLoop::work_one() {
     }
     // The cycle ends once its transfers are done too.
     return bus_.idle() ? Work::None : Work::Waiting;
+}
+
+void ControlLoop::demand_changed(const MotorValues& orders) {
+    bool any_due = false;
+    for (size_t i = 0; i < bus_.size() && i < kMotorCount; ++i)
+        if (orders[i] != orders_[i] || bus_.ordered_value(i) != orders[i]) {
+            schedule_.mark_order(i);
+            any_due = true;
+        }
+    orders_ = orders;
+    if (any_due)
+        schedule_work();
+}
+
+void ControlLoop::zero_all(ZeroOrder where) {
+    // Behind: a command the client had sent reaches the wire before its zeros, so a one-shot
+    // `busctl call` moves the thrusters for a moment, whether or not its disconnect arrives
+    // before the loop sent the orders.
+    if (where == ZeroOrder::Behind)
+        for (size_t i = 0; !bus_.recovering() && schedule_.pop_order(i);)
+            bus_.send_order(i, orders_[i]);
+    orders_.fill(0);
+    schedule_.drop_orders();
+    bus_.zero_all(where);
+}
+
+void ControlLoop::resend_orders() {
+    for (size_t i = 0; i < bus_.size() && i < kMotorCount; ++i)
+        bus_.send_order(i, orders_[i]);
 }
 
 bool ControlLoop::healthy(uint64_t now_ns) const {

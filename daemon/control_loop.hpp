@@ -1,4 +1,5 @@
-// The control loop's event sources and their priorities. A tick at the loop rate starts a
+// The control loop: the one owner of the order schedule and of the orders standing now (handed
+// down by Vehicle as a DemandListener), and its event sources and their priorities. A tick at the loop rate starts a
 // cycle (safety timeouts, every order refreshed, status reads, the Teensy's slot); the bus
 // work runs below D-Bus: each I2C transfer is handed to the bus worker's thread (one at a
 // time, so a new command's order is next in line) and the loop goes on serving D-Bus, the
@@ -8,6 +9,8 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "core/order_schedule.hpp"
+#include "daemon/demand_listener.hpp"
 #include "daemon/input_probe.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/teensy_port.hpp"
@@ -27,7 +30,7 @@ namespace caracara {
 inline constexpr int64_t kWorkPriority = SD_EVENT_PRIORITY_NORMAL + 10;
 inline constexpr int64_t kAnnouncePriority = kWorkPriority + 1;
 
-class ControlLoop {
+class ControlLoop final : public DemandListener {
 public:
     ControlLoop(sd_event* event, const ControlSettings& settings, Vehicle& vehicle, ThrusterBus& bus,
                 TeensyPort& teensy, SafetyLines& lines, VehicleEvents& events);
@@ -40,6 +43,14 @@ public:
     void schedule_work();
     // A transfer handed to the bus worker is over (ThrusterBus's done callback).
     void bus_done(const BusJob& job);
+
+    // Marks due at once the orders that changed or are not on the wire: they go out now, one
+    // transaction per loop iteration, not at the next tick; an unchanged one is refreshed by it.
+    void demand_changed(const MotorValues& orders) override;
+    void zero_all(ZeroOrder where) override;
+    // Every thruster's standing order, now: a recovered bus (BusRecovery) does not know what
+    // the thrusters were last told.
+    void resend_orders();
 
     uint64_t cycles() const { return cycles_; }
     // Healthy = a cycle completed recently (fed to the systemd watchdog).
@@ -65,6 +76,9 @@ private:
     SafetyLines& lines_;
     VehicleEvents& events_;
     const InputProbe* input_ = nullptr;
+
+    OrderSchedule schedule_;
+    MotorValues orders_{}; // what each thruster is to be ordered (Vehicle's last demand_changed)
 
     SourcePtr tick_source_;
     SourcePtr work_source_;

@@ -163,14 +163,8 @@ int main(int argc, char** argv) {
         else if (std::string e = estop.arm(std::move(panic_hw.io), cr.config->i2c.device, cr.config->thrusters, cr.config->spi); !e.empty())
             log_warning("emergency stop not armed: %s", e.c_str());
         else {
-            daemon.bus().set_crash_gate(&estop.bus_gate());
+            daemon.attach_emergency_stop(estop);
             EmergencyStop::install_fatal_handlers(&estop);
-            daemon.lines().set_kill_output_watcher([&estop](GpioLine* line) { estop.set_kill_output(line); });
-            daemon.recovery().set_node_holders([&estop] { estop.release(); },
-                                               [&estop] {
-                                                   if (std::string why = estop.reopen(); !why.empty())
-                                                       log_warning("emergency stop not re-armed: %s", why.c_str());
-                                               });
         }
     }
 
@@ -200,7 +194,7 @@ int main(int argc, char** argv) {
     int r = sd_event_loop(event.get());
     if (r > 0) // only sd-bus's exit on disconnect leaves the loop with a failure status
         log_error("lost its connection to the bus: thrusters to zero, exiting");
-    daemon.events().attach(static_cast<VehicleObserver*>(nullptr));
+    daemon.events().attach(nullptr);
     daemon.shutdown();
     EmergencyStop::install_fatal_handlers(nullptr);
     daemon.status().stopping();

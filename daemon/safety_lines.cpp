@@ -55,7 +55,7 @@ std::string SafetyLines::open_switch() {
 
 void SafetyLines::close() {
     if (kill_output_watcher_)
-        kill_output_watcher_(nullptr);
+        kill_output_watcher_->set_kill_output(nullptr);
     kill_switch_source_.reset();
     reopen_timer_.reset();
 }
@@ -140,7 +140,7 @@ int SafetyLines::on_reopen(sd_event_source*, uint64_t, void* userdata) {
 
 void SafetyLines::output_lost(std::unique_ptr<GpioLine>& line, const char* what, int err) {
     if (&line == &kill_out_ && kill_output_watcher_)
-        kill_output_watcher_(nullptr);
+        kill_output_watcher_->set_kill_output(nullptr);
     line.reset();
     log_error("%s cannot be written (%s): vehicle killed; asking for it again once a second", what,
               errno_name(-err).c_str());

@@ -5,10 +5,10 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "drivers/devices/kill_output_watcher.hpp"
 #include "drivers/platform/event_loop.hpp"
 #include "drivers/platform/gpio_backend.hpp"
 
-#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -41,8 +41,8 @@ public:
     void assert_power_off();
     // Told the kill output line whenever it changes (null before it goes): the fatal-signal
     // emergency stop writes it first.
-    void set_kill_output_watcher(std::function<void(GpioLine*)> fn) {
-        kill_output_watcher_ = std::move(fn);
+    void set_kill_output_watcher(KillOutputWatcher* watcher) {
+        kill_output_watcher_ = watcher;
         kill_output_changed();
     }
     // The switch's event fd (for the loop's "is anything waiting" check), or -1.
@@ -71,10 +71,10 @@ private:
     SourcePtr kill_switch_source_;
     SourcePtr reopen_timer_;
     bool kill_asserted_ = true; // what the kill output should show (for a reopened line)
-    std::function<void(GpioLine*)> kill_output_watcher_;
+    KillOutputWatcher* kill_output_watcher_ = nullptr;
     void kill_output_changed() {
         if (kill_output_watcher_)
-            kill_output_watcher_(kill_out_.get());
+            kill_output_watcher_->set_kill_output(kill_out_.get());
     }
 };
 

@@ -5,6 +5,7 @@
 #include "daemon/control_loop.hpp"
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle.hpp"
+#include "daemon/vehicle_observer.hpp"
 #include "drivers/platform/event_loop.hpp"
 
 #include <cstdint>
@@ -12,12 +13,17 @@
 
 namespace caracara {
 
-class ServiceStatus {
+class ServiceStatus final : public VehicleObserver {
 public:
     ServiceStatus(sd_event* event, const Vehicle& vehicle, const ThrusterBus& bus, const ControlLoop& loop)
         : event_(event), vehicle_(vehicle), bus_(bus), loop_(loop) {}
 
     void publish() const;
+    // A change of state, bus, profile or faults shows on the STATUS= line.
+    void vehicle_changed(uint32_t changes) override {
+        if (changes & (kChangeState | kChangeBus | kChangeProfile | kChangeFaults))
+            publish();
+    }
     // Starts feeding the watchdog if systemd asked for one (WatchdogSec=).
     void start_watchdog();
     void ready(const char* bus_name) const;

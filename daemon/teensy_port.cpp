@@ -183,7 +183,7 @@ Result TeensyPort::distance(int sensor, uint16_t& mm) {
 }
 
 Result TeensyPort::turn(double radians, bool absolute, std::string_view client,
-                        std::function<void(const Result&)> done) {
+                        Completion done) {
     if (Result r = gate_.state_error(); !r.ok())
         return r;
     if (turn_done_)

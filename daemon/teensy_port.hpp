@@ -6,6 +6,7 @@
 #include "core/config.hpp"
 #include "core/status.hpp"
 #include "daemon/command_gate.hpp"
+#include "daemon/completion.hpp"
 #include "daemon/vehicle_events.hpp"
 #include "drivers/devices/teensy_link.hpp"
 #include "drivers/platform/device_io.hpp"
@@ -55,7 +56,7 @@ public:
     Result distance(int sensor, uint16_t& mm);
     // Starts a Turn (relative) or Turn to (absolute); `done` runs when the Teensy confirms
     // completion, or on failure. Returns an error at once if it cannot start.
-    Result turn(double radians, bool absolute, std::string_view client, std::function<void(const Result&)> done);
+    Result turn(double radians, bool absolute, std::string_view client, Completion done);
 
     const TeensyTelemetry& telemetry() const { return tm_; }
     const TeensyLinkCounters& counters() const { return link_.counters(); }
@@ -81,7 +82,7 @@ private:
     bool wheels_moving_ = false;
     unsigned poll_index_ = 0;
     teensy::ConfirmHandshake handshake_;
-    std::function<void(const Result&)> turn_done_;
+    Completion turn_done_;
     SourcePtr turn_source_;
     SourcePtr reopen_timer_;
 };

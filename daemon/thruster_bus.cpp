@@ -33,7 +33,6 @@ ThrusterBus::ThrusterBus(DeviceIo& io, const DaemonConfig& config, VehicleEvents
       worker_(thrusters_),
       ordered_(config.thrusters.size(), 0),
       faults_(config.thrusters.size()),
-      schedule_(config.thrusters.size()),
       lockup_(static_cast<uint32_t>(kMotorCount)),
       failed_in_row_(config.thrusters.size(), 0),
       unreachable_(config.thrusters.size(), false) {}
@@ -49,7 +48,6 @@ void ThrusterBus::send_order(std::size_t i, int32_t value) {
 }
 
 void ThrusterBus::zero_all(ZeroOrder where) {
-    schedule_.drop_orders();
     std::array<BusJob, kMotorCount> zeros{};
     const std::size_t n = std::min(thrusters_.size(), zeros.size());
     for (std::size_t i = 0; i < n; ++i) {
@@ -110,10 +108,9 @@ void ThrusterBus::report_faults(std::size_t i) {
 
 void ThrusterBus::set_recovering(bool r) {
     recovering_ = r;
-    if (r) {
-        schedule_.drop_bus_work();
+    if (r)
         worker_.drop_queued(); // the adapter is about to close; what is on the wire finishes
-    } else
+    else
         lockup_.reset();
 }
 

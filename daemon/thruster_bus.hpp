@@ -1,12 +1,11 @@
 // The I2C bus to the thrusters: the adapter, the PCA9544A state, one driver per thruster,
-// the schedule of what goes on the wire next, lockup detection and the bus's telemetry.
+// lockup detection and the bus's telemetry.
 // The transfers themselves run on the BusWorker's thread; every outcome comes back to the
 // loop thread through note(), which spots a locked bus and tells the listener (BusRecovery).
 #pragma once
 
 #include "core/config.hpp"
 #include "core/lockup_detector.hpp"
-#include "core/order_schedule.hpp"
 #include "daemon/bus_worker.hpp"
 #include "daemon/command_gate.hpp"
 #include "daemon/vehicle_events.hpp"
@@ -48,10 +47,6 @@ public:
         virtual ~Listener() = default;
         virtual void bus_locked_up(const std::string& reason) = 0;
     };
-    // Where a kill's zero orders go: in front of everything queued (dropping it), or behind
-    // it (a command timeout or a client that left: what it had sent goes out first).
-    enum class ZeroOrder { First, Behind };
-
     ThrusterBus(DeviceIo& io, const DaemonConfig& config, VehicleEvents& events);
 
     // The adapter is opened and closed only while the worker is idle (see BusWorker).
@@ -89,7 +84,6 @@ public:
     // Runs `fn` once the transfers handed over so far are done (at once when idle).
     void when_idle(std::function<void()> fn);
 
-    OrderSchedule& schedule() { return schedule_; }
     // While recovering, the adapter is closed on purpose: no bus work, and failures say nothing.
     bool recovering() const { return recovering_; }
     void set_recovering(bool r);
@@ -121,7 +115,6 @@ private:
     BusWorker worker_;
     std::vector<int32_t> ordered_;
     std::vector<FaultSet> faults_;
-    OrderSchedule schedule_;
     LockupDetector lockup_;
     BusTelemetry tm_;
     bool recovering_ = false;

@@ -4,7 +4,6 @@
 #include "core/packet.hpp"
 #include "core/status_of.hpp"
 
-#include "daemon/control_loop.hpp"
 #include "daemon/log.hpp"
 #include "drivers/platform/io_error.hpp"
 
@@ -56,7 +55,7 @@ void Vehicle::handle(const SafetyAction& a) {
     if (a.zero_outputs) {
         // A kill's zeros go before anything queued; a timeout's or a departed client's go
         // behind what that client had sent.
-        bus_.zero_all(safety_.kill_output_asserted() ? ThrusterBus::ZeroOrder::First : ThrusterBus::ZeroOrder::Behind);
+        orders_->zero_all(safety_.kill_output_asserted() ? ZeroOrder::First : ZeroOrder::Behind);
         // The wheels are motors too. A kill or power-off stops them itself, and tells a
         // running turn why.
         if (!safety_.kill_output_asserted())
@@ -108,17 +107,11 @@ int Vehicle::on_deadline(sd_event_source*, uint64_t, void* userdata) {
     return 0;
 }
 
-void Vehicle::orders_due(const MotorValues& before, const MotorValues& next) {
-    // The changed orders go out now, one transaction per loop iteration, not at the next tick;
-    // an unchanged one is already on the wire and refreshed by the tick.
-    bool any_due = false;
+void Vehicle::demand_changed() {
+    MotorValues orders{};
     for (size_t i = 0; i < kMotorCount; ++i)
-        if (before[i] != next[i] || bus_.ordered_value(i) != next[i]) {
-            bus_.schedule().mark_order(i);
-            any_due = true;
-        }
-    if (any_due && loop_)
-        loop_->schedule_work();
+        orders[i] = order_value(i);
+    orders_->demand_changed(orders);
 }
 
 Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
@@ -132,10 +125,9 @@ Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std
     if (!a.ok())
         return state_error();
     arm_deadline();
-    const MotorValues before = demand_.applied();
     // A stream re-sending the same command changes nothing worth announcing.
     const bool changed = demand_.take(wanted, b, mix_saturated);
-    orders_due(before, demand_.applied());
+    demand_changed();
     events_.changed((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
     return {};
 }
@@ -161,9 +153,8 @@ Result Vehicle::set_profile(std::string_view name) {
         return {};
     log_notice("thrust profile %s (factor %g)", p->name.c_str(), p->factor);
     // The command standing now goes out under the new factor at once.
-    const MotorValues before = demand_.applied();
     const bool changed = demand_.set_profile(*p);
-    orders_due(before, demand_.applied());
+    demand_changed();
     events_.changed(kChangeProfile | (changed ? kChangeMotors : 0u));
     return {};
 }
@@ -215,7 +206,7 @@ Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view cl
         // killState 0 is the packet's "all clear": it clears a packet kill (arming follows).
         SafetyAction a = safety_.clear_kill(monotonic_ns());
         if (!a.ok())
-            return {a.error == SafetyError::KillSwitchSet ? Status::KillSwitchSet : Status::Killed, a.message};
+            return {status_of(a.error), a.message};
         handle(a);
         set_leds(p.red, p.green, p.blue);
         return {};
@@ -237,6 +228,29 @@ Result Vehicle::kill(KillSource source, std::string_view reason) {
     teensy_.stop_motion();
     teensy_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
     return {};
+}
+
+void Vehicle::after_zeros(Completion done, Result r) {
+    bus_.when_idle([done = std::move(done), r = std::move(r)] { done(r); });
+}
+
+void Vehicle::kill(KillSource source, std::string_view reason, Completion done) {
+    after_zeros(std::move(done), kill(source, reason));
+}
+
+void Vehicle::power_off(std::string_view confirmation, Completion done) {
+    after_zeros(std::move(done), power_off(confirmation));
+}
+
+void Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client, Completion done) {
+    const SafetyState before = safety_.state();
+    Result r = apply_packet(words, client);
+    const SafetyState after = safety_.state();
+    // An error too: a refused packet that carried a kill still killed, and its zeros go first.
+    if (after != before && (after == SafetyState::Killed || after == SafetyState::PoweredOff))
+        after_zeros(std::move(done), std::move(r));
+    else
+        done(r);
 }
 
 Result Vehicle::clear_kill() {
@@ -262,7 +276,7 @@ Result Vehicle::power_off(std::string_view confirmation) {
     if (a.error == SafetyError::PoweredOff)
         return {Status::PoweredOff, a.message};
     handle(a);
-    bus_.zero_all(); // thrusters first, whatever handle() decided
+    orders_->zero_all(ZeroOrder::First); // thrusters first, whatever handle() decided
     log_warning("POWER-OFF confirmed: thrusters to zero%s", lines_.has_power_off() ? ", then the power-off line" : "");
     // The power-off line once the zeros are on the wire (the bus worker's thread).
     bus_.when_idle([this] { lines_.assert_power_off(); });
@@ -281,11 +295,7 @@ void Vehicle::client_left(std::string_view unique_name) {
     if (unique_name.empty() || unique_name != safety_.commanding_client())
         return;
     log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
-    // A command it had accepted reaches the wire before the zero: a one-shot `busctl call`
-    // moves the thrusters for a moment, the same whether or not its disconnect happens to
-    // arrive before the loop sent the orders.
-    for (size_t i = 0; !bus_.recovering() && bus_.schedule().pop_order(i);)
-        bus_.send_order(i, order_value(i));
+    // Its zeros go behind what it had sent (ZeroOrder::Behind).
     handle(safety_.client_left(unique_name, monotonic_ns())); // announces Controller with the motors
 }
 

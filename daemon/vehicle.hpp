@@ -11,6 +11,8 @@
 #include "core/safety.hpp"
 #include "core/status.hpp"
 #include "daemon/command_gate.hpp"
+#include "daemon/completion.hpp"
+#include "daemon/demand_listener.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/teensy_port.hpp"
 #include "daemon/thruster_bus.hpp"
@@ -25,23 +27,28 @@
 
 namespace caracara {
 
-class ControlLoop;
-
 class Vehicle final : public CommandGate, public SafetyLines::Listener {
 public:
     Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
             VehicleEvents& events);
-    void set_loop(ControlLoop* loop) { loop_ = loop; }
+    // Where the motor values go down to the thrusters (the control loop).
+    void set_demand_listener(DemandListener* orders) { orders_ = orders; }
     // Makes the deadline timer (end of arming, command timeout). "" or why it could not.
     std::string start(sd_event* event);
     void stop() { deadline_.reset(); }
 
     Result set_thrust(std::span<const int32_t> values, std::string_view client);
     Result set_motion(const AxisDemand& demand, std::string_view client);
-    Result apply_packet(std::span<const int32_t> words, std::string_view client);
     Result kill(KillSource source, std::string_view reason = {});
     Result clear_kill();
     Result power_off(std::string_view confirmation);
+    // The calls that stop the thrusters hand their result to `done` once the zero orders they
+    // put on the bus are on the wire (the bus worker's thread): a caller that gets it knows
+    // the thrusters were told zero. The loop does not wait for them; the kill output was
+    // asserted before any of them. A packet that neither kills nor powers off is done at once.
+    void kill(KillSource source, std::string_view reason, Completion done);
+    void power_off(std::string_view confirmation, Completion done);
+    void apply_packet(std::span<const int32_t> words, std::string_view client, Completion done);
     Result set_leds(int red, int green, int blue);
     // Selects a thrust profile by name; the current command goes out again under it at once.
     Result set_profile(std::string_view name);
@@ -74,18 +81,21 @@ public:
 
 private:
     static int on_deadline(sd_event_source*, uint64_t usec, void* userdata);
+    Result apply_packet(std::span<const int32_t> words, std::string_view client);
+    // `done(r)` once the transfers handed to the bus so far are on the wire.
+    void after_zeros(Completion done, Result r);
     void arm_deadline();
     void handle(const SafetyAction& a);
     Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);
-    // Marks due at once the orders whose value changed from `before` or is not on the wire.
-    void orders_due(const MotorValues& before, const MotorValues& next);
+    // Hands the orders standing now down (DemandListener::demand_changed).
+    void demand_changed();
 
     const DaemonConfig& config_;
     ThrusterBus& bus_;
     SafetyLines& lines_;
     TeensyPort& teensy_;
     VehicleEvents& events_;
-    ControlLoop* loop_ = nullptr;
+    DemandListener* orders_ = nullptr;
     SafetyMachine safety_;
     SourcePtr deadline_;
     uint64_t deadline_at_ = SafetyMachine::kNoDeadline; // what deadline_ is armed for

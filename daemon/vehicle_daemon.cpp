@@ -13,11 +13,11 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, Gp
       teensy_(event, io, config_.spi, vehicle_, events_),
       vehicle_(config_, bus_, lines_, teensy_, events_),
       loop_(event, config_.control, vehicle_, bus_, teensy_, lines_, events_),
-      recovery_(event, config_, io, gpio, bus_, vehicle_, events_),
+      recovery_(event, config_, io, gpio, bus_, loop_, vehicle_, events_),
       status_(event, vehicle_, bus_, loop_) {
-    vehicle_.set_loop(&loop_);
+    vehicle_.set_demand_listener(&loop_);
     bus_.set_listener(&recovery_);
-    events_.attach(&status_);
+    events_.attach_status(&status_);
 }
 
 std::string VehicleDaemon::start() {
@@ -49,6 +49,12 @@ std::string VehicleDaemon::start() {
         return e;
     started_ = true;
     return {};
+}
+
+void VehicleDaemon::attach_emergency_stop(EmergencyStop& stop) {
+    bus_.set_crash_gate(&stop.bus_gate());
+    lines_.set_kill_output_watcher(&stop);
+    recovery_.set_node_holder(&stop);
 }
 
 void VehicleDaemon::shutdown() {

@@ -14,6 +14,7 @@
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle.hpp"
 #include "daemon/vehicle_events.hpp"
+#include "drivers/devices/emergency_stop.hpp"
 #include "drivers/platform/device_io.hpp"
 #include "drivers/platform/gpio_backend.hpp"
 
@@ -35,6 +36,10 @@ public:
     std::string start();
     // Orders zero to every thruster (SIGTERM, fatal errors). Safe to call more than once.
     void shutdown();
+    // An armed emergency stop, made before the daemon so that it outlives it: the bus worker
+    // enters its gate, the safety lines tell it the kill output, a bus recovery lets go of
+    // its I2C node while the adapter is rebound.
+    void attach_emergency_stop(EmergencyStop& stop);
 
     const DaemonConfig& config() const { return config_; }
     VehicleEvents& events() { return events_; }
@@ -47,8 +52,6 @@ public:
     ControlLoop& loop() { return loop_; }
     const ControlLoop& loop() const { return loop_; }
     ServiceStatus& status() { return status_; }
-    BusRecovery& recovery() { return recovery_; }
-    SafetyLines& lines() { return lines_; }
     // The dive recorder, or nullptr when recorder.enabled is false.
     const DiveRecorder* recorder() const { return recorder_.get(); }
 

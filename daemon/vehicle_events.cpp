@@ -1,12 +1,10 @@
 #include "daemon/vehicle_events.hpp"
 
-#include "daemon/service_status.hpp"
-
 namespace caracara {
 
 void VehicleEvents::changed(uint32_t changes) {
-    if ((changes & (kChangeState | kChangeBus | kChangeProfile | kChangeFaults)) && status_)
-        status_->publish();
+    if (changes && status_)
+        status_->vehicle_changed(changes);
     if (changes && recorder_)
         recorder_->vehicle_changed(changes);
     if (changes && observer_)

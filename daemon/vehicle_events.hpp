@@ -1,7 +1,6 @@
-// One place every daemon object reports changes to: it forwards them to the presentation
-// (a VehicleObserver, i.e. D-Bus), to the dive recorder (a second VehicleObserver) and, for
-// state and bus changes, to systemd's STATUS= line. The receivers are attached once main
-// has built them.
+// One place every daemon object reports changes to: it forwards them to systemd's STATUS=
+// line (ServiceStatus), to the dive recorder and to the presentation (D-Bus), each a
+// VehicleObserver, in that order. The receivers are attached once main has built them.
 #pragma once
 
 #include "daemon/vehicle_observer.hpp"
@@ -12,12 +11,10 @@
 
 namespace caracara {
 
-class ServiceStatus;
-
 class VehicleEvents {
 public:
     void attach(VehicleObserver* observer) { observer_ = observer; }
-    void attach(const ServiceStatus* status) { status_ = status; }
+    void attach_status(VehicleObserver* status) { status_ = status; }
     void attach_recorder(VehicleObserver* recorder) { recorder_ = recorder; }
     // Who is calling, while a D-Bus method runs (the presentation layer knows; "" otherwise):
     // the recorder writes it beside each state change.
@@ -47,7 +44,7 @@ public:
 private:
     VehicleObserver* observer_ = nullptr;
     VehicleObserver* recorder_ = nullptr;
-    const ServiceStatus* status_ = nullptr;
+    VehicleObserver* status_ = nullptr;
     std::function<std::string()> caller_;
 };
 

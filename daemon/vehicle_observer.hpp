@@ -1,5 +1,6 @@
-// What the daemon's objects tell the presentation layer (dbus/ implements it): which vehicle
-// properties changed, periodic telemetry, and the I2C bus going and coming back.
+// What the daemon's objects tell those who show or keep the vehicle's state (D-Bus, the dive
+// recorder, systemd's status line): which vehicle properties changed, periodic telemetry, and
+// the I2C bus going and coming back.
 #pragma once
 
 #include <cstdint>
@@ -22,12 +23,13 @@ class VehicleObserver {
 public:
     virtual ~VehicleObserver() = default;
     virtual void vehicle_changed(uint32_t changes) = 0;
+    // The rest only some observers care about.
     // Periodic: thruster, Teensy and bus telemetry, command age, cycles.
-    virtual void telemetry() = 0;
+    virtual void telemetry() {}
     // The I2C bus was found locked up / came back after a recovery.
-    virtual void bus_lost(const std::string& reason) = 0;
-    virtual void bus_restored(uint32_t pulses, double milliseconds) = 0;
-    // Every control-loop cycle (the dive recorder's samples); most observers ignore it.
+    virtual void bus_lost(const std::string& /*reason*/) {}
+    virtual void bus_restored(uint32_t /*pulses*/, double /*milliseconds*/) {}
+    // Every control-loop cycle (the dive recorder's samples).
     virtual void cycle(uint64_t /*now_ns*/) {}
 };
 

@@ -2,6 +2,8 @@
 
 #include "dbus/vehicle_names.hpp"
 
+#include <memory>
+
 namespace caracara::dbus {
 
 std::string error_name(Status s) { return std::string(kErrorPrefix) + std::string(status_name(s)); }
@@ -15,6 +17,11 @@ int reply(sd_bus_message* call, const Result& result) {
     const int r = sd_bus_reply_method_error(call, &error);
     sd_bus_error_free(&error);
     return r;
+}
+
+Completion reply_later(sd_bus_message* call) {
+    auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(call), sd_bus_message_unref);
+    return [held](const Result& result) { reply(held.get(), result); };
 }
 
 } // namespace caracara::dbus

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/status.hpp"
+#include "daemon/completion.hpp"
 
 #include <string>
 #include <systemd/sd-bus.h>
@@ -18,5 +19,8 @@ inline std::string sender(sd_bus_message* m) {
 std::string error_name(Status s);
 // Replies to `call` (now, or later for a deferred reply): an empty return, or the error.
 int reply(sd_bus_message* call, const Result& result);
+// The reply to `call` as a Completion, for the daemon to hand the result back later; the
+// handler then returns 1 (the reply is on its way).
+Completion reply_later(sd_bus_message* call);
 
 } // namespace caracara::dbus

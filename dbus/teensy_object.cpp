@@ -49,8 +49,7 @@ int turn(sd_bus_message* m, void* userdata, bool absolute) {
     if (int r = sd_bus_message_read(m, "d", &radians); r < 0)
         return r;
     // Replied to when the Teensy confirms; other calls are served meanwhile.
-    auto call = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
-    Result res = ctl(userdata).turn(radians, absolute, sender(m), [call](const Result& done) { reply(call.get(), done); });
+    Result res = ctl(userdata).turn(radians, absolute, sender(m), reply_later(m));
     return res.ok() ? 1 : reply(m, res);
 }
 

@@ -5,7 +5,6 @@
 #include "dbus/vehicle_names.hpp"
 
 #include <cstring>
-#include <memory>
 #include <tuple>
 #include <vector>
 
@@ -13,7 +12,8 @@ namespace caracara::dbus {
 
 namespace {
 
-Vehicle& ctl(void* userdata) { return static_cast<VehicleDaemon*>(userdata)->vehicle(); }
+using Parts = VehicleObject::Parts;
+Vehicle& ctl(void* userdata) { return static_cast<Parts*>(userdata)->vehicle; }
 
 int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
     const void* p = nullptr;
@@ -25,19 +25,6 @@ int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
     if (n)
         std::memcpy(out.data(), p, n);
     return 0;
-}
-
-// Kill, PowerOff and a packet that kills or powers off reply once their zero orders are done on the wire (the
-// bus worker's thread): a caller that sees the reply sees the thrusters told zero. The loop
-// does not wait for them; the kill output was asserted before any of them.
-int reply_after_zeros(sd_bus_message* m, void* userdata, const Result& result) {
-    // An error too: a refused packet that carried a kill still killed, and its zeros go first.
-    ThrusterBus& bus = static_cast<VehicleDaemon*>(userdata)->bus();
-    if (bus.idle())
-        return reply(m, result);
-    auto call = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
-    bus.when_idle([call, result] { reply(call.get(), result); });
-    return 1;
 }
 
 int m_set_thrust(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -58,17 +45,14 @@ int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error*) {
     std::vector<int32_t> v;
     if (int r = read_ints(m, v); r < 0)
         return r;
-    const SafetyState before = ctl(userdata).safety().state();
-    const Result r = ctl(userdata).apply_packet(v, sender(m));
-    const SafetyState after = ctl(userdata).safety().state();
-    // A packet that killed or powered off replies as Kill and PowerOff do.
-    if (after != before && (after == SafetyState::Killed || after == SafetyState::PoweredOff))
-        return reply_after_zeros(m, userdata, r);
-    return reply(m, r);
+    // Replied to when the vehicle says the packet is done (Vehicle::apply_packet).
+    ctl(userdata).apply_packet(v, sender(m), reply_later(m));
+    return 1;
 }
 
 int m_kill(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    return reply_after_zeros(m, userdata, ctl(userdata).kill(KillSource::DBus, "Kill() from " + sender(m)));
+    ctl(userdata).kill(KillSource::DBus, "Kill() from " + sender(m), reply_later(m));
+    return 1;
 }
 
 int m_clear_kill(sd_bus_message* m, void* userdata, sd_bus_error*) { return reply(m, ctl(userdata).clear_kill()); }
@@ -77,7 +61,8 @@ int m_power_off(sd_bus_message* m, void* userdata, sd_bus_error*) {
     const char* confirmation = nullptr;
     if (int r = sd_bus_message_read(m, "s", &confirmation); r < 0)
         return r;
-    return reply_after_zeros(m, userdata, ctl(userdata).power_off(confirmation));
+    ctl(userdata).power_off(confirmation, reply_later(m));
+    return 1;
 }
 
 int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -87,7 +72,7 @@ int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return reply(m, ctl(userdata).set_leds(red, green, blue));
 }
 
-using D = const VehicleDaemon&;
+using D = const Parts&;
 int m_set_profile(sd_bus_message* m, void* userdata, sd_bus_error*) {
     const char* name = nullptr;
     if (int r = sd_bus_message_read(m, "s", &name); r < 0)
@@ -95,7 +80,7 @@ int m_set_profile(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return reply(m, ctl(userdata).set_profile(name));
 }
 
-const ControlSettings& control(D d) { return d.config().control; }
+const ControlSettings& control(D d) { return d.control; }
 
 constexpr Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("SetThrust", SD_BUS_ARGS("ai", values), SD_BUS_NO_RESULT, m_set_thrust, kUnpriv)),
@@ -108,28 +93,28 @@ constexpr Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetProfile", SD_BUS_ARGS("s", name), SD_BUS_NO_RESULT, m_set_profile, kUnpriv)),
-    property<[](D d) { return d.vehicle().state_name(); }>("State", kChange, kChangeState),
-    property<[](D d) { return d.vehicle().kill_source_name(); }>("KillSource", kChange, kChangeState),
-    property<[](D d) -> const auto& { return d.vehicle().motor_values(); }>("MotorValues", kChange, kChangeMotors),
-    property<[](D d) -> const auto& { return d.vehicle().requested_values(); }>("RequestedValues", kChange, kChangeMotors),
-    property<[](D d) { return d.vehicle().budget_limit(); }>("BudgetLimit", kChange, kChangeMotors),
-    property<[](D d) { return d.vehicle().saturated(); }>("Saturated", kChange, kChangeMotors),
+    property<[](D d) { return d.vehicle.state_name(); }>("State", kChange, kChangeState),
+    property<[](D d) { return d.vehicle.kill_source_name(); }>("KillSource", kChange, kChangeState),
+    property<[](D d) -> const auto& { return d.vehicle.motor_values(); }>("MotorValues", kChange, kChangeMotors),
+    property<[](D d) -> const auto& { return d.vehicle.requested_values(); }>("RequestedValues", kChange, kChangeMotors),
+    property<[](D d) { return d.vehicle.budget_limit(); }>("BudgetLimit", kChange, kChangeMotors),
+    property<[](D d) { return d.vehicle.saturated(); }>("Saturated", kChange, kChangeMotors),
     property<[](D d) { return policy_name(control(d).budget_policy); }>("BudgetPolicy", kConst),
-    property<[](D d) -> const auto& { return d.vehicle().profile().name; }>("Profile", kChange, kChangeProfile),
-    property<[](D d) { return d.vehicle().profile().factor; }>("ProfileFactor", kChange, kChangeProfile),
-    property<[](D d) { auto l = d.teensy().leds(); return std::tuple{l[0], l[1], l[2]}; }>("Leds", kChange, kChangeLeds),
-    property<[](D d) { return d.vehicle().command_age_ms(); }>("CommandAgeMs", kChange, kTelemetryTick),
-    property<[](D d) -> const auto& { return d.vehicle().controller_client(); }>("Controller", kChange, kChangeController),
+    property<[](D d) -> const auto& { return d.vehicle.profile().name; }>("Profile", kChange, kChangeProfile),
+    property<[](D d) { return d.vehicle.profile().factor; }>("ProfileFactor", kChange, kChangeProfile),
+    property<[](D d) { auto l = d.teensy.leds(); return std::tuple{l[0], l[1], l[2]}; }>("Leds", kChange, kChangeLeds),
+    property<[](D d) { return d.vehicle.command_age_ms(); }>("CommandAgeMs", kChange, kTelemetryTick),
+    property<[](D d) -> const auto& { return d.vehicle.controller_client(); }>("Controller", kChange, kChangeController),
     property<[](D d) { return control(d).command_timeout_ms; }>("CommandTimeoutMs", kConst),
     property<[](D d) { return control(d).arming_delay_ms; }>("ArmingDelayMs", kConst),
     property<[](D d) { return double(control(d).loop_rate_hz); }>("LoopRateHz", kConst),
-    property<[](D d) { return d.loop().cycles(); }>("Cycles", kChange, kTelemetryTick),
+    property<[](D d) { return d.loop.cycles(); }>("Cycles", kChange, kTelemetryTick),
 };
 constexpr auto kVtable = vtable(kMembers);
 
 } // namespace
 
-VehicleObject::VehicleObject(sd_bus* bus, VehicleDaemon& daemon)
-    : object_(bus, kRootPath, kVehicleIface, kMembers, kVtable, &daemon) {}
+VehicleObject::VehicleObject(sd_bus* bus, const Parts& parts)
+    : parts_(parts), object_(bus, kRootPath, kVehicleIface, kMembers, kVtable, &parts_) {}
 
 } // namespace caracara::dbus

@@ -1,20 +1,34 @@
 // /org/caracara/Vehicle1, org.caracara.Vehicle1: commands in, vehicle state out.
 #pragma once
 
-#include "daemon/vehicle_daemon.hpp"
+#include "core/config.hpp"
+#include "daemon/control_loop.hpp"
+#include "daemon/teensy_port.hpp"
+#include "daemon/vehicle.hpp"
 #include "dbus/announced_object.hpp"
 
 namespace caracara::dbus {
 
 class VehicleObject {
 public:
-    VehicleObject(sd_bus* bus, VehicleDaemon& daemon);
+    // What the object drives and shows: the vehicle, the Teensy's LEDs, the loop's cycle
+    // count and the control settings.
+    struct Parts {
+        Vehicle& vehicle;
+        const TeensyPort& teensy;
+        const ControlLoop& loop;
+        const ControlSettings& control;
+    };
+    VehicleObject(sd_bus* bus, const Parts& parts);
+    VehicleObject(const VehicleObject&) = delete;
+    VehicleObject& operator=(const VehicleObject&) = delete;
     int start() { return object_.start(); }
     // Every property of the changes, changed or not: a command that sets the same values again
     // is still announced.
     void announce(uint32_t changes) { object_.announce(changes, AnnouncedObject::When::Always); }
 
 private:
+    Parts parts_; // the methods' and properties' userdata
     AnnouncedObject object_;
 };
 

@@ -2,8 +2,8 @@
 
 #include "core/clock.hpp"
 #include "drivers/sdbus/property.hpp"
-#include "sim/device_server.hpp"
-#include "sim/inspect.hpp"
+#include "sim/inspect_reply.hpp"
+#include "sim/simulator_parts.hpp"
 
 namespace caracara::sim {
 
@@ -14,7 +14,7 @@ using dbus::kUnpriv; // who may call what is the bus policy's job (systemd/org.c
 using dbus::member;
 using dbus::property;
 
-SimVehicle& vehicle(void* userdata) { return static_cast<Inspector*>(userdata)->vehicle(); }
+SimVehicle& vehicle(void* userdata) { return static_cast<SimulatorParts*>(userdata)->vehicle; }
 
 const char* hang_name(I2cBusModel::Hang h) {
     switch (h) {
@@ -115,18 +115,18 @@ int m_set_clock(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     return sd_bus_reply_method_return(m, "");
 }
 
-using I = Inspector&;
-I2cBusModel& i2c(I i) { return i.vehicle().i2c(); }
-GpioModel& gpio(I i) { return i.vehicle().gpio(); }
+using I = SimulatorParts&;
+I2cBusModel& i2c(I i) { return i.vehicle.i2c(); }
+GpioModel& gpio(I i) { return i.vehicle.gpio(); }
 
 constexpr dbus::Member kMembers[] = {
     property<[](I i) { return i2c(i).clock_hz(); }>("ClockHz"),
-    property<[](I i) { return i.vehicle().realistic_timing(); }>("RealisticTiming"),
+    property<[](I i) { return i.vehicle.realistic_timing(); }>("RealisticTiming"),
     property<[](I i) { return i2c(i).transactions(); }>("Transactions"),
     property<[](I i) { return i2c(i).wire_time_ns(); }>("WireTimeNs"),
-    property<[](I i) { return uint32_t(i.vehicle().thrusters().size()); }>("ThrusterCount", kConst),
-    property<[](I i) { return i.server().bad_requests(); }>("BadRequests"),
-    property<[](I i) { return uint32_t(i.server().clients()); }>("Clients"),
+    property<[](I i) { return uint32_t(i.vehicle.thrusters().size()); }>("ThrusterCount", kConst),
+    property<[](I i) { return i.server.bad_requests(); }>("BadRequests"),
+    property<[](I i) { return uint32_t(i.server.clients()); }>("Clients"),
     member(SD_BUS_METHOD_WITH_ARGS("GetWireLog", SD_BUS_ARGS("t", since), SD_BUS_RESULT("t", next, "a(tttsqbayays)", entries),
                                    m_wire_log, kUnpriv)),
     member(SD_BUS_METHOD("ClearWireLog", "", "", m_clear_log, kUnpriv)),
@@ -141,11 +141,11 @@ constexpr dbus::Member kMembers[] = {
     property<[](I i) { return gpio(i).level(GpioModel::kScl); }>("Scl"),
     property<[](I i) { return gpio(i).level(GpioModel::kSda); }>("Sda"),
     property<[](I i) { return i2c(i).i2c_function(); }>("I2cFunction"),
-    property<[](I i) { return i.vehicle().i2c_timeout; }>("I2cTimeout"),
-    property<[](I i) { return i.vehicle().i2c_retries; }>("I2cRetries"),
-    property<[](I i) { return i.vehicle().driver_bound(); }>("DriverBound"),
-    property<[](I i) { return i.vehicle().unbinds(); }>("Unbinds"),
-    property<[](I i) { return i.vehicle().binds(); }>("Binds"),
+    property<[](I i) { return i.vehicle.i2c_timeout; }>("I2cTimeout"),
+    property<[](I i) { return i.vehicle.i2c_retries; }>("I2cRetries"),
+    property<[](I i) { return i.vehicle.driver_bound(); }>("DriverBound"),
+    property<[](I i) { return i.vehicle.unbinds(); }>("Unbinds"),
+    property<[](I i) { return i.vehicle.binds(); }>("Binds"),
     property<[](I i) { return hang_name(i2c(i).hang()); }>("BusHang"),
     property<[](I i) { return i2c(i).hang_pulses_seen(); }>("HangPulsesSeen"),
     property<[](I i) { return i2c(i).hang_pulses_needed(); }>("HangPulsesNeeded"),

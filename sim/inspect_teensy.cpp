@@ -1,7 +1,8 @@
 #include "sim/inspect_teensy.hpp"
 
 #include "drivers/sdbus/property.hpp"
-#include "sim/inspect.hpp"
+#include "sim/inspect_reply.hpp"
+#include "sim/vehicle.hpp"
 
 #include <string>
 #include <tuple>

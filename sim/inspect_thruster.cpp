@@ -1,7 +1,7 @@
 #include "sim/inspect_thruster.hpp"
 
 #include "drivers/sdbus/property.hpp"
-#include "sim/inspect.hpp"
+#include "sim/inspect_reply.hpp"
 #include "sim/thruster_model.hpp"
 
 #include <string>

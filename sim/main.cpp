@@ -5,7 +5,7 @@
 #include "sim/device_server.hpp"
 #include "sim/dive_replay.hpp"
 #include "drivers/platform/io_error.hpp"
-#include "sim/inspect.hpp"
+#include "sim/inspector.hpp"
 #include "sim/kernel_bridge.hpp"
 #include "drivers/sdbus/sdbus.hpp"
 #include "sim/sim_config.hpp"

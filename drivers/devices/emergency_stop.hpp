@@ -8,6 +8,8 @@
 #include "drivers/platform/device_io.hpp"
 #include "core/config.hpp"
 #include "drivers/devices/bus_gate.hpp"
+#include "drivers/devices/i2c_node_holder.hpp"
+#include "drivers/devices/kill_output_watcher.hpp"
 #include "drivers/devices/thruster_driver.hpp"
 #include "drivers/platform/gpio_line.hpp"
 #include "drivers/platform/spi_dev.hpp"
@@ -23,7 +25,7 @@
 
 namespace caracara {
 
-class EmergencyStop {
+class EmergencyStop final : public KillOutputWatcher, public I2cNodeHolder {
 public:
     // Opens `i2c_path` on `io` (its own connection / file description) and encodes a zero order
     // per thruster, with its mux select; and, when the Teensy's SPI device opens, a Stop for
@@ -35,14 +37,14 @@ public:
     void fire() noexcept;
     // The kill output line as SafetyLines holds it now (null while it has none): set before the
     // line is made and cleared before it is destroyed, so fire() never sees a dead one.
-    void set_kill_output(GpioLine* line) noexcept { kill_output_.store(line); }
+    void set_kill_output(GpioLine* line) noexcept override { kill_output_.store(line); }
     // Closes the prepared connection while the I2C adapter's driver is unbound and rebound:
     // the kernel's i2c_del_adapter() waits until every open /dev/i2c-N is closed, so a file
     // kept open here would hang the unbinding write (and the daemon) for good. fire() does
     // nothing until reopen().
-    void release();
+    void release() override;
     // Opens the node again after the rebind; "" or why not (then it stays released).
-    std::string reopen();
+    std::string reopen() override;
     bool armed() const { return fd_ >= 0; }
     // The daemon's bus worker enters this gate for each transfer; fire() closes it before the
     // kill output and waits (at most kGateWaitMs) for the transfer on the wire before its zeros.

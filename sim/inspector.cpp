@@ -1,5 +1,6 @@
-#include "sim/inspect.hpp"
+#include "sim/inspector.hpp"
 
+#include "sim/inspect_reply.hpp"
 #include "sim/inspect_simulator.hpp"
 #include "sim/inspect_teensy.hpp"
 #include "sim/inspect_thruster.hpp"
@@ -23,14 +24,14 @@ int Inspector::start() {
         return r;
     slots_.emplace_back(slot);
     const std::string root = kInspectRoot;
-    if ((r = add(root, "org.caracara.Simulator1", simulator_inspection(), this)) < 0)
+    if ((r = add(root, "org.caracara.Simulator1", simulator_inspection(), &parts_)) < 0)
         return r;
-    auto& ts = vehicle_.thrusters();
+    auto& ts = parts_.vehicle.thrusters();
     for (size_t i = 0; i < ts.size(); ++i)
         if ((r = add(root + "/thruster/" + std::to_string(i), "org.caracara.Simulator1.Thruster", thruster_inspection(),
                      ts[i].get())) < 0)
             return r;
-    if ((r = add(root + "/teensy", "org.caracara.Simulator1.Teensy", teensy_inspection(), &vehicle_)) < 0)
+    if ((r = add(root + "/teensy", "org.caracara.Simulator1.Teensy", teensy_inspection(), &parts_.vehicle)) < 0)
         return r;
     return sd_bus_request_name(bus_, "org.caracara.Simulator1", 0);
 }
