@@ -29,13 +29,13 @@ BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& 
       policy_(config.recovery.attempts, config.recovery.backoff_ms) {}
 
 void BusRecovery::bus_locked_up(const std::string& reason) {
-    BusTelemetry& tm = bus_.telemetry();
+    BusTelemetry& tm = bus_.monitor().telemetry();
     if (bus_.recovering() || tm.state == BusState::Lost)
         return;
     if (!config_.recovery.enabled) {
         // Nothing to clear the bus with: report it and keep trying the transfers each tick.
         log_error("I2C bus %s lost (%s); recovery is not configured: reopening the adapter once a second",
-                  bus_.device().c_str(), reason.c_str());
+                  bus_.monitor().device().c_str(), reason.c_str());
         events_.bus_lost(reason);
         declare_lost(reason);
         // An adapter that went away (unbound, a restarted simulator) is only found again by
@@ -48,7 +48,7 @@ void BusRecovery::bus_locked_up(const std::string& reason) {
     policy_.begin(monotonic_ns());
     tm.state = BusState::Recovering;
     tm.last_recovery_error = reason;
-    log_warning("I2C bus %s locked up (%s): recovering", bus_.device().c_str(), reason.c_str());
+    log_warning("I2C bus %s locked up (%s): recovering", bus_.monitor().device().c_str(), reason.c_str());
     events_.bus_lost(reason);
     events_.changed(kChangeBus);
     // From the event loop, not from inside the transfer that noticed it.
@@ -75,7 +75,7 @@ int BusRecovery::on_lost_timer(sd_event_source*, uint64_t, void* userdata) {
 }
 
 void BusRecovery::reopen() {
-    if (bus_.telemetry().state != BusState::Lost) {
+    if (bus_.monitor().telemetry().state != BusState::Lost) {
         phase_ = Phase::Idle; // a transfer got through: the bus is back
         return;
     }
@@ -94,7 +94,7 @@ void BusRecovery::reopen() {
 }
 
 void BusRecovery::declare_lost(const std::string& why) {
-    BusTelemetry& tm = bus_.telemetry();
+    BusTelemetry& tm = bus_.monitor().telemetry();
     if (tm.state == BusState::Lost)
         return;
     tm.state = BusState::Lost;
@@ -204,7 +204,7 @@ void BusRecovery::verify() {
     bus_.set_recovering(false);
     if (lost_timer_)
         sd_event_source_set_enabled(lost_timer_.get(), SD_EVENT_OFF);
-    BusTelemetry& tm = bus_.telemetry();
+    BusTelemetry& tm = bus_.monitor().telemetry();
     const bool was_lost = tm.state == BusState::Lost;
     tm.state = BusState::Ok;
     ++tm.recoveries;
@@ -229,7 +229,7 @@ void BusRecovery::reopen_node_holder() {
 }
 
 void BusRecovery::failed(const std::string& why) {
-    BusTelemetry& tm = bus_.telemetry();
+    BusTelemetry& tm = bus_.monitor().telemetry();
     ++tm.recovery_failures;
     tm.last_recovery_error = why;
     phase_ = Phase::Backoff;

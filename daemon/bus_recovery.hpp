@@ -22,7 +22,7 @@
 
 namespace caracara {
 
-class BusRecovery final : public ThrusterBus::Listener {
+class BusRecovery final : public BusMonitor::Listener {
 public:
     BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio, ThrusterBus& bus,
                 ControlLoop& loop, Vehicle& vehicle, VehicleEvents& events);

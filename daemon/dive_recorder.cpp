@@ -56,7 +56,7 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
     h.reason = reason;
     writer_.open(dive_file_name(wall), dive::encode_header(h));
     for (std::size_t i = 0; i < faults_.size() && i < bus_.size(); ++i)
-        faults_[i] = bus_.faults(i).bits;
+        faults_[i] = bus_.health().faults(i).bits;
     // The state it starts in, with who asked for it.
     dive::Event e;
     e.kind = dive::EventKind::State;
@@ -108,7 +108,7 @@ void DiveRecorder::vehicle_changed(uint32_t changes) {
     }
     if (changes & kChangeFaults) {
         for (std::size_t i = 0; i < faults_.size() && i < bus_.size(); ++i) {
-            const uint8_t bits = bus_.faults(i).bits;
+            const uint8_t bits = bus_.health().faults(i).bits;
             if (bits == faults_[i])
                 continue;
             faults_[i] = bits;
@@ -170,7 +170,7 @@ dive::Sample DiveRecorder::sample(uint64_t now_ns) const {
         s.applied[i] = clamp16(vehicle_.order_value(i));
     }
     s.budget_limit = clamp16(vehicle_.budget_limit());
-    const BusTelemetry& bt = bus_.telemetry();
+    const BusTelemetry& bt = bus_.monitor().telemetry();
     s.flags = static_cast<uint8_t>((vehicle_.saturated() ? dive::kSaturated : 0) |
                                    (vehicle_.safety().kill_switch_set() ? dive::kKillSwitch : 0) |
                                    (teensy_.telemetry().online ? dive::kTeensyOnline : 0) |

@@ -11,10 +11,10 @@ void ServiceStatus::publish() const {
     std::string faults;
     for (size_t i = 0; i < bus_.size(); ++i)
         for (Fault f : {Fault::WaterDetect, Fault::Overtemp})
-            if (bus_.faults(i).has(f))
+            if (bus_.health().faults(i).has(f))
                 faults += "; thruster " + std::to_string(i) + " " + std::string(fault_name(f));
     sd_notifyf(0, "STATUS=%s%s%s; profile %s; I2C bus %s; %zu thrusters%s", state.c_str(), ks.empty() ? "" : " by ",
-               ks.c_str(), vehicle_.profile().name.c_str(), std::string(bus_state_name(bus_.telemetry().state)).c_str(),
+               ks.c_str(), vehicle_.profile().name.c_str(), std::string(bus_state_name(bus_.monitor().telemetry().state)).c_str(),
                bus_.size(), faults.c_str());
 }
 

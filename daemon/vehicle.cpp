@@ -26,8 +26,8 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
 Result Vehicle::state_error() const {
     // Nothing moves while the thrusters cannot be reached: no order could get there, and each
     // thruster keeps whatever it was last told. Killed too, but this is what to fix first.
-    if (bus_.telemetry().state == BusState::Lost && safety_.state() != SafetyState::PoweredOff)
-        return {Status::BusLost, "the I2C bus to the thrusters is lost (" + bus_.telemetry().last_recovery_error +
+    if (bus_.monitor().telemetry().state == BusState::Lost && safety_.state() != SafetyState::PoweredOff)
+        return {Status::BusLost, "the I2C bus to the thrusters is lost (" + bus_.monitor().telemetry().last_recovery_error +
                                      "); the vehicle stays killed until it is back and ClearKill is called"};
     switch (safety_.state()) {
     case SafetyState::Ready: return {};
@@ -254,9 +254,9 @@ void Vehicle::apply_packet(std::span<const int32_t> words, std::string_view clie
 }
 
 Result Vehicle::clear_kill() {
-    if (bus_.telemetry().state == BusState::Lost && safety_.state() == SafetyState::Killed)
+    if (bus_.monitor().telemetry().state == BusState::Lost && safety_.state() == SafetyState::Killed)
         return {Status::BusLost, "the I2C bus to the thrusters is not back yet; the kill stays"};
-    if (const auto i = bus_.first_unreachable(); i && safety_.state() == SafetyState::Killed)
+    if (const auto i = bus_.health().first_unreachable(); i && safety_.state() == SafetyState::Killed)
         return {Status::ThrusterUnreachable,
                 "thruster " + std::to_string(*i) + " does not answer (last " +
                     std::string(io_error_name(bus_.thruster(*i).last_error())) + "); the kill stays"};
@@ -317,7 +317,7 @@ void Vehicle::kill_switch_read(bool set) {
 std::string_view Vehicle::state_name() const {
     // A vehicle that could run but reaches none of its thrusters is in fault, whatever it was asked.
     const SafetyState s = safety_.state();
-    if ((s == SafetyState::Ready || s == SafetyState::Arming) && bus_.telemetry().state == BusState::Lost)
+    if ((s == SafetyState::Ready || s == SafetyState::Arming) && bus_.monitor().telemetry().state == BusState::Lost)
         return "fault";
     return caracara::state_name(s);
 }

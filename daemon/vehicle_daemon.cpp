@@ -16,7 +16,7 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, Gp
       recovery_(event, config_, io, gpio, bus_, loop_, vehicle_, events_),
       status_(event, vehicle_, bus_, loop_) {
     vehicle_.set_demand_listener(&loop_);
-    bus_.set_listener(&recovery_);
+    bus_.monitor().set_listener(&recovery_);
     events_.attach_status(&status_);
 }
 
@@ -36,7 +36,7 @@ std::string VehicleDaemon::start() {
     teensy_.stop_motion(); // the wheels too may have been left running by an earlier instance
     if (std::string e = vehicle_.start(event_); !e.empty())
         return e;
-    bus_.set_gate(&vehicle_); // a thruster that stopped answering kills the vehicle
+    bus_.health().set_gate(&vehicle_); // a thruster that stopped answering kills the vehicle
     if (config_.recorder.enabled) {
         dive_writer_ = std::make_unique<DiveWriter>(config_.recorder.directory,
                                                     uint64_t(config_.recorder.max_total_mb) << 20);
@@ -61,7 +61,7 @@ void VehicleDaemon::shutdown() {
     if (!started_)
         return;
     started_ = false;
-    bus_.set_gate(nullptr);
+    bus_.health().set_gate(nullptr);
     loop_.stop();
     if (recorder_) {
         recorder_->stop(); // the dive ends here, before the zeros of the way out

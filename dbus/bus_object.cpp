@@ -7,7 +7,7 @@ namespace caracara::dbus {
 
 namespace {
 
-using C = const ThrusterBus&;
+using C = const BusMonitor&;
 // Announced at telemetry ticks and as soon as the controller reports a bus event.
 constexpr uint32_t kNow = kTelemetryTick | kChangeBus;
 
@@ -29,8 +29,8 @@ constexpr auto kVtable = vtable(kMembers);
 
 } // namespace
 
-BusObject::BusObject(sd_bus* bus, ThrusterBus& thrusters)
-    : object_(bus, kBusPath, kBusIface, kMembers, kVtable, &thrusters) {}
+BusObject::BusObject(sd_bus* bus, BusMonitor& monitor)
+    : object_(bus, kBusPath, kBusIface, kMembers, kVtable, &monitor) {}
 
 void BusObject::emit_lost(const std::string& reason) {
     sd_bus_emit_signal(object_.bus(), object_.path().c_str(), object_.iface(), "BusLost", "s", reason.c_str());

@@ -1,7 +1,7 @@
 // /org/caracara/Vehicle1/bus, org.caracara.Vehicle1.Bus: the I2C bus, its errors and recoveries.
 #pragma once
 
-#include "daemon/thruster_bus.hpp"
+#include "daemon/bus_monitor.hpp"
 #include "dbus/announced_object.hpp"
 
 #include <string>
@@ -10,7 +10,7 @@ namespace caracara::dbus {
 
 class BusObject {
 public:
-    BusObject(sd_bus* bus, ThrusterBus& thrusters);
+    BusObject(sd_bus* bus, BusMonitor& monitor);
     int start() { return object_.start(); }
     // The properties of the changes whose values moved since they were last announced.
     void announce(uint32_t changes) { object_.announce(changes, AnnouncedObject::When::Changed); }
