@@ -1,0 +1,7 @@
+# The daemon's objects (Vehicle, ControlLoop, ThrusterBus with its BusWorker) in process, on the
+# fakes of the device seam in tests/unit/fakes/ (no processes): each judged by its fake wire.
+add_library(daemon_fakes STATIC unit/fakes/fake_device_io.cpp unit/fakes/fake_gpio.cpp unit/fakes/daemon_rig.cpp)
+target_link_libraries(daemon_fakes PUBLIC caracara_daemon)
+caracara_unit_test(test_vehicle SOURCES unit/test_vehicle.cpp LIBS daemon_fakes)
+caracara_unit_test(test_control_loop SOURCES unit/test_control_loop.cpp LIBS daemon_fakes)
+caracara_unit_test(test_thruster_bus SOURCES unit/test_thruster_bus.cpp LIBS daemon_fakes)

@@ -1,0 +1,71 @@
+#include "tests/unit/fakes/daemon_rig.hpp"
+
+#include "core/clock.hpp"
+#include "core/safety.hpp"
+#include "drivers/protocol/seabotix.hpp"
+
+#include <stdexcept>
+
+namespace caracara::test {
+
+namespace {
+DaemonConfig parse(const std::string& control) {
+    ConfigResult r = parse_config_string("[control]\narm_at_start = true\narming_delay_ms = 0\n" + control +
+                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n",
+                                         "the test rig");
+    if (!r.ok())
+        throw std::runtime_error(r.error());
+    return *r.config;
+}
+} // namespace
+
+DaemonRig::DaemonRig(const std::string& control) : config_(parse(control)), io_(wire_, config_), gpio_(wire_) {
+    if (sd_event_new(&event_) < 0)
+        throw std::runtime_error("sd_event_new");
+    daemon_ = std::make_unique<VehicleDaemon>(event_, io_, io_, gpio_, config_);
+    if (std::string e = daemon_->start(); !e.empty())
+        throw std::runtime_error(e);
+}
+
+DaemonRig::~DaemonRig() {
+    daemon_.reset();
+    sd_event_unref(event_);
+}
+
+bool DaemonRig::run_until(const std::function<bool()>& done, int timeout_ms) {
+    const uint64_t end = monotonic_ns() + ms_to_ns(static_cast<uint64_t>(timeout_ms));
+    while (!done() && monotonic_ns() < end)
+        sd_event_run(event_, 10'000);
+    return done();
+}
+
+void DaemonRig::run_for(int ms) {
+    run_until([] { return false; }, ms);
+}
+
+void DaemonRig::run_until_ready() {
+    const bool ready = run_until([&] {
+        if (!vehicle().may_drive())
+            return false;
+        const auto ev = wire_.events();
+        for (std::size_t i = 0; i < config_.thrusters.size(); ++i)
+            if (find(ev, [i](const WireEvent& e) { return e.kind == WireEvent::Kind::Order && e.thruster == i; }) < 0)
+                return false;
+        return true;
+    });
+    if (!ready)
+        throw std::runtime_error("the vehicle did not become ready");
+}
+
+int32_t on_wire(int32_t v) {
+    return speed_to_motor(*motor_to_speed(v)).value_or(0);
+}
+
+long find(const std::vector<WireEvent>& events, const std::function<bool(const WireEvent&)>& match, long from) {
+    for (long i = from; i < static_cast<long>(events.size()); ++i)
+        if (match(events[static_cast<std::size_t>(i)]))
+            return i;
+    return -1;
+}
+
+} // namespace caracara::test

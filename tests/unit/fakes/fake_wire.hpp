@@ -1,0 +1,88 @@
+// What reached the "wire" of the in-process fakes of the device seam (FakeDeviceIo, FakeGpio),
+// in the order it got there: every thruster order with its motor value, every status read, and
+// every write of the kill and power-off outputs. Tests judge the daemon's objects from it, as
+// the e2e tests judge the whole daemon from the simulator's wire log. Thread-safe: the bus
+// worker writes from its own thread.
+#pragma once
+
+#include <cstddef>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+namespace caracara::test {
+
+struct WireEvent {
+    enum class Kind { Order, StatusRead, KillOutput, PowerOff };
+    Kind kind = Kind::Order;
+    std::size_t thruster = 0; // Order, StatusRead
+    int32_t value = 0;        // Order: the motor value the speed byte means; outputs: 0/1
+    uint8_t speed = 0;        // Order: the SeaBotix speed byte
+
+    bool is_order(std::size_t i, int32_t v) const { return kind == Kind::Order && thruster == i && value == v; }
+};
+
+class FakeWire {
+public:
+    void add(const WireEvent& e) {
+        std::lock_guard lk(mu_);
+        events_.push_back(e);
+    }
+    std::vector<WireEvent> events() const {
+        std::lock_guard lk(mu_);
+        return events_;
+    }
+    void clear() {
+        std::lock_guard lk(mu_);
+        events_.clear();
+    }
+    // Thruster i answers every transfer with -err from now on (0: answers again).
+    void fail(std::size_t i, int err) {
+        std::lock_guard lk(mu_);
+        if (failing_.size() <= i)
+            failing_.resize(i + 1, 0);
+        failing_[i] = err;
+    }
+    int failure(std::size_t i) const {
+        std::lock_guard lk(mu_);
+        return i < failing_.size() ? failing_[i] : 0;
+    }
+    // While held, a transfer that reaches the wire waits there (a thruster holding the bus):
+    // what the daemon hands over meanwhile queues behind it.
+    void hold() {
+        std::lock_guard lk(mu_);
+        held_ = true;
+    }
+    void release() {
+        {
+            std::lock_guard lk(mu_);
+            held_ = false;
+        }
+        released_.notify_all();
+    }
+    // Blocks while held (called by the transfer); true when it had to wait.
+    bool wait_released() {
+        std::unique_lock lk(mu_);
+        const bool waited = held_;
+        waiting_ += waited;
+        released_.wait(lk, [this] { return !held_; });
+        waiting_ -= waited;
+        return waited;
+    }
+    // A transfer is waiting on the wire.
+    bool transfer_waiting() const {
+        std::lock_guard lk(mu_);
+        return waiting_ > 0;
+    }
+
+private:
+    mutable std::mutex mu_;
+    std::vector<WireEvent> events_;
+    std::vector<int> failing_;
+    std::condition_variable released_;
+    bool held_ = false;
+    int waiting_ = 0;
+};
+
+} // namespace caracara::test

@@ -1,0 +1,120 @@
+// The control loop on the in-process fakes of the device seam: the orders it is handed go out
+// with their values (changed ones at once, the rest refreshed by the tick), the status reads
+// go round, and the zeros go first or behind as asked.
+#include "tests/unit/fakes/daemon_rig.hpp"
+
+#include "core/clock.hpp"
+
+#include "tests/catch.hpp"
+
+#include <set>
+
+using namespace caracara;
+using namespace caracara::test;
+using Kind = WireEvent::Kind;
+
+namespace {
+MotorValues values(int32_t base) {
+    MotorValues m{};
+    for (std::size_t i = 0; i < m.size(); ++i)
+        m[i] = base * static_cast<int32_t>(i + 1);
+    return m;
+}
+} // namespace
+
+TEST_CASE("a changed order goes out at once, not at the next tick") {
+    DaemonRig rig("loop_rate_hz = 2\n"); // a tick every 500 ms refreshes all eight, thruster 0 first
+    rig.run_until_ready();
+    MotorValues m{};
+    rig.loop().demand_changed(m); // what stands now: nothing changed, nothing due
+    // Right after a cycle's work (its orders, then its status read): the next tick is far.
+    const uint64_t cycles = rig.loop().cycles();
+    REQUIRE(rig.run_until([&] { return rig.loop().cycles() > cycles; }));
+    rig.wire().clear();
+    const auto is_read = [](const WireEvent& e) { return e.kind == Kind::StatusRead; };
+    REQUIRE(rig.run_until([&] { return find(rig.wire().events(), is_read) >= 0 && rig.daemon().bus().idle(); }));
+    rig.wire().clear();
+    m[2] = 3000;
+    rig.loop().demand_changed(m);
+    const auto is_order = [](const WireEvent& e) { return e.kind == Kind::Order; };
+    REQUIRE(rig.run_until([&] { return find(rig.wire().events(), is_order) >= 0; }, 1000));
+    const auto ev = rig.wire().events();
+    CHECK(ev[static_cast<std::size_t>(find(ev, is_order))].is_order(2, on_wire(3000)));
+}
+
+TEST_CASE("the tick refreshes every order with the value it was handed, and reads each thruster's status in turn") {
+    DaemonRig rig("loop_rate_hz = 100\n");
+    rig.run_until_ready();
+    const MotorValues m = values(500);
+    rig.loop().demand_changed(m);
+    rig.run_for(30);
+    rig.wire().clear();
+    rig.run_for(200); // about 20 ticks
+    const auto ev = rig.wire().events();
+    std::array<int, 8> orders{};
+    std::set<std::size_t> read;
+    for (const WireEvent& e : ev) {
+        if (e.kind == Kind::Order) {
+            CHECK(e.value == on_wire(m[e.thruster]));
+            ++orders[e.thruster];
+        } else if (e.kind == Kind::StatusRead) {
+            read.insert(e.thruster);
+        }
+    }
+    for (int n : orders)
+        CHECK(n >= 5);
+    CHECK(read.size() == 8);
+}
+
+TEST_CASE("zeros behind: the orders already due reach the wire first") {
+    DaemonRig rig("loop_rate_hz = 2\n");
+    rig.run_until_ready();
+    rig.wire().clear();
+    const MotorValues m = values(700);
+    rig.loop().demand_changed(m);
+    rig.loop().zero_all(ZeroOrder::Behind); // before the loop ran: all eight still due
+    REQUIRE(rig.run_until([&] { return rig.daemon().bus().idle(); }));
+    const auto ev = rig.wire().events();
+    for (std::size_t i = 0; i < 8; ++i) {
+        const long sent = find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(m[i])); });
+        const long zero = find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); });
+        REQUIRE(sent >= 0);
+        CHECK(sent < zero);
+    }
+}
+
+TEST_CASE("zeros first: the orders still due never reach the wire") {
+    DaemonRig rig("loop_rate_hz = 2\n");
+    rig.run_until_ready();
+    rig.wire().clear();
+    rig.loop().demand_changed(values(700));
+    rig.loop().zero_all(ZeroOrder::First);
+    rig.run_for(100);
+    const auto ev = rig.wire().events();
+    for (std::size_t i = 0; i < 8; ++i)
+        CHECK(find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); }) >= 0);
+    CHECK(find(ev, [](const WireEvent& e) { return e.kind == Kind::Order && e.value != 0; }) < 0);
+}
+
+TEST_CASE("a recovered bus gets every standing order again") {
+    DaemonRig rig("loop_rate_hz = 2\n");
+    rig.run_until_ready();
+    const MotorValues m = values(300);
+    rig.loop().demand_changed(m);
+    REQUIRE(rig.run_until([&] { return rig.daemon().bus().idle(); }));
+    rig.wire().clear();
+    rig.loop().resend_orders();
+    REQUIRE(rig.run_until([&] { return rig.daemon().bus().idle(); }));
+    const auto ev = rig.wire().events();
+    for (std::size_t i = 0; i < 8; ++i)
+        CHECK(find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(m[i])); }) >= 0);
+}
+
+TEST_CASE("the loop counts its cycles and is healthy while they complete") {
+    DaemonRig rig("loop_rate_hz = 100\n");
+    rig.run_until_ready();
+    const uint64_t before = rig.loop().cycles();
+    rig.run_for(100);
+    CHECK(rig.loop().cycles() >= before + 5);
+    CHECK(rig.loop().healthy(monotonic_ns()));
+}

@@ -1,0 +1,231 @@
+// Vehicle on the in-process fakes of the device seam: each command judged by what reaches the
+// fake wire (orders with their motor values, the kill and power-off outputs), in order.
+#include "tests/unit/fakes/daemon_rig.hpp"
+
+#include "core/packet.hpp"
+#include "tests/catch.hpp"
+
+#include <optional>
+#include <vector>
+
+using namespace caracara;
+using namespace caracara::test;
+using Kind = WireEvent::Kind;
+
+namespace {
+
+const std::vector<int32_t> kThrust{1000, -2000, 3000, -4000, 500, -500, 1500, -1500};
+
+bool each_ordered(const std::vector<WireEvent>& ev, const std::vector<int32_t>& values, long from = 0) {
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(values[i])); }, from) < 0)
+            return false;
+    return true;
+}
+
+bool all_zeroed(const std::vector<WireEvent>& ev, long from = 0) { return each_ordered(ev, std::vector<int32_t>(8, 0), from); }
+
+long first_nonzero_order(const std::vector<WireEvent>& ev, long from = 0) {
+    return find(ev, [](const WireEvent& e) { return e.kind == Kind::Order && e.value != 0; }, from);
+}
+
+long kill_output(const std::vector<WireEvent>& ev, int value, long from = 0) {
+    return find(ev, [&](const WireEvent& e) { return e.kind == Kind::KillOutput && e.value == value; }, from);
+}
+
+} // namespace
+
+TEST_CASE("SetThrust: each motor value reaches its thruster, and the tick keeps it there") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    rig.wire().clear();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    rig.run_for(100); // five ticks at 50 Hz
+    for (const WireEvent& e : rig.wire().events())
+        if (e.kind == Kind::Order)
+            CHECK(e.value == on_wire(kThrust[e.thruster])); // nothing else was ever ordered
+}
+
+TEST_CASE("a refused command changes nothing on the wire") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    rig.wire().clear();
+    std::vector<int32_t> bad = kThrust;
+    bad[3] = 9000;
+    CHECK(rig.vehicle().set_thrust(bad, ":1.7").status == Status::OutOfRange);
+    CHECK(rig.vehicle().set_thrust(std::vector<int32_t>(7, 100), ":1.7").status == Status::InvalidLength);
+    rig.run_for(100);
+    CHECK(first_nonzero_order(rig.wire().events()) < 0);
+}
+
+TEST_CASE("Kill: the kill output first, then a zero to every thruster; the completion after the zeros") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    rig.wire().clear();
+    std::optional<std::vector<WireEvent>> at_completion;
+    rig.vehicle().kill(KillSource::DBus, "test", [&](const Result& r) {
+        CHECK(r.ok());
+        at_completion = rig.wire().events();
+    });
+    REQUIRE(rig.run_until([&] { return at_completion.has_value(); }));
+    const auto ev = rig.wire().events();
+    const long asserted = kill_output(ev, 1);
+    REQUIRE(asserted == 0); // before anything else reached the wire
+    CHECK(all_zeroed(*at_completion, asserted)); // the reply waits for the zeros
+    CHECK(first_nonzero_order(ev, asserted) < 0);
+    CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
+}
+
+TEST_CASE("a Kill behind a hung transfer: the kill output at once, no older order after it") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    rig.wire().hold();
+    REQUIRE(rig.run_until([&] { return rig.wire().transfer_waiting(); }));
+    // Orders queued behind the hung transfer, then the kill.
+    REQUIRE(rig.vehicle().set_thrust(std::vector<int32_t>(8, 4000), ":1.7").ok());
+    rig.run_for(20);
+    rig.wire().clear();
+    bool completed = false;
+    rig.vehicle().kill(KillSource::DBus, "test", [&](const Result&) { completed = true; });
+    CHECK(kill_output(rig.wire().events(), 1) == 0); // not behind the bus
+    CHECK_FALSE(completed);
+    rig.wire().release();
+    REQUIRE(rig.run_until([&] { return completed; }));
+    const auto ev = rig.wire().events();
+    CHECK(all_zeroed(ev));
+    // At most the transfer already on the wire went out with its old value.
+    const long stale = first_nonzero_order(ev);
+    if (stale >= 0)
+        CHECK(first_nonzero_order(ev, stale + 1) < 0);
+    CHECK(find(ev, [](const WireEvent& e) { return e.kind == Kind::Order && e.value == on_wire(4000); }) < 0);
+}
+
+TEST_CASE("the kill switch: the kill output first, then the zeros; released, the kill stays") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    rig.wire().clear();
+    rig.gpio().set_kill_switch(true);
+    REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events()); }));
+    const auto ev = rig.wire().events();
+    CHECK(kill_output(ev, 1) == 0);
+    CHECK(first_nonzero_order(ev) < 0);
+    rig.gpio().set_kill_switch(false);
+    rig.run_for(60);
+    CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
+    CHECK(kill_output(rig.wire().events(), 0) < 0);
+}
+
+TEST_CASE("a client that leaves: what it sent reaches the wire, then its zeros; no kill") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    rig.wire().clear();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    rig.vehicle().client_left(":1.7"); // before the loop ran: the orders are still due
+    REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events()); }));
+    const auto ev = rig.wire().events();
+    for (std::size_t i = 0; i < kThrust.size(); ++i) {
+        const long sent = find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(kThrust[i])); });
+        const long zero = find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); });
+        CHECK(sent >= 0);
+        CHECK(sent < zero);
+    }
+    CHECK(kill_output(ev, 1) < 0);
+    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+    CHECK(rig.vehicle().controller_client().empty());
+}
+
+TEST_CASE("another client leaving changes nothing") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    rig.vehicle().client_left(":1.8");
+    rig.run_for(60);
+    const auto ev = rig.wire().events();
+    CHECK(each_ordered(ev, kThrust));
+    CHECK(rig.vehicle().motor_values()[0] == 1000);
+}
+
+TEST_CASE("the command timeout: zeros, no kill") {
+    DaemonRig rig("loop_rate_hz = 50\ncommand_timeout_ms = 100\n");
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    rig.wire().clear();
+    REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events()); }, 1000));
+    CHECK(kill_output(rig.wire().events(), 1) < 0);
+    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+}
+
+TEST_CASE("PowerOff: the zeros, then the power-off line; the completion after the zeros") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    rig.wire().clear();
+    std::optional<std::vector<WireEvent>> at_completion;
+    rig.vehicle().power_off("power-off", [&](const Result& r) {
+        CHECK(r.ok());
+        at_completion = rig.wire().events();
+    });
+    REQUIRE(rig.run_until([&] { return at_completion.has_value(); }));
+    CHECK(all_zeroed(*at_completion));
+    const auto ev = rig.wire().events();
+    const long line = find(ev, [](const WireEvent& e) { return e.kind == Kind::PowerOff && e.value == 1; });
+    REQUIRE(line >= 0);
+    CHECK(kill_output(ev, 1) < line);
+    for (std::size_t i = 0; i < 8; ++i)
+        CHECK(find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); }) < line);
+    CHECK(first_nonzero_order(ev) < 0);
+}
+
+TEST_CASE("PowerOff without its confirmation changes nothing") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    std::optional<Result> result;
+    rig.vehicle().power_off("yes", [&](const Result& r) { result = r; });
+    REQUIRE(rig.run_until([&] { return result.has_value(); }));
+    CHECK(result->status == Status::ConfirmationRequired);
+    rig.run_for(40);
+    CHECK(find(rig.wire().events(), [](const WireEvent& e) { return e.kind == Kind::PowerOff && e.value == 1; }) < 0);
+    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+}
+
+TEST_CASE("a packet that kills completes after its zeros; one that drives completes at once") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    std::vector<int32_t> packet(kPacketWords, 0);
+    for (std::size_t i = 0; i < kThrust.size(); ++i)
+        packet[i] = kThrust[i];
+    std::optional<Result> drove;
+    rig.vehicle().apply_packet(packet, ":1.7", [&](const Result& r) { drove = r; });
+    REQUIRE(drove.has_value()); // at once
+    CHECK(drove->ok());
+    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    rig.wire().clear();
+    packet[kPacketKill] = 1;
+    std::optional<std::vector<WireEvent>> at_completion;
+    rig.vehicle().apply_packet(packet, ":1.7", [&](const Result&) { at_completion = rig.wire().events(); });
+    REQUIRE(rig.run_until([&] { return at_completion.has_value(); }));
+    CHECK(kill_output(*at_completion, 1) == 0);
+    CHECK(all_zeroed(*at_completion));
+    CHECK(rig.vehicle().safety().kill_source() == KillSource::Packet);
+}
+
+TEST_CASE("a thruster that stops answering kills the vehicle (source device); the kill stays until it answers") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    rig.wire().fail(5, ENXIO);
+    REQUIRE(rig.run_until([&] { return rig.vehicle().safety().state() == SafetyState::Killed; }));
+    CHECK(rig.vehicle().safety().kill_source() == KillSource::Device);
+    CHECK(rig.vehicle().clear_kill().status == Status::ThrusterUnreachable);
+    rig.wire().fail(5, 0);
+    REQUIRE(rig.run_until([&] { return !rig.daemon().bus().health().first_unreachable(); }));
+    CHECK(rig.vehicle().clear_kill().ok());
+}
