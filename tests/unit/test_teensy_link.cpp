@@ -511,4 +511,4 @@ TEST_CASE("teensy handshake ignores results it did not ask for, and restarts cle
 }
 
 // The spidev driver and the frame engine over a real SPI path are tested against the
-// simulated Teensy in tests/integration/test_teensy_sim.cpp, not against a scripted stand-in.
+// simulated Teensy in tests/integration/test_teensy_link_on_sim.cpp, not against a scripted stand-in.

@@ -1,0 +1,3 @@
+caracara_integration_test(test_bus_recovery SOURCES integration/test_bus_recovery.cpp LIBS caracara_devices DEPENDS caracara-sim caracarad)
+caracara_integration_test(test_kill_switch_and_power_off SOURCES integration/test_kill_switch_and_power_off.cpp LIBS caracara_devices DEPENDS caracara-sim caracarad)
+caracara_integration_test(test_exit_paths SOURCES integration/test_exit_paths.cpp LIBS caracara_devices DEPENDS caracara-sim caracarad)

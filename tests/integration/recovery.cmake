@@ -1,1 +1,0 @@
-caracara_integration_test(test_recovery SOURCES integration/test_recovery.cpp LIBS caracara_devices DEPENDS caracara-sim caracarad)

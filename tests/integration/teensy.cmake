@@ -1,1 +1,0 @@
-caracara_integration_test(test_teensy_sim SOURCES integration/test_teensy_sim.cpp LIBS caracara_devices DEPENDS caracara-sim)

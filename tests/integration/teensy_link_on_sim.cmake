@@ -1,0 +1,1 @@
+caracara_integration_test(test_teensy_link_on_sim SOURCES integration/test_teensy_link_on_sim.cpp LIBS caracara_devices DEPENDS caracara-sim)

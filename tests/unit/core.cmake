@@ -1,0 +1,9 @@
+# core/: one test program per piece of pure logic.
+caracara_unit_test(test_mixing SOURCES unit/test_mixing.cpp LIBS caracara_core)
+caracara_unit_test(test_budget SOURCES unit/test_budget.cpp LIBS caracara_core)
+caracara_unit_test(test_packet SOURCES unit/test_packet.cpp LIBS caracara_core)
+caracara_unit_test(test_safety SOURCES unit/test_safety.cpp LIBS caracara_core)
+caracara_unit_test(test_config SOURCES unit/test_config.cpp LIBS caracara_core)
+# The shipped example must stay a valid config: the test parses it.
+target_compile_definitions(test_config PRIVATE
+  CARACARA_EXAMPLE_CONFIG="${CMAKE_SOURCE_DIR}/daemon/caracarad.toml.example")

@@ -1,1 +1,0 @@
-caracara_unit_test(test_sim_teensy SOURCES unit/test_sim_teensy.cpp LIBS caracara_simcore)

@@ -1,0 +1,1 @@
+caracara_unit_test(test_simulated_teensy SOURCES unit/test_simulated_teensy.cpp LIBS caracara_simcore)

@@ -1,0 +1,1 @@
+caracara_unit_test(test_teensy_link SOURCES unit/test_teensy_link.cpp LIBS caracara_protocol)
