@@ -6,38 +6,14 @@ set -u
 out=/systest-out
 exec >>"$out/check.log" 2>&1
 
-V=org.caracara.Vehicle1
-VP=/org/caracara/Vehicle1
+results=$out/results.txt
+. "$(dirname "$0")/helpers.sh"
 VT=org.caracara.Vehicle1.Teensy
-S=org.caracara.Simulator1
-SP=/org/caracara/Simulator1
 ST=org.caracara.Simulator1.Thruster
 STE=org.caracara.Simulator1.Teensy
 CONF=/etc/caracara/caracarad.toml
 
-pass() { echo "PASS: $*" | tee -a "$out/results.txt"; }
-fail() { echo "FAIL: $*" | tee -a "$out/results.txt"; }
-info() { echo "INFO: $*"; }
-# check NAME COMMAND...: PASS if the command succeeds.
-check() {
-  local name=$1
-  shift
-  if "$@"; then pass "$name"; else fail "$name"; fi
-}
-now_ms() { echo $(($(date +%s%N) / 1000000)); }
-# wait_until SECONDS COMMAND...: true as soon as the command succeeds, false after SECONDS.
-wait_until() {
-  local end=$(($(now_ms) + $1 * 1000))
-  shift
-  until "$@"; do
-    [ "$(now_ms)" -lt "$end" ] || return 1
-    sleep 0.1
-  done
-}
-# prop BUS-NAME PATH INTERFACE PROPERTY: the value without its signature and quotes.
-prop() { busctl get-property "$@" 2>/dev/null | sed -E 's/^[^ ]+ //; s/^"(.*)"$/\1/'; }
 unit() { systemctl show -p "$2" --value "$1"; }
-state() { prop $V $VP $V State; }
 speed() { prop $S "$SP/thruster/$1" $ST OrderedSpeed; }
 speeds() { local n s=; for n in 0 1 2 3 4 5 6 7; do s+="$(speed $n) "; done; echo "${s% }"; }
 # The SPEED byte of a stopped thruster is 0x80 (or 0x7F).
@@ -49,7 +25,6 @@ all_zero() {
   done
 }
 speed_is() { [ "$(speed "$1")" = "$2" ]; }
-state_is() { [ "$(state)" = "$1" ]; }
 active() { [ "$(systemctl is-active "$1")" = active ]; }
 # as USER COMMAND...
 as() { local u=$1; shift; runuser -u "$u" -- "$@"; }
@@ -120,8 +95,6 @@ mono_us() {
   done
   return 1
 }
-# The simulator's next wire-log index (entries logged from now on have it or a larger one).
-wire_next() { busctl call $S $SP $S GetWireLog t 9223372036854775808 | awk '{print $2}'; }
 # zero_orders_since INDEX: "addr7 time_ns" for every zero order (SPEED 0x80) on the wire since INDEX.
 zero_orders_since() {
   busctl call $S $SP $S GetWireLog t "$1" |

@@ -194,6 +194,7 @@ fi
 
 # The checks: a test-only unit that runs check.sh once the system is up, then powers off.
 install -D -m 0755 "$here/check.sh" "$root/usr/local/libexec/caracara-systest/check.sh"
+install -D -m 0644 "$here/helpers.sh" "$root/usr/local/libexec/caracara-systest/helpers.sh"
 install -D -m 0755 "$here/check-topside.sh" "$root/usr/local/libexec/caracara-systest/check-topside.sh"
 install -D -m 0644 "$here/caracara-systest.service" "$root/etc/systemd/system/caracara-systest.service"
 mkdir -p "$root/etc/systemd/system/multi-user.target.wants"

@@ -13,28 +13,9 @@ set -u
 OUT=$CARACARA_TOPSIDE_OUT
 TOP=$CARACARA_TOPSIDE_DIR
 SRC=$CARACARA_TOPSIDE_SRC
-V=org.caracara.Vehicle1
-VP=/org/caracara/Vehicle1
-S=org.caracara.Simulator1
-SP=/org/caracara/Simulator1
-
-pass() { echo "PASS: topside: $*" | tee -a "$OUT/results.txt"; }
-fail() { echo "FAIL: topside: $*" | tee -a "$OUT/results.txt"; }
-info() { echo "INFO: $*"; }
-check() {
-  local name=$1
-  shift
-  if "$@"; then pass "$name"; else fail "$name"; fi
-}
-now_ms() { echo $(($(date +%s%N) / 1000000)); }
-wait_until() {
-  local end=$(($(now_ms) + $1 * 1000))
-  shift
-  until "$@"; do
-    [ "$(now_ms)" -lt "$end" ] || return 1
-    sleep 0.1
-  done
-}
+results=$OUT/results.txt
+label="topside: "
+. "$(dirname "$0")/helpers.sh"
 # CLOCK_MONOTONIC in microseconds: the clock of the simulator's wire log (one kernel, no time
 # namespace between this side and the container).
 mono_us() { /usr/bin/python3 -c 'import time; print(time.monotonic_ns() // 1000)'; }
@@ -68,10 +49,7 @@ t0=$(now_ms)
 
 # Reads go through the visitor, who is not in the caracara group: anyone may read.
 rd() { busctl -H visitor@vehicle "$@"; }
-prop() { rd get-property "$@" 2>/dev/null | sed -E 's/^[^ ]+ //; s/^"(.*)"$/\1/'; }
-state() { prop $V $VP $V State; }
-state_is() { [ "$(state)" = "$1" ]; }
-wire_next() { rd call $S $SP $S GetWireLog t 9223372036854775808 | awk '{print $2}'; }
+vbus() { rd "$@"; }
 # orders_since INDEX: "time_ns addr7 speed" of every thruster order on the wire since INDEX.
 orders_since() {
   rd call $S $SP $S GetWireLog t "$1" |

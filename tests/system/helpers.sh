@@ -1,0 +1,35 @@
+# The helpers the system test's two sides share, sourced by check.sh (inside the container) and
+# topside.sh (on the topside, outside it). Before sourcing, the caller sets `results` (the
+# results file) and may set `label` (a prefix for its PASS/FAIL lines); after it, it may
+# redefine vbus (how it reaches the vehicle's bus; busctl on the system bus by default).
+V=org.caracara.Vehicle1
+VP=/org/caracara/Vehicle1
+S=org.caracara.Simulator1
+SP=/org/caracara/Simulator1
+
+pass() { echo "PASS: ${label:-}$*" | tee -a "$results"; }
+fail() { echo "FAIL: ${label:-}$*" | tee -a "$results"; }
+info() { echo "INFO: $*"; }
+# check NAME COMMAND...: PASS if the command succeeds.
+check() {
+  local name=$1
+  shift
+  if "$@"; then pass "$name"; else fail "$name"; fi
+}
+now_ms() { echo $(($(date +%s%N) / 1000000)); }
+# wait_until SECONDS COMMAND...: true as soon as the command succeeds, false after SECONDS.
+wait_until() {
+  local end=$(($(now_ms) + $1 * 1000))
+  shift
+  until "$@"; do
+    [ "$(now_ms)" -lt "$end" ] || return 1
+    sleep 0.1
+  done
+}
+vbus() { busctl "$@"; }
+# prop BUS-NAME PATH INTERFACE PROPERTY: the value without its signature and quotes.
+prop() { vbus get-property "$@" 2>/dev/null | sed -E 's/^[^ ]+ //; s/^"(.*)"$/\1/'; }
+state() { prop $V $VP $V State; }
+state_is() { [ "$(state)" = "$1" ]; }
+# The simulator's next wire-log index (entries logged from now on have it or a larger one).
+wire_next() { vbus call $S $SP $S GetWireLog t 9223372036854775808 | awk '{print $2}'; }
