@@ -157,7 +157,9 @@ void ControlLoop::cycle() {
     const uint64_t t = monotonic_ns();
     lines_.poll(); // a backstop for a lost edge event
     vehicle_.tick(t);
-    events_.cycle(t); // the dive recorder's sample
+    // The dive recorder's sample, stamped after the tick: an event the poll or the tick caused
+    // is in the dive already, stamped when it happened, and a dive's time never goes back.
+    events_.cycle(monotonic_ns());
     if (in_cycle_) {
         // The bus did not finish the last cycle in one period: the next one starts as soon as
         // it is done, as at loop rate 0. Refreshing the orders now instead would put them in
