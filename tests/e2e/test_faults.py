@@ -59,6 +59,20 @@ class HungThrusterTest(unittest.TestCase):
                                   if e.bus == "gpio" and e.addr == KILL_OUT and e.data == b"\x01"), None), 5,
                     message="no kill output edge")
 
+    def zeros_since(self, since):
+        return [e.index for e in self.rig.wire_log(since)[1]
+                if e.bus == "i2c" and not e.read and len(e.data) == 3 and e.data[0] == ZERO]
+
+    def assert_kill_output_first(self, since, edge, what):
+        """The kill output is written before any bus transfer of the kill, and every thruster's
+        zero follows (judged by wire-log order, not stamps: the simulator stamps I2C messages at
+        their modelled end on the wire). The strongest test of this, for a Kill() call and for
+        the kill switch: a transfer is hung on the wire when the kill comes."""
+        poll(lambda: len(self.zeros_since(since)) >= MOTORS, 5)
+        zeros = self.zeros_since(since)
+        self.assertGreaterEqual(len(zeros), MOTORS, "%s: not every thruster got its zero" % what)
+        self.assertLess(edge.index, zeros[0], "%s: the kill output came after a zero order" % what)
+
     def test_kill_call_reaches_the_kill_output_at_once(self):
         lat = []
         for _ in range(4):
@@ -72,6 +86,7 @@ class HungThrusterTest(unittest.TestCase):
                      if e.bus == "i2c" and not e.read and len(e.data) == 3 and e.data[0] == ZERO]
             self.assertTrue(zeros and edge.index < zeros[0], "the kill output came after a zero order")
             self.rig.sim_thruster_call(HUNG, "SetHang", 0, signature="u")
+            self.assert_kill_output_first(since, edge, "Kill()")
             poll(lambda: error_name(self.rig.vcall, "ClearKill") is None, 10)
         print("\nKill() -> kill output with a thruster hanging 1 s: p50 %.2f ms, max %.2f ms" %
               (statistics.median(lat), max(lat)))
@@ -89,9 +104,11 @@ class HungThrusterTest(unittest.TestCase):
                 switch = next(e for e in self.rig.wire_log(since)[1] if e.bus == "gpio" and e.addr == KILL_SWITCH)
                 lat.append((edge.time_ns - switch.time_ns) / 1e6)
                 self.assertLess(switch.index, edge.index)
+                poll(lambda: self.rig.state() == "killed", 5)
             finally:
                 self.rig.sim_call("SetKillSwitch", False, signature="b")
             self.rig.sim_thruster_call(HUNG, "SetHang", 0, signature="u")
+            self.assert_kill_output_first(since, edge, "kill switch")
             poll(lambda: error_name(self.rig.vcall, "ClearKill") is None, 10)
         print("\nkill switch edge -> kill output with a thruster hanging 1 s: p50 %.2f ms, max %.2f ms" %
               (statistics.median(lat), max(lat)))

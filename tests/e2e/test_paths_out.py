@@ -73,44 +73,6 @@ class KillInABadPacketTest(VehicleTestCase):
         self.assertNotEqual(self.rig.sim_speeds(), [ZERO] * MOTORS)
 
 
-class KillOutputFirstTest(VehicleTestCase):
-    """The kill output is written before any bus transfer of the kill (judged by wire-log order,
-    not stamps: the simulator stamps I2C messages at their modelled end on the wire)."""
-
-    def setUp(self):
-        self.rig.reset()
-        values = [2500] * 8
-        self.rig.thrust(values)
-        self.rig.wait_sim_speeds([speed_byte(2500)] * 8)
-
-    def check_order(self, since, what):
-        def zeros_of(log):
-            return [e.index for e in log if e.bus == "i2c" and not e.read and len(e.data) == 3 and e.data[0] == ZERO]
-        # The zeros follow on the bus worker's thread: wait for them (bounded), then judge.
-        poll(lambda: len(zeros_of(self.rig.wire_log(since)[1])) >= MOTORS, 5)
-        log = self.rig.wire_log(since)[1]
-        kill_edge = [e.index for e in log if e.bus == "gpio" and e.addr == KILL_OUT and e.data == b"\x01"]
-        zeros = zeros_of(log)
-        self.assertTrue(kill_edge, "%s: no kill output edge" % what)
-        self.assertGreaterEqual(len(zeros), MOTORS, "%s: not every thruster got its zero" % what)
-        print("\n%s: kill output at entry %d, zero orders at %d..%d" % (what, kill_edge[0], zeros[0], zeros[MOTORS - 1]))
-        self.assertLess(kill_edge[0], zeros[0], "%s: the kill output came after a zero order" % what)
-
-    def test_kill_call(self):
-        since = self.rig.wire_next()
-        self.rig.vcall("Kill")
-        self.check_order(since, "Kill()")
-
-    def test_kill_switch(self):
-        since = self.rig.wire_next()
-        self.rig.sim_call("SetKillSwitch", True, signature="b")
-        try:
-            poll(lambda: self.rig.state() == "killed", 5)
-            self.check_order(since, "kill switch")
-        finally:
-            self.rig.sim_call("SetKillSwitch", False, signature="b")
-
-
 class FaultsToldTest(VehicleTestCase):
     """A thruster fault that appears or clears is logged once, not once per status read, and
     water detect and over-temperature are spelt out by caracaractl status."""

@@ -33,6 +33,13 @@ long kill_output(const std::vector<WireEvent>& ev, int value, long from = 0) {
     return find(ev, [&](const WireEvent& e) { return e.kind == Kind::KillOutput && e.value == value; }, from);
 }
 
+// Ready, with kThrust on the wire.
+void drive(DaemonRig& rig) {
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+}
+
 } // namespace
 
 TEST_CASE("SetThrust: each motor value reaches its thruster, and the tick keeps it there") {
@@ -61,9 +68,7 @@ TEST_CASE("a refused command changes nothing on the wire") {
 
 TEST_CASE("Kill: the kill output first, then a zero to every thruster; the completion after the zeros") {
     DaemonRig rig;
-    rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
-    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    drive(rig);
     rig.wire().clear();
     std::optional<std::vector<WireEvent>> at_completion;
     rig.vehicle().kill(KillSource::DBus, "test", [&](const Result& r) {
@@ -81,9 +86,7 @@ TEST_CASE("Kill: the kill output first, then a zero to every thruster; the compl
 
 TEST_CASE("a Kill behind a hung transfer: the kill output at once, no older order after it") {
     DaemonRig rig;
-    rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
-    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    drive(rig);
     rig.wire().hold();
     REQUIRE(rig.run_until([&] { return rig.wire().transfer_waiting(); }));
     // Orders queued behind the hung transfer, then the kill.
@@ -107,9 +110,7 @@ TEST_CASE("a Kill behind a hung transfer: the kill output at once, no older orde
 
 TEST_CASE("the kill switch: the kill output first, then the zeros; released, the kill stays") {
     DaemonRig rig;
-    rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
-    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    drive(rig);
     rig.wire().clear();
     rig.gpio().set_kill_switch(true);
     REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events()); }));
@@ -154,9 +155,7 @@ TEST_CASE("another client leaving changes nothing") {
 
 TEST_CASE("the command timeout: zeros, no kill") {
     DaemonRig rig("loop_rate_hz = 50\ncommand_timeout_ms = 100\n");
-    rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
-    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    drive(rig);
     rig.wire().clear();
     REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events()); }, 1000));
     CHECK(kill_output(rig.wire().events(), 1) < 0);
@@ -165,9 +164,7 @@ TEST_CASE("the command timeout: zeros, no kill") {
 
 TEST_CASE("PowerOff: the zeros, then the power-off line; the completion after the zeros") {
     DaemonRig rig;
-    rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
-    REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
+    drive(rig);
     rig.wire().clear();
     std::optional<std::vector<WireEvent>> at_completion;
     rig.vehicle().power_off("power-off", [&](const Result& r) {
