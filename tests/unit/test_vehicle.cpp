@@ -5,6 +5,7 @@
 #include "core/packet.hpp"
 #include "tests/catch.hpp"
 
+#include <algorithm>
 #include <optional>
 #include <vector>
 
@@ -33,6 +34,18 @@ long kill_output(const std::vector<WireEvent>& ev, int value, long from = 0) {
     return find(ev, [&](const WireEvent& e) { return e.kind == Kind::KillOutput && e.value == value; }, from);
 }
 
+// The kill output was asserted, then every thruster got its zero; after the kill output at most
+// one order carries an older value (the transfer already on the wire when the kill came).
+// Returns where the kill output is.
+long check_kill_output_first(const std::vector<WireEvent>& ev) {
+    const long asserted = kill_output(ev, 1);
+    REQUIRE(asserted >= 0);
+    CHECK(all_zeroed(ev, asserted));
+    if (const long stale = first_nonzero_order(ev, asserted); stale >= 0)
+        CHECK(first_nonzero_order(ev, stale + 1) < 0);
+    return asserted;
+}
+
 // Ready, with kThrust on the wire.
 void drive(DaemonRig& rig) {
     rig.run_until_ready();
@@ -48,10 +61,24 @@ TEST_CASE("SetThrust: each motor value reaches its thruster, and the tick keeps 
     rig.wire().clear();
     REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
     REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
-    rig.run_for(100); // five ticks at 50 Hz
-    for (const WireEvent& e : rig.wire().events())
-        if (e.kind == Kind::Order)
-            CHECK(e.value == on_wire(kThrust[e.thruster])); // nothing else was ever ordered
+    // The ticks refresh each order with the same value (three times here)...
+    const auto orders_of = [&](const std::vector<WireEvent>& ev, std::size_t i) {
+        return std::count_if(ev.begin(), ev.end(), [&](const WireEvent& e) { return e.is_order(i, on_wire(kThrust[i])); });
+    };
+    REQUIRE(rig.run_until([&] {
+        const auto ev = rig.wire().events();
+        for (std::size_t i = 0; i < kThrust.size(); ++i)
+            if (orders_of(ev, i) < 3)
+                return false;
+        return true;
+    }));
+    // ... and once a thruster has its value, it is never ordered anything else.
+    const auto ev = rig.wire().events();
+    for (std::size_t i = 0; i < kThrust.size(); ++i) {
+        const long first = find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(kThrust[i])); });
+        CHECK(find(ev, [&](const WireEvent& e) { return e.kind == Kind::Order && e.thruster == i && e.value != on_wire(kThrust[i]); },
+                   first) < 0);
+    }
 }
 
 TEST_CASE("a refused command changes nothing on the wire") {
@@ -77,10 +104,8 @@ TEST_CASE("Kill: the kill output first, then a zero to every thruster; the compl
     });
     REQUIRE(rig.run_until([&] { return at_completion.has_value(); }));
     const auto ev = rig.wire().events();
-    const long asserted = kill_output(ev, 1);
-    REQUIRE(asserted == 0); // before anything else reached the wire
+    const long asserted = check_kill_output_first(ev);
     CHECK(all_zeroed(*at_completion, asserted)); // the reply waits for the zeros
-    CHECK(first_nonzero_order(ev, asserted) < 0);
     CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
 }
 
@@ -114,9 +139,7 @@ TEST_CASE("the kill switch: the kill output first, then the zeros; released, the
     rig.wire().clear();
     rig.gpio().set_kill_switch(true);
     REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events()); }));
-    const auto ev = rig.wire().events();
-    CHECK(kill_output(ev, 1) == 0);
-    CHECK(first_nonzero_order(ev) < 0);
+    check_kill_output_first(rig.wire().events());
     rig.gpio().set_kill_switch(false);
     rig.run_for(60);
     CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
@@ -129,15 +152,18 @@ TEST_CASE("a client that leaves: what it sent reaches the wire, then its zeros; 
     rig.wire().clear();
     REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
     rig.vehicle().client_left(":1.7"); // before the loop ran: the orders are still due
-    REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events()); }));
-    const auto ev = rig.wire().events();
-    for (std::size_t i = 0; i < kThrust.size(); ++i) {
-        const long sent = find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(kThrust[i])); });
-        const long zero = find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); });
-        CHECK(sent >= 0);
-        CHECK(sent < zero);
-    }
-    CHECK(kill_output(ev, 1) < 0);
+    // Each thruster gets what the client sent, then its zero.
+    const auto sent_then_zero = [&] {
+        const auto ev = rig.wire().events();
+        for (std::size_t i = 0; i < kThrust.size(); ++i) {
+            const long sent = find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(kThrust[i])); });
+            if (sent < 0 || find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); }, sent) < 0)
+                return false;
+        }
+        return true;
+    };
+    CHECK(rig.run_until(sent_then_zero));
+    CHECK(kill_output(rig.wire().events(), 1) < 0);
     CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
     CHECK(rig.vehicle().controller_client().empty());
 }
@@ -176,10 +202,10 @@ TEST_CASE("PowerOff: the zeros, then the power-off line; the completion after th
     const auto ev = rig.wire().events();
     const long line = find(ev, [](const WireEvent& e) { return e.kind == Kind::PowerOff && e.value == 1; });
     REQUIRE(line >= 0);
-    CHECK(kill_output(ev, 1) < line);
+    const long asserted = check_kill_output_first(ev);
+    CHECK(asserted < line);
     for (std::size_t i = 0; i < 8; ++i)
-        CHECK(find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); }) < line);
-    CHECK(first_nonzero_order(ev) < 0);
+        CHECK(find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); }, asserted) < line);
 }
 
 TEST_CASE("PowerOff without its confirmation changes nothing") {
@@ -210,8 +236,7 @@ TEST_CASE("a packet that kills completes after its zeros; one that drives comple
     std::optional<std::vector<WireEvent>> at_completion;
     rig.vehicle().apply_packet(packet, ":1.7", [&](const Result&) { at_completion = rig.wire().events(); });
     REQUIRE(rig.run_until([&] { return at_completion.has_value(); }));
-    CHECK(kill_output(*at_completion, 1) == 0);
-    CHECK(all_zeroed(*at_completion));
+    check_kill_output_first(*at_completion); // the completion comes after the zeros
     CHECK(rig.vehicle().safety().kill_source() == KillSource::Packet);
 }
 
