@@ -52,6 +52,11 @@ class Suite:
         st = [t[1] for t in self.tests]
         if "failed" in st:
             return "FAILED (%d of %d tests)" % (st.count("failed"), len(st)), True
+        # Every scenario or none: a count short of its plan fails whatever the exit status said.
+        short = [(what, got, of) for what, got, of in self.counts
+                 if what in ("checks", "scenarios") and of is not None and got != of]
+        if short:
+            return "FAILED (%s)" % ", ".join("%d of %d %s" % (g, o, w) for w, g, o in short), True
         if "skipped" in st:
             why = self.skip_reason or "skipped"
             return "skipped: %s" % why, CI or self.can_run and not self.skip_reason
@@ -167,12 +172,16 @@ def main():
             s13 = section(text, "debian13: system test", "debian13: kernel test")
             k13 = section(text, "debian13: kernel test")
             _, _, reason = inner_counts(text)
+            # debian13.sh's last line: "system test exit R (S s); kernel test exit R (S s)".
+            took = {k: float(v) for k, v in re.findall(r"(system|kernel) test exit \S+ \((\d+) s\)", text)}
             for sname, part in (("Debian 13 build+ctest", b), ("system Debian 13", s13),
                                 ("kernel Debian 13", k13 or text)):
                 st = status
                 if sname == "kernel Debian 13" and "kernel: not run" in text:
                     st = "skipped"
-                add(by[sname], (name, st, secs if sname == "Debian 13 build+ctest" else 0, part), part)
+                part_secs = {"Debian 13 build+ctest": secs - sum(took.values()),
+                             "system Debian 13": took.get("system", 0.0), "kernel Debian 13": took.get("kernel", 0.0)}
+                add(by[sname], (name, st, part_secs[sname], part), part)
                 if st == "skipped" and reason:
                     by[sname].skip_reason = reason
             continue
