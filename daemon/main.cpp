@@ -37,6 +37,7 @@ void usage(FILE* f) {
                "  --check-config         validate the configuration and exit\n"
                "  --zero-thrusters       assert the kill output, order zero to every thruster, stop\n"
                "                         the Teensy's wheels, and exit (systemd's ExecStopPost=)\n"
+               "  --version              the version, and exit\n"
                "  -h, --help             this text\n",
                f);
 }
@@ -87,6 +88,7 @@ int main(int argc, char** argv) {
         else if (a == "--check-config") check_only = true;
         else if (a == "--zero-thrusters") zero_only = true;
         else if (a == "-h" || a == "--help") { usage(stdout); return 0; }
+        else if (a == "--version") { std::printf("caracarad %s\n", CARACARA_VERSION); return 0; }
         else {
             std::fprintf(stderr, "caracarad: unknown option '%s'\n", a.c_str());
             usage(stderr);

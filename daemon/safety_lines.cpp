@@ -10,6 +10,9 @@ namespace caracara {
 
 namespace {
 constexpr uint64_t kReopenUs = 1'000'000;
+// Not every tick: in sim mode each read is a round trip to the simulator. A kill output gone
+// between two checks is found at the next, or at once by the kill's own write.
+constexpr uint64_t kOutputCheckUs = 100'000;
 } // namespace
 
 std::string SafetyLines::open(bool kill_asserted, Listener* listener) {
@@ -71,6 +74,7 @@ int SafetyLines::on_kill_switch(sd_event_source*, int, uint32_t revents, void* u
 }
 
 void SafetyLines::poll() {
+    check_outputs();
     if (!kill_switch_ || !listener_)
         return;
     const int v = kill_switch_->get();
@@ -79,6 +83,20 @@ void SafetyLines::poll() {
         return;
     }
     listener_->kill_switch_read(v == 1);
+}
+
+void SafetyLines::check_outputs() {
+    uint64_t now_us = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
+    if (now_us < next_output_check_us_)
+        return;
+    next_output_check_us_ = now_us + kOutputCheckUs;
+    if (kill_out_)
+        if (int r = kill_out_->get(); r < 0)
+            output_lost(kill_out_, "kill output", r);
+    if (power_off_)
+        if (int r = power_off_->get(); r < 0)
+            output_lost(power_off_, "power-off output", r);
 }
 
 void SafetyLines::switch_lost(const std::string& why) {

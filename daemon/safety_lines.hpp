@@ -34,10 +34,13 @@ public:
     std::string open(bool kill_asserted, Listener* listener);
     void close();
 
-    // Reads the switch and reports it (a backstop for a lost edge event).
+    // Reads the switch and reports it (a backstop for a lost edge event); reads the outputs back
+    // now and then, since an output that went away has no event to say so.
     void poll();
     void set_kill_output(bool asserted);
     bool has_power_off() const { return power_off_ != nullptr; }
+    // A kill output is configured but its line went away (asked for again once a second).
+    bool kill_output_missing() const { return settings_.kill_output && !kill_out_; }
     void assert_power_off();
     // Told the kill output line whenever it changes (null before it goes): the fatal-signal
     // emergency stop writes it first.
@@ -57,6 +60,8 @@ private:
     // for again with the reopen timer (the kill output then starts asserted).
     void output_lost(std::unique_ptr<GpioLine>& line, const char* what, int err);
     void schedule_reopen();
+    // Every kOutputCheckUs: an output that cannot be read back went away (output_lost).
+    void check_outputs();
     // The switch cannot be read (its chip or the simulator went away): its source goes (no busy
     // loop), it counts as set (a kill), and it is asked for again once a second.
     void switch_lost(const std::string& why);
@@ -71,6 +76,7 @@ private:
     SourcePtr kill_switch_source_;
     SourcePtr reopen_timer_;
     bool kill_asserted_ = true; // what the kill output should show (for a reopened line)
+    uint64_t next_output_check_us_ = 0;
     KillOutputWatcher* kill_output_watcher_ = nullptr;
     void kill_output_changed() {
         if (kill_output_watcher_)

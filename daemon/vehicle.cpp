@@ -260,6 +260,8 @@ Result Vehicle::clear_kill() {
         return {Status::ThrusterUnreachable,
                 "thruster " + std::to_string(*i) + " does not answer (last " +
                     std::string(io_error_name(bus_.thruster(*i).last_error())) + "); the kill stays"};
+    if (lines_.kill_output_missing() && safety_.state() == SafetyState::Killed)
+        return {Status::Hardware, "the kill output line is gone (asked for again once a second); the kill stays"};
     SafetyAction a = safety_.clear_kill(monotonic_ns());
     if (!a.ok())
         return {status_of(a.error), a.message};

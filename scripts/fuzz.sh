@@ -8,6 +8,9 @@
 # The grown corpus and any crash-*/leak-*/timeout-* input stay in
 # ${CARACARA_FUZZ_DIR:-/var/tmp/caracara-fuzz}/<harness>/; a crash input belongs in
 # fuzz/regressions/<harness>/ once its cause is fixed. Builds build-fuzz/ with clang-14 first.
+# Each harness's executions, coverage (cov, ft), corpus size and time go to
+# bench/fuzz-results.json (CARACARA_FUZZ_RESULTS overrides), which the README cites; a run of
+# some harnesses replaces only their entries.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 harnesses=(packet seabotix teensy config sim_request dive)
@@ -32,8 +35,10 @@ cmake --build "$build" -j"$(nproc)" --target fuzzers >/dev/null
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+results=${CARACARA_FUZZ_RESULTS:-$top/bench/fuzz-results.json}
 failed=()
 summary=()
+records=()
 for h in "${harnesses[@]}"; do
   out="$store/$h"
   mkdir -p "$out/corpus"
@@ -52,6 +57,7 @@ for h in "${harnesses[@]}"; do
   execs=$(grep -E '^stat::number_of_executed_units' "$out/log" | awk '{print $2}')
   summary+=("$(printf '%-12s %12s execs %6ss  %s' "$h" "${execs:-?}" "$secs" \
     "$(sed -E 's/^#[0-9]+[[:space:]]+[A-Z]+ +//; s/ lim:.*exec\/s/ exec\/s/; s/ rss:.*//' <<<"$done_line")")")
+  records+=("$h" "$status" "$secs" "${execs:-0}" "$done_line" "$(find "$out/corpus" -type f | wc -l)" "${stop[*]}")
   if [ "$status" -ne 0 ]; then
     failed+=("$h")
     echo "fuzz $h: FAILED (exit $status); input: $(ls "$out" | grep -E '^(crash|leak|timeout|oom)-' | tr '\n' ' ')"
@@ -60,6 +66,24 @@ for h in "${harnesses[@]}"; do
 done
 echo "== summary"
 printf '%s\n' "${summary[@]}"
+/usr/bin/python3 - "$results" "${records[@]}" <<'PY'
+import json, os, re, sys, time
+path, rec = sys.argv[1], sys.argv[2:]
+data = json.load(open(path)) if os.path.exists(path) else {"harnesses": {}}
+for i in range(0, len(rec), 7):
+    h, status, secs, execs, done, corpus, limit = rec[i:i + 7]
+    cov = re.search(r"cov: (\d+)", done)
+    ft = re.search(r"ft: (\d+)", done)
+    data["harnesses"][h] = {"passed": status == "0", "seconds": int(secs), "executions": int(execs),
+                            "cov": int(cov.group(1)) if cov else None, "ft": int(ft.group(1)) if ft else None,
+                            "corpus_files": int(corpus), "limit": limit,
+                            "finished": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
+data["command"] = "scripts/fuzz.sh"
+with open(path, "w") as f:
+    json.dump(data, f, indent=1, sort_keys=True)
+    f.write("\n")
+print("fuzz.sh: counts written to %s" % path)
+PY
 if ((${#failed[@]})); then
   echo "fuzz.sh: failed: ${failed[*]} (logs in $store/<harness>/log)"
   exit 1

@@ -8,44 +8,78 @@
 #   scripts/test.sh normal     only the normal build (faster, for development)
 #   scripts/test.sh cross      only arm64 (scripts/cross_test.sh, scripts/package.sh arm64)
 #   scripts/test.sh fuzz       only the fuzzers (scripts/fuzz.sh runs them longer)
+# It ends with one table (scripts/suite_table.py): each suite, ran or not, its counts and its
+# time; it fails when a suite failed or did not run where this machine can run it, and under CI
+# (CI=true) on any skip. Every step runs even after one failed, so the table is whole.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 "$top/scripts/deps.sh"
 which=${1:-all}
 jobs=$(nproc)
 
+# What the table reads: each step's selection, exit status and time, and each ctest run's
+# results (JUnit, passed tests' output kept whole: the suites' counts are in it) and labels.
+results=${CARACARA_SUITE_RESULTS:-$top/build-results}
+rm -rf "$results"
+mkdir -p "$results"
+# ctest_run STEP DIR [ctest options...]
+ctest_run() {
+  local step=$1 dir=$2; shift 2
+  # (Called where set -e does not hold: each command's failure is returned by hand.)
+  ctest --test-dir "$dir" --show-only=json-v1 "$@" >"$results/$step.json" || return
+  ctest --test-dir "$dir" --output-on-failure --output-junit "$results/$step.xml" \
+    --test-output-size-passed 1048576 --test-output-size-failed 1048576 "$@"
+}
 run_suite() {
-  local dir=$1; shift
+  local step=$1 dir=$2; shift 2
   echo "== build $dir ($*)"
-  "$top/scripts/build.sh" "$dir" -DCARACARA_WERROR=ON "$@"
+  "$top/scripts/build.sh" "$dir" -DCARACARA_WERROR=ON "$@" || return
   echo "== test $dir"
-  ctest --test-dir "$dir" --output-on-failure -j"$jobs" --timeout 900
+  ctest_run "$step" "$dir" -j"$jobs" --timeout 900
 }
 # Each step's wall time, so that the 30-minute budget of CI can be read from its log.
 stamp() { echo "== $1 done at $((SECONDS / 60)) min $((SECONDS % 60)) s"; }
-
-if [ "$which" = all ] || [ "$which" = normal ]; then
-  run_suite "$top/build"
-  stamp "normal build"
-fi
-if [ "$which" = all ] || [ "$which" = cross ]; then
-  "$top/scripts/cross_test.sh" "$top/build-arm64"
-  echo "== arm64 packages"
-  "$top/scripts/package.sh" arm64 "$top/build-deb"
-  stamp "arm64"
-fi
-if [ "$which" = all ] || [ "$which" = sanitize ]; then
-  export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
-  export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-  run_suite "$top/build-asan" -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
-  stamp "ASan+UBSan build"
-fi
-if [ "$which" = all ] || [ "$which" = fuzz ]; then
+# step NAME COMMAND...: runs it if selected, records "NAME SELECTED EXIT SECONDS", goes on.
+failed=0
+step() {
+  local name=$1 selected=0 rc=0 t0=$SECONDS; shift
+  case $which in all|"$name") selected=1 ;; esac
+  [ "$name" = arm64-packages ] && case $which in all|cross) selected=1 ;; esac
+  if [ "$selected" = 1 ]; then
+    "$@" || rc=$?
+    [ "$rc" -eq 0 ] || failed=1
+    stamp "$name (exit $rc)"
+  fi
+  echo "$name $selected $rc $((SECONDS - t0))" >>"$results/steps.txt"
+}
+fuzz_suite() {
   echo "== build $top/build-fuzz (libFuzzer harnesses)"
   cmake -S "$top" -B "$top/build-fuzz" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCARACARA_FUZZ=ON -DCARACARA_WERROR=ON \
-    -DCMAKE_CXX_COMPILER="$(command -v clang++-14 || command -v clang++)" >/dev/null
-  cmake --build "$top/build-fuzz" -j"$jobs" --target fuzzers
+    -DCMAKE_CXX_COMPILER="$(command -v clang++-14 || command -v clang++)" >/dev/null || return
+  cmake --build "$top/build-fuzz" -j"$jobs" --target fuzzers || return
   echo "== fuzz $top/build-fuzz"
-  ctest --test-dir "$top/build-fuzz" --output-on-failure -j2 -L fuzz
-  stamp "fuzzers"
-fi
+  ctest_run fuzz "$top/build-fuzz" -j2 -L fuzz
+}
+cross_suite() {
+  CARACARA_CTEST_JUNIT="$results/cross.xml" "$top/scripts/cross_test.sh" "$top/build-arm64"
+}
+arm64_packages() {
+  echo "== arm64 packages"
+  "$top/scripts/package.sh" arm64 "$top/build-deb"
+}
+sanitize_suite() {
+  export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
+  export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+  run_suite sanitize "$top/build-asan" -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
+}
+
+step normal run_suite normal "$top/build"
+step cross cross_suite
+step arm64-packages arm64_packages
+step sanitize sanitize_suite
+step fuzz fuzz_suite
+
+table=0
+/usr/bin/python3 "$top/scripts/suite_table.py" "$results" || table=$?
+stamp "all"
+[ "$failed" -eq 0 ] && [ "$table" -eq 0 ]

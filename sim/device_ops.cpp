@@ -96,8 +96,10 @@ size_t DeviceOps::handle(DeviceSession& session, std::span<const uint8_t> req, s
 
 void DeviceOps::release(DeviceSession& session) {
     for (auto& [h, line] : session.gpio_lines)
-        vehicle_.gpio().release(line, monotonic_ns());
+        if (session.gpio_epochs[h] == vehicle_.gpio().epoch(line)) // not one gone since
+            vehicle_.gpio().release(line, monotonic_ns());
     session.gpio_lines.clear();
+    session.gpio_epochs.clear();
 }
 
 uint64_t DeviceOps::open(Request& q) {
@@ -290,6 +292,7 @@ uint64_t DeviceOps::gpio_request(Request& q) {
         return q.bad(res);
     int hnd = q.session.next_handle++;
     q.session.gpio_lines[hnd] = line;
+    q.session.gpio_epochs[hnd] = vehicle_.gpio().epoch(line);
     q.begin(hnd);
     return 0;
 }
@@ -303,13 +306,20 @@ uint64_t DeviceOps::gpio_line_op(Request& q) {
     if (it == q.session.gpio_lines.end())
         return q.bad(-EBADF);
     int res = 0;
-    if (q.op == Op::GpioGet)
+    // A handle to a line that went away since: dead for good, as a file descriptor of a removed
+    // chip is (its release frees nothing: the line may be another handle's by now).
+    const bool stale = q.session.gpio_epochs[hnd] != vehicle_.gpio().epoch(it->second);
+    if (stale && q.op != Op::GpioRelease)
+        res = -ENODEV;
+    else if (q.op == Op::GpioGet)
         res = vehicle_.gpio().get(it->second);
     else if (q.op == Op::GpioSet)
         res = vehicle_.gpio().set(it->second, value, monotonic_ns());
     else {
-        vehicle_.gpio().release(it->second, monotonic_ns());
+        if (!stale)
+            vehicle_.gpio().release(it->second, monotonic_ns());
         q.session.gpio_lines.erase(it);
+        q.session.gpio_epochs.erase(hnd);
     }
     q.begin(res);
     return 0;
@@ -324,6 +334,8 @@ uint64_t DeviceOps::gpio_watch(Request& q) {
     int line = vehicle_.gpio().find(chip, name, offset);
     if (line < 0)
         return q.bad(line);
+    if (!vehicle_.gpio().present(line))
+        return q.bad(-ENODEV);
     q.session.watched_line = line;
     q.begin(0);
     return 0;

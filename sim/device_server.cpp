@@ -4,6 +4,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <vector>
 #include <ctime>
 #include <sys/prctl.h>
 #include <sys/socket.h>
@@ -39,6 +40,15 @@ DeviceServer::DeviceServer(sd_event* event, SimVehicle& vehicle) : event_(event)
     // The default timer slack (50 us) would eat half of wait_until's spun tail.
     ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
     vehicle_.gpio().on_change = [this](int line, int value, uint64_t when_ns) { push_gpio_event(line, value, when_ns); };
+    // A line gone: its edge watchers' connections end, as a removed chip's event fd hangs up.
+    vehicle_.gpio().on_gone = [this](int line) {
+        std::vector<Client*> watchers;
+        for (auto& [key, c] : clients_)
+            if (c->session.watched_line == line)
+                watchers.push_back(key);
+        for (Client* c : watchers)
+            drop(c);
+    };
 }
 
 void DeviceServer::push_gpio_event(int line, int value, uint64_t when_ns) {
@@ -56,6 +66,7 @@ void DeviceServer::push_gpio_event(int line, int value, uint64_t when_ns) {
 
 DeviceServer::~DeviceServer() {
     vehicle_.gpio().on_change = nullptr;
+    vehicle_.gpio().on_gone = nullptr;
     clients_.clear();
     accept_source_.reset();
     if (listen_fd_ >= 0) {

@@ -17,6 +17,7 @@ struct DeviceSession {
     };
     std::map<int, Handle> handles;
     std::map<int, int> gpio_lines; // handle -> line index in the GPIO model
+    std::map<int, uint32_t> gpio_epochs; // handle -> the line's epoch at request (GpioModel::epoch)
     int watched_line = -1;         // a GpioWatch connection: pushes edges of this line
     int next_handle = 3;
 };

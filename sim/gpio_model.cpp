@@ -8,6 +8,8 @@ GpioModel::GpioModel(I2cBusModel& bus, WireLog& log, bool kill_switch_active_low
     : bus_(bus), log_(log), kill_switch_active_low_(kill_switch_active_low) {
     info_ = {{"GPIO2", kSda}, {"GPIO3", kScl}, {"KILL_SWITCH", kKillSwitch}, {"POWER_OFF", kPowerOff}, {"KILL_OUT", kKillOut}};
     lines_.resize(info_.size());
+    gone_.resize(info_.size());
+    epochs_.resize(info_.size());
 }
 
 int GpioModel::find(const std::string& chip, const std::string& name, int offset) const {
@@ -46,6 +48,8 @@ std::vector<bool> GpioModel::levels() const {
 
 int GpioModel::request(int line, GpioMode mode, bool active_low, int initial, uint64_t now_ns) {
     Line& l = lines_[static_cast<size_t>(line)];
+    if (gone_[static_cast<size_t>(line)])
+        return -ENODEV;
     if (l.requested)
         return -EBUSY;
     const uint32_t off = info_[static_cast<size_t>(line)].offset;
@@ -65,11 +69,15 @@ int GpioModel::request(int line, GpioMode mode, bool active_low, int initial, ui
 
 int GpioModel::get(int line) const {
     const Line& l = lines_[static_cast<size_t>(line)];
+    if (gone_[static_cast<size_t>(line)])
+        return -ENODEV;
     return physical(static_cast<size_t>(line)) != l.active_low ? 1 : 0;
 }
 
 int GpioModel::set(int line, int logical, uint64_t now_ns) {
     Line& l = lines_[static_cast<size_t>(line)];
+    if (gone_[static_cast<size_t>(line)])
+        return -ENODEV;
     if (l.mode == GpioMode::Input || l.mode == GpioMode::InputEdges)
         return -EPERM;
     auto before = levels();
@@ -82,6 +90,25 @@ void GpioModel::release(int line, uint64_t now_ns) {
     auto before = levels();
     lines_[static_cast<size_t>(line)] = Line{};
     update(now_ns, before);
+}
+
+void GpioModel::set_present(int line, bool present, uint64_t now_ns) {
+    const auto i = static_cast<size_t>(line);
+    if (gone_[i] == !present)
+        return;
+    if (!present) {
+        release(line, now_ns); // its level changes as an unrequested line's: logged as an edge
+        ++epochs_[i];
+    }
+    gone_[i] = !present;
+    WireEntry e;
+    e.bus = "gpio";
+    e.addr = static_cast<uint16_t>(info_[i].offset);
+    e.time_ns = now_ns;
+    e.result = present ? "back" : "gone";
+    log_.append(std::move(e));
+    if (!present && on_gone)
+        on_gone(line);
 }
 
 void GpioModel::set_kill_switch(bool engaged, uint64_t now_ns) {

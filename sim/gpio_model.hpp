@@ -36,15 +36,23 @@ public:
 
     // Line lookup by chip and name, or offset (>= 0). -ENOENT when there is no such line.
     int find(const std::string& chip, const std::string& name, int offset) const;
-    // -EBUSY if the line is already requested; 0 on success.
+    // -EBUSY if the line is already requested, -ENODEV while it is gone; 0 on success.
     int request(int line, GpioMode mode, bool active_low, int initial, uint64_t now_ns);
-    int get(int line) const;                          // logical value
-    int set(int line, int logical, uint64_t now_ns);  // -EPERM on an input
+    int get(int line) const;                          // logical value; -ENODEV while gone
+    int set(int line, int logical, uint64_t now_ns);  // -EPERM on an input; -ENODEV while gone
     void release(int line, uint64_t now_ns);
     bool requested(int line) const { return lines_[static_cast<size_t>(line)].requested; }
 
     // The simulator's side.
     void set_kill_switch(bool engaged, uint64_t now_ns);
+    // One line taken away (its driver gone, as a vanished chip is for every line) and brought
+    // back: while gone it is released (an output's level drops), requests, reads and writes get
+    // -ENODEV, and a handle from before never works again (epoch). Logged as {bus "gpio",
+    // addr = offset, result "gone" or "back"}; on_gone tells the edge watchers' server.
+    void set_present(int line, bool present, uint64_t now_ns);
+    bool present(int line) const { return !gone_[static_cast<size_t>(line)]; }
+    uint32_t epoch(int line) const { return epochs_[static_cast<size_t>(line)]; }
+    std::function<void(int)> on_gone;
     bool kill_switch_engaged() const { return kill_switch_engaged_; }
     bool kill_switch_active_low() const { return kill_switch_active_low_; } // engaged = low on the wire
     bool level(uint32_t offset) const; // physical level on the wire
@@ -75,6 +83,8 @@ private:
     bool kill_switch_engaged_ = false;
     std::vector<GpioLineInfo> info_;
     std::vector<Line> lines_;
+    std::vector<bool> gone_;         // kept apart from Line: a release resets that
+    std::vector<uint32_t> epochs_;   // bumped each time a line goes
     uint64_t stops_ = 0;
     uint64_t scl_pulses_ = 0;
     uint64_t last_scl_rise_ns_ = 0;

@@ -55,6 +55,22 @@ int m_vanish(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     return sd_bus_reply_method_return(m, "");
 }
 
+// SetLinePresent(s line, b present): one of the safety lines (KILL_SWITCH, KILL_OUT, POWER_OFF,
+// the chip's names) taken away or brought back (GpioModel::set_present).
+int m_set_line_present(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    const char* name = nullptr;
+    int present = 0;
+    if (int r = sd_bus_message_read(m, "sb", &name, &present); r < 0)
+        return r;
+    GpioModel& g = vehicle(userdata).gpio();
+    const int line = g.find(GpioModel::kChip, name, -1);
+    const std::string n = name;
+    if (line < 0 || (n != "KILL_SWITCH" && n != "KILL_OUT" && n != "POWER_OFF"))
+        return sd_bus_error_setf(err, kInspectInvalid, "the line is KILL_SWITCH, KILL_OUT or POWER_OFF, got '%s'", name);
+    g.set_present(line, present, monotonic_ns());
+    return sd_bus_reply_method_return(m, "");
+}
+
 int m_hold_scl(sd_bus_message* m, void* userdata, sd_bus_error*) {
     vehicle(userdata).i2c().hang_scl();
     return sd_bus_reply_method_return(m, "");
@@ -154,6 +170,8 @@ constexpr dbus::Member kMembers[] = {
     property<[](I i) { return gpio(i).min_scl_period_ns(); }>("MinSclPeriodNs"),
     member(SD_BUS_METHOD_WITH_ARGS("SetKillSwitch", SD_BUS_ARGS("b", engaged), SD_BUS_NO_RESULT, m_set_kill_switch, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("Vanish", SD_BUS_ARGS("s", device, "u", ms), SD_BUS_NO_RESULT, m_vanish, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetLinePresent", SD_BUS_ARGS("s", line, "b", present), SD_BUS_NO_RESULT,
+                                   m_set_line_present, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("HangBus", SD_BUS_ARGS("u", pulses), SD_BUS_NO_RESULT, m_hang_bus, kUnpriv)),
     member(SD_BUS_METHOD("HoldScl", "", "", m_hold_scl, kUnpriv)),
     member(SD_BUS_METHOD("ReleaseBus", "", "", m_release_bus, kUnpriv)),

@@ -46,6 +46,7 @@ void usage(FILE* f) {
                "  --replay DIVE         the thrusters and the Teensy answer with a recorded dive's\n"
                "                        status and orientation, from caracarad's ClearKill on\n"
                "                        (docs/dive-format.md)\n"
+               "  --version             the version, and exit\n"
                "  -h, --help            this text\n",
                f);
 }
@@ -102,6 +103,7 @@ int main(int argc, char** argv) {
         else if (a == "--clock-hz") clock_hz = std::strtol(value("--clock-hz").c_str(), nullptr, 10);
         else if (a == "--physics-hz") physics_hz = std::strtol(value("--physics-hz").c_str(), nullptr, 10);
         else if (a == "-h" || a == "--help") { usage(stdout); return 0; }
+        else if (a == "--version") { std::printf("caracara-sim %s\n", CARACARA_VERSION); return 0; }
         else {
             std::fprintf(stderr, "caracara-sim: unknown option '%s'\n", a.c_str());
             usage(stderr);

@@ -271,6 +271,7 @@ void print_help() {
                  "  -H --host=[USER@]HOST[:PORT]     Connect to the system bus of HOST over SSH (ssh runs\n"
                  "                                   systemd-stdio-bridge there, as for systemctl -H)\n"
                  "  --yes-power-off                  Confirm power-off without asking (also after it)\n"
+                 "  --version                        Show the version\n"
                  "  -h --help                        Show this help\n"
                  "\nCommand options (after the command, before or after its values):\n"
                  "  --for SECONDS                    thrust, motion, packet: hold for SECONDS (decimals\n"
@@ -345,6 +346,9 @@ int main(int argc, char** argv) {
                 options.yes_power_off = true;
             } else if (a == "-h" || a == "--help") {
                 print_help();
+                return kExitOk;
+            } else if (a == "--version") {
+                std::cout << "caracaractl " << CARACARA_VERSION << '\n';
                 return kExitOk;
             } else if (a.starts_with("-")) {
                 usage_error("unknown option '" + a + "'");

@@ -7,6 +7,8 @@ import time
 import unittest
 
 
+from bounds import (HUNG_KILL_OUTPUT_MS_MAX, VANISHED_CPU_PERCENT_MAX, VANISHED_LOG_LINES_MAX,
+                    VANISHED_WINDOW_S)
 from harness import (ERR, MOTORS, ZERO, Rig, error_name, poll, speed_byte)
 from test_paths_out import KILL_OUT, cpu_seconds
 
@@ -91,7 +93,7 @@ class HungThrusterTest(unittest.TestCase):
         print("\nKill() -> kill output with a thruster hanging 1 s: p50 %.2f ms, max %.2f ms" %
               (statistics.median(lat), max(lat)))
         # On the event loop's thread the kill would wait for the transfer on the wire (up to 1 s).
-        self.assertLess(max(lat), 500)
+        self.assertLess(max(lat), HUNG_KILL_OUTPUT_MS_MAX)
 
     def test_kill_switch_reaches_the_kill_output_at_once(self):
         lat = []
@@ -112,7 +114,7 @@ class HungThrusterTest(unittest.TestCase):
             poll(lambda: error_name(self.rig.vcall, "ClearKill") is None, 10)
         print("\nkill switch edge -> kill output with a thruster hanging 1 s: p50 %.2f ms, max %.2f ms" %
               (statistics.median(lat), max(lat)))
-        self.assertLess(max(lat), 500)
+        self.assertLess(max(lat), HUNG_KILL_OUTPUT_MS_MAX)
 
     def test_dbus_keeps_answering(self):
         self.drive_hung()
@@ -286,13 +288,13 @@ class SimulatorRestartTest(unittest.TestCase):
         poll(lambda: rig.state() == "killed", 10, message="the vanished hardware did not kill")
         cpu0, t0 = cpu_seconds(pid), time.monotonic()
         lines0 = rig.log().count("\n")
-        time.sleep(3)
+        time.sleep(VANISHED_WINDOW_S)
         cpu = (cpu_seconds(pid) - cpu0) / (time.monotonic() - t0) * 100
         lines = rig.log().count("\n") - lines0
-        print("\nsimulator gone: CPU %.2f %% of a core over 3 s, %d log lines, KillSource %s, bus %s" %
-              (cpu, lines, rig.vget("KillSource"), bus_state(rig)))
-        self.assertLess(cpu, 10.0)  # the target is 2 %; loosely here: a shared machine
-        self.assertLess(lines, 30)
+        print("\nsimulator gone: CPU %.2f %% of a core over %.0f s, %d log lines, KillSource %s, bus %s" %
+              (cpu, VANISHED_WINDOW_S, lines, rig.vget("KillSource"), bus_state(rig)))
+        self.assertLessEqual(cpu, VANISHED_CPU_PERCENT_MAX)
+        self.assertLessEqual(lines, VANISHED_LOG_LINES_MAX)
         self.assertEqual(error_name(rig.vcall, "ClearKill")[:len(ERR)], ERR)
 
         t_back = time.monotonic()

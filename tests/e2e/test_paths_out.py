@@ -15,6 +15,8 @@ import signal
 import dbus
 
 import harness
+from bounds import (COMMAND_TIMEOUT_LATENESS_MS_MAX, VANISHED_CPU_PERCENT_MAX, VANISHED_LOG_LINES_MAX,
+                    VANISHED_WINDOW_S)
 from harness import (ERR, MOTORS, ZERO, DEFAULT_MT, Rig, VehicleTestCase, command, error_name, poll, speed_byte)
 
 MISSION = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples", "mission_square.py")
@@ -351,15 +353,15 @@ class VanishedLinesTest(unittest.TestCase):
         poll(lambda: rig.state() == "killed", 10, message="a kill switch that cannot be read did not kill")
         log_before = rig.log().count("\n")
         cpu0, t0 = cpu_seconds(pid), time.monotonic()
-        time.sleep(5)
+        time.sleep(VANISHED_WINDOW_S)
         cpu = (cpu_seconds(pid) - cpu0) / (time.monotonic() - t0) * 100
         lines = rig.log().count("\n") - log_before
-        print("\nsimulator gone: daemon CPU %.2f %% of a core over 5 s, %d log lines, KillSource %s"
-              % (cpu, lines, rig.vget("KillSource")))
+        print("\nsimulator gone: daemon CPU %.2f %% of a core over %.0f s, %d log lines, KillSource %s"
+              % (cpu, VANISHED_WINDOW_S, lines, rig.vget("KillSource")))
         self.assertIn(rig.vget("KillSource"), ("switch", "bus"))
         self.assertIn("kill switch", rig.log())
-        self.assertLess(cpu, 10.0)  # the target is 2 %; loosely here: a shared machine
-        self.assertLess(lines, 60)
+        self.assertLessEqual(cpu, VANISHED_CPU_PERCENT_MAX)
+        self.assertLessEqual(lines, VANISHED_LOG_LINES_MAX)
         # Still serving D-Bus.
         self.assertEqual(error_name(rig.thrust, [100] * MOTORS)[:len(ERR)], ERR)
 
@@ -480,7 +482,7 @@ class CommandTimeoutTimerTest(VehicleTestCase):
         print("\ncommand timeout 500 ms: first zero order %s ms after it (median %.2f ms)"
               % (", ".join("%.2f" % v for v in lateness), median))
         # Before, the zero waited for the next 50 Hz tick: 13-19 ms late.
-        self.assertLess(median, 8.0)
+        self.assertLess(median, COMMAND_TIMEOUT_LATENESS_MS_MAX)
         self.assertGreater(median, -2.0, "zeroed before the timeout")
 
 

@@ -25,7 +25,9 @@
 # Needs root, debootstrap, systemd-container, openssh-client and iproute2 (installed with apt-get
 # when missing), and /usr/bin/python3 with python3-dbus for the example mission (scripts/deps.sh). The
 # Debian mirror is the one this machine's apt uses (CARACARA_SYSTEST_MIRROR overrides it).
-# Exit status 77 (skipped) when not run as root.
+# Exit status 77 (skipped) when not run as root; under CI (CI=true) that fails instead.
+# It passes only with every planned check passed (checks_planned below: "system: N of N checks
+# passed"), so a check script cut off early, or a topside.sh that died, fails it.
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -57,10 +59,22 @@ recipe=1
 
 say() { echo "system-test: $*"; }
 die() { echo "system-test: FAIL: $*" >&2; exit 1; }
+# cannot_run REASON: skipped (77) on a developer's machine; under CI a suite that cannot run fails.
+cannot_run() {
+  [ "${CI:-}" != true ] || die "cannot run under CI (CI=true): $*"
+  say "SKIP: $*"
+  echo "system: not run ($*)"
+  exit 77
+}
+# The number of checks (PASS/FAIL lines of check.sh, check-debs.sh, check-topside.sh and
+# topside.sh) a complete run makes: with --debs (what CTest and CI run) and with a build tree
+# (cmake --install: check.sh's two installation checks instead of check-debs.sh's 34). A check
+# added or removed changes it here.
+checks_planned_debs=157
+checks_planned_install=125
 
 if [ "$(id -u)" -ne 0 ]; then
-  say "SKIP: needs root (debootstrap, systemd-nspawn)"
-  exit 77
+  cannot_run "needs root (debootstrap, systemd-nspawn)"
 fi
 [ -n "$debs" ] || for bin in caracarad caracara-sim caracaractl; do
   case $bin in caracarad) p=daemon/$bin ;; caracara-sim) p=sim/$bin ;; *) p=tools/$bin ;; esac
@@ -279,8 +293,12 @@ if [ ! -f "$out/done" ]; then
 fi
 npass=$(grep -c '^PASS: ' "$out/results.txt" 2>/dev/null || true)
 nfail=$(grep -c '^FAIL: ' "$out/results.txt" 2>/dev/null || true)
+if [ -n "$debs" ]; then planned=$checks_planned_debs; else planned=$checks_planned_install; fi
 [ "${nfail:-0}" -eq 0 ] || failed=1
-[ "${npass:-0}" -gt 0 ] || failed=1
+if [ "$((${npass:-0} + ${nfail:-0}))" -ne "$planned" ]; then
+  say "FAIL: $((${npass:-0} + ${nfail:-0})) checks ran, $planned planned"
+  failed=1
+fi
 if [ "$failed" -ne 0 ]; then
   echo "---- container console (last 80 lines) ----"
   tail -n 80 "$work/console.log" || true
@@ -291,4 +309,6 @@ if [ "$failed" -ne 0 ]; then
   grep '^FAIL: ' "$out/results.txt" 2>/dev/null || true
 fi
 say "${npass:-0} passed, ${nfail:-0} failed ($(($(date +%s) - t0)) s in all)"
+# The line scripts/test.sh's table reads.
+echo "system: ${npass:-0} of $planned checks passed"
 exit "$failed"

@@ -2,7 +2,8 @@
 # Debian 12 container booted with systemd-nspawn, installed from this tree's Debian packages
 # with apt-get (then upgraded while the thrusters run, and purged). system_debs builds them
 # first (scripts/package.sh, nocheck: the suite runs here anyway; alone, so that its compile
-# does not slow the timing-sensitive tests down). Needs root; exit status 77 (skipped) otherwise.
+# does not slow the timing-sensitive tests down). Needs root; exit status 77 (skipped) otherwise,
+# a failure under CI (CI=true).
 # Run once, in the normal build.
 if(NOT CARACARA_SANITIZE AND NOT CMAKE_CROSSCOMPILING)
   add_test(NAME system_debs
