@@ -442,30 +442,36 @@ def sc_i2ctransfer(rig):
     check(nack and nack[-1].result == "nack", "no NACK of 0x11 in the wire log")
 
 
+def write_config(rig, **sections):
+    """Replaces some sections of the daemon's configuration file (read at its next start)."""
+    rig.extra_config = dict(rig.extra_config, **sections)
+    with open(rig.config_path, "w") as f:
+        f.write(rig.config_text())
+
+
 def restart_with(rig, **sections):
     """Stops caracarad and starts it again with some config sections replaced."""
     rig.terminate("caracarad")
-    cfg = dict(rig.extra_config)
-    cfg.update(sections)
-    rig.extra_config = cfg
-    with open(rig.config_path, "w") as f:
-        f.write(rig.config_text())
+    write_config(rig, **sections)
     rig.start_daemon()
     rig.arm(60)
+
+
+def kill_and_clear(rig, message):
+    """Kill raises the kill output (line 27) on the wire; ClearKill makes the vehicle ready."""
+    since = rig.wire_next()
+    rig.vcall("Kill")
+    wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5, message)
+    rig.vcall("ClearKill")
+    rig.wait_state("ready", 20)
 
 
 def sc_unwired_line(rig):
     """A line the kernel refuses (the bridge wires no GPIO5): the daemon names it and exits."""
     rig.terminate("caracarad")
-    gpio = dict(GPIO, kill_output={"chip": "gpiochip0", "line": "GPIO5"})
-    path = os.path.join(rig.dir, "unwired.toml")
-    cfg = dict(rig.extra_config, gpio=gpio)
-    with open(path, "w") as f:
-        f.write(harness.toml_dumps(dict({"control": rig.control}, **cfg)) + "\n" + rig.extra_toml)
-    r = subprocess.run([binary("caracarad"), "--bus-address", rig.address, "--config", path],
-                       capture_output=True, text=True, timeout=60)
-    out = r.stdout + r.stderr
-    check(r.returncode != 0, "caracarad started with an unwired kill output")
+    code, out = restart_refused(rig, os.path.join(rig.dir, "unwired.toml"),
+                                gpio=dict(GPIO, kill_output={"chip": "gpiochip0", "line": "GPIO5"}))
+    check(code != 0, "caracarad started with an unwired kill output")
     check("GPIO5" in out and "kill_output" in out, "the error does not name the line: %r" % out[-400:])
 
 
@@ -496,12 +502,7 @@ def sc_gpio_lookup(rig):
         for name, direction in (("GPIO17", "in"), ("GPIO27", "out"), ("GPIO22", "out")):
             check(used.get(name, ("", ""))[0] == "caracarad", "%s not requested by caracarad: %r" % (name, used))
             check(used[name][1] == direction, "%s is %s, not %s" % (name, used[name][1], direction))
-        since = rig.wire_next()
-        rig.vcall("Kill")
-        wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5,
-                  "the kill output found by label and offset did not go high")
-        rig.vcall("ClearKill")
-        rig.wait_state("ready", 20)
+        kill_and_clear(rig, "the kill output found by label and offset did not go high")
         rig.sim_call("SetKillSwitch", True, signature="b")
         try:
             rig.wait_state("killed", 10)
@@ -541,10 +542,8 @@ def sc_per_byte_spi_active_low(rig):
               "the active-low kill output did not go back high")
     # An active-low kill switch, inverted by gpiolib too: at rest (physically low) it reads set.
     rig.terminate("caracarad")
-    rig.extra_config = dict(rig.extra_config, gpio=dict(gpio, kill_switch=dict(GPIO["kill_switch"], active_low=True)))
     try:
-        with open(rig.config_path, "w") as f:
-            f.write(rig.config_text())
+        write_config(rig, gpio=dict(gpio, kill_switch=dict(GPIO["kill_switch"], active_low=True)))
         rig.start_daemon()
         rig.wait_state("killed", 10)
         # The start kill stands (source "start"); the switch read set keeps it from being cleared.
@@ -699,13 +698,34 @@ def sc_recovery_driver_path_missing(rig):
                   "the failed %s is not named: %r" % (what, text[-600:]))
     finally:
         rig.terminate("caracarad")
-        cfg = dict(rig.extra_config, recovery=RECOVERY)
-        rig.extra_config = cfg
-        with open(rig.config_path, "w") as f:
-            f.write(rig.config_text())
+        write_config(rig, recovery=RECOVERY)
         rig.start_daemon()
     poll(lambda: rig.bus("State") == "ok", 60, interval=0.2, message="the bus never came back")
     rig.arm(60)
+
+
+def sc_adapter_lost_without_recovery(rig):
+    """Recovery not configured: every transfer failing (EIO) loses the bus and kills with source
+    "bus"; the adapter is closed and opened again once a second, the first reopens refused
+    (I2C_FUNCS without plain I2C) with the transfers in between failing as no device, until
+    the adapter answers again: the bus is back, the vehicle stays killed until ClearKill."""
+    restart_with(rig, recovery=dict(RECOVERY, enabled=False))
+    mark = len(rig.log("caracarad"))
+    try:
+        inject(i2c_fail_addr=-1, i2c_fail_errno=errno.EIO, i2c_fail_count=1000000, i2c_func_fail_count=2)
+        rig.wait_state("killed", 30)
+        check(rig.vget("KillSource") == "bus", "KillSource %r" % rig.vget("KillSource"))
+        check(rig.bus("State") == "lost", "bus state %s" % rig.bus("State"))
+        wait_log(rig, mark, r"recovery is not configured: reopening the adapter once a second")
+        poll(lambda: injected("i2c_func_fail_count") == 0, 15, message="the adapter was not opened again")
+    finally:
+        clear_faults()
+    poll(lambda: rig.bus("State") == "ok", 30, interval=0.2, message="the bus never came back")
+    rig.wait_sim_zero(20)
+    check(rig.state() == "killed", "a bus kill cleared itself")
+    rig.vcall("ClearKill")
+    rig.wait_state("ready", 20)
+    restart_with(rig, recovery=RECOVERY)
 
 
 def sc_adapter_never_binds(rig):
@@ -806,23 +826,26 @@ def sc_gpio_refused(rig):
 
 
 def sc_kill_switch_read_fails(rig):
-    """The kill switch's value read (after an edge) fails in the kernel: the switch counts as
-    set (a kill, source "switch"), and the line is asked for again; once it reads clear the
-    vehicle can be armed."""
-    mark = len(rig.log("caracarad"))
-    inject(gpio_fail_offset=17, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=errno.EIO, gpio_fail_count=1)
-    try:
-        rig.sim_call("SetKillSwitch", True, signature="b")
-        rig.sim_call("SetKillSwitch", False, signature="b")
-        rig.wait_state("killed", 10)
-        check(rig.vget("KillSource") == "switch", "KillSource %r" % rig.vget("KillSource"))
-        check(injected("gpio_fail_count") == 0, "the read never failed")
-        wait_log(rig, mark, r"kill switch gpiochip0:GPIO17 cannot be read \(EIO")
-        wait_log(rig, mark, r"kill switch gpiochip0:GPIO17 is back", 10)
-    finally:
-        inject(gpio_fail_count=0, gpio_fail_offset=-1, gpio_fail_op=0)
-    rig.vcall("ClearKill")
-    rig.wait_state("ready", 20)
+    """The kill switch's value read (after an edge) fails in the kernel, with EIO and with the
+    errnos libgpiod 2's C++ binding turns into exceptions of their own (E2BIG, EDOM, ENOMEM):
+    each time the switch counts as set (a kill, source "switch") under the kernel's errno, and
+    the line is asked for again; once it reads clear the vehicle can be armed."""
+    for err in (errno.EIO, errno.E2BIG, errno.EDOM, errno.ENOMEM):
+        name = errno.errorcode[err]
+        mark = len(rig.log("caracarad"))
+        inject(gpio_fail_offset=17, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=err, gpio_fail_count=1)
+        try:
+            rig.sim_call("SetKillSwitch", True, signature="b")
+            rig.sim_call("SetKillSwitch", False, signature="b")
+            rig.wait_state("killed", 10)
+            check(rig.vget("KillSource") == "switch", "%s: KillSource %r" % (name, rig.vget("KillSource")))
+            check(injected("gpio_fail_count") == 0, "%s: the read never failed" % name)
+            wait_log(rig, mark, r"kill switch gpiochip0:GPIO17 cannot be read \(%s" % name)
+            wait_log(rig, mark, r"kill switch gpiochip0:GPIO17 is back", 10)
+        finally:
+            inject(gpio_fail_count=0, gpio_fail_offset=-1, gpio_fail_op=0)
+        rig.vcall("ClearKill")
+        rig.wait_state("ready", 20)
 
 
 def sc_kill_switch_event_overflow(rig):
@@ -851,12 +874,11 @@ def bind_gpio(bound):
 
 def sc_gpio_chip_gone(rig):
     """The GPIO chip goes while caracarad holds its lines (its driver unbound: the module
-    cannot be unloaded while they are held): the kill switch's event file reports it, the
-    vehicle is killed, the daemon asks for the lines once a second, and when the chip is
-    bound again (found by its label: it comes back under a new number) the lines are back,
-    the kill output works, and the vehicle can be armed. The gone chip's number stays taken
-    (Linux 6.1 keeps the references of the lines held when it went): the scenarios after this
-    one find the chip by its label."""
+    cannot be unloaded while they are held): the daemon finds the kill switch unreadable and
+    the kill output unwritable, the vehicle is killed, the lines are asked for once a second,
+    and when the chip is bound again (found by its label, whatever number it comes back
+    under) the lines are back, the kill output works, and the vehicle can be armed. The
+    scenarios after this one find the chip by its label too."""
     by_label = {k: dict(v, chip="caracara-gpio") for k, v in GPIO.items()}
     restart_with(rig, gpio=by_label)
     mark = len(rig.log("caracarad"))
@@ -878,12 +900,7 @@ def sc_gpio_chip_gone(rig):
         check(bool(rig.sim_get("KillOutput")), "the kill output came back deasserted on a killed vehicle")
         rig.vcall("ClearKill")
         rig.wait_state("ready", 20)
-        since = rig.wire_next()
-        rig.vcall("Kill")
-        wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5,
-                  "the kill output on the chip bound again did not go high")
-        rig.vcall("ClearKill")
-        rig.wait_state("ready", 20)
+        kill_and_clear(rig, "the kill output on the chip bound again did not go high")
     finally:
         if not bound:
             bind_gpio(True)
@@ -970,6 +987,7 @@ SCENARIOS = [
     ("spi_message_and_mode_refused", sc_spi_refused),
     ("bus_clear_gpio_faults_and_failed_bind", sc_bus_clear_faults),
     ("adapter_never_binds_bus_lost", sc_adapter_never_binds),
+    ("adapter_lost_without_recovery_reopened", sc_adapter_lost_without_recovery),
     ("recovery_driver_path_missing", sc_recovery_driver_path_missing),
     ("scl_held_low_bus_kill", sc_scl_low),
     ("per_byte_spi_and_active_low_output", sc_per_byte_spi_active_low),
