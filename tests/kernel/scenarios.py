@@ -577,7 +577,8 @@ def injected(name):
 
 def clear_faults():
     inject(i2c_fail_count=0, i2c_func_fail_count=0, i2c_probe_fail_count=0, spi_fail_count=0,
-           spi_setup_fail_count=0, gpio_fail_count=0, i2c_fail_addr=-1, gpio_fail_offset=-1, gpio_fail_op=0)
+           spi_setup_fail_count=0, gpio_fail_count=0, gpio_fail_skip=0, i2c_fail_addr=-1, gpio_fail_offset=-1,
+           gpio_fail_op=0, gpio_fail_errno=errno.EIO)
 
 
 def log_since(rig, mark):
@@ -644,13 +645,18 @@ def sc_spi_refused(rig):
     the first reopen is refused (the controller refuses the mode: SPI_IOC_WR_MODE), the next
     one brings the Teensy back."""
     poll(lambda: bool(tget(rig, "Online")), 15, message="Teensy not online")
-    inject(spi_fail_errno=errno.EIO, spi_fail_count=2)
-    # Two polls in a row refused: the Teensy reads offline until a poll gets through.
-    poll(lambda: not tget(rig, "Online"), 15, message="refused SPI messages left the Teensy online")
-    check(injected("spi_fail_count") < 2, "no SPI message refused")
+    refusals = 1000000
+    inject(spi_fail_errno=errno.EIO, spi_fail_count=refusals)
+    try:
+        # Every message refused: the Teensy reads offline, and stays so; no kill for EIO.
+        poll(lambda: not tget(rig, "Online"), 15, message="refused SPI messages left the Teensy online")
+        check(injected("spi_fail_count") < refusals, "no SPI message refused")
+        time.sleep(1.0)
+        check(not tget(rig, "Online"), "the Teensy reads online while every message is refused")
+        check(rig.state() == "ready", "an SPI EIO killed: %s (%s)" % (rig.state(), rig.vget("KillSource")))
+    finally:
+        inject(spi_fail_count=0)
     poll(lambda: bool(tget(rig, "Online")), 15, message="Teensy not back online after EIO")
-    check(injected("spi_fail_count") == 0, "the Teensy came back before both refusals")
-    check(rig.state() == "ready", "an SPI EIO killed: %s (%s)" % (rig.state(), rig.vget("KillSource")))
     mark = len(rig.log("caracarad"))
     bound = True
     try:
@@ -788,8 +794,8 @@ def hold_line(offset):
 
 
 def sc_gpio_refused(rig):
-    """A line another process holds (EBUSY), a chip that does not exist, a line name or offset
-    the chip does not have, an adapter without plain I2C: caracarad names the line (or the
+    """A line another process holds (EBUSY), a chip that does not exist (or has no name), a line
+    name or offset the chip does not have, an adapter without plain I2C: caracarad names the line (or the
     bus) and the kernel's reason, and does not start. Output and input lines both (libgpiod's
     output and input request paths differ). Then it starts again on the real lines."""
     rig.terminate("caracarad")
@@ -805,7 +811,8 @@ def sc_gpio_refused(rig):
         cases.append(("%s held elsewhere" % key, code, out, ["gpio." + key, line, "busy"]))
         for what, spec, words in (("on a missing chip", {"chip": "gpiochip9", "line": line}, ["gpiochip9"]),
                                   ("a missing line name", {"chip": "gpiochip0", "line": "NOSUCH"}, ["NOSUCH"]),
-                                  ("a missing offset", {"chip": "gpiochip0", "line": 40}, ["gpiochip0 line 40"])):
+                                  ("a missing offset", {"chip": "gpiochip0", "line": 40}, ["gpiochip0 line 40"]),
+                                  ("an empty chip name", {"chip": "", "line": line}, [])):
             code, out = restart_refused(rig, path, gpio=dict(GPIO, **{key: spec}))
             cases.append(("%s %s" % (key, what), code, out, ["gpio." + key] + words))
     inject(i2c_func_fail_count=1)
@@ -843,7 +850,7 @@ def sc_kill_switch_read_fails(rig):
             wait_log(rig, mark, r"kill switch gpiochip0:GPIO17 cannot be read \(%s" % name)
             wait_log(rig, mark, r"kill switch gpiochip0:GPIO17 is back", 10)
         finally:
-            inject(gpio_fail_count=0, gpio_fail_offset=-1, gpio_fail_op=0)
+            clear_faults()
         rig.vcall("ClearKill")
         rig.wait_state("ready", 20)
 
@@ -910,7 +917,8 @@ def sc_gpio_chip_gone(rig):
 def sc_bus_clear_faults(rig):
     """Bus recoveries the kernel makes harder: the SCL line refused at its request and the
     adapter's driver refusing to bind (attempt 1 fails and names both), the node back without
-    plain I2C once, then SDA, then SCL unreadable, then the SDA line busy in the next hangs: each time the next attempt clears
+    plain I2C once, then SDA, then SCL unreadable, the SDA line busy, SCL read low after a
+    pulse, SDA read low through all nine pulses in the next hangs: each time the next attempt clears
     the bus, the adapter comes back, and the orders resume without a kill."""
     values = [0, 1700, 0, 0, 0, 0, 0, 0]
     rig.thrust(values)
@@ -924,7 +932,13 @@ def sc_bus_clear_faults(rig):
             (3, dict(gpio_fail_offset=3, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=errno.EIO, gpio_fail_count=1),
              [r"reading SCL: EIO"]),
             (4, dict(gpio_fail_offset=2, gpio_fail_op=GPIO_OP_REQUEST, gpio_fail_errno=errno.EBUSY, gpio_fail_count=1),
-             [r"SDA: gpiochip0:GPIO2: .*busy"])):
+             [r"SDA: gpiochip0:GPIO2: .*busy"]),
+            # Levels, not errors: SCL read low after the first pulse, SDA low through all nine.
+            (5, dict(gpio_fail_offset=3, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=0, gpio_fail_skip=1,
+                     gpio_fail_count=1),
+             [r"SCL stayed low after a clock pulse"]),
+            (6, dict(gpio_fail_offset=2, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=0, gpio_fail_count=10),
+             [r"SDA still low after 9 clock pulses"])):
         rec0 = int(rig.bus("Recoveries"))
         bind0 = int(rig.sim_get("Binds"))
         mark = len(rig.log("caracarad"))

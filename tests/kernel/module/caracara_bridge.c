@@ -23,8 +23,9 @@
  *   - spi_fail_errno, spi_fail_count: an SPI message refused; spi_setup_fail_count: the
  *     controller refuses a mode/word size/speed (spidev's SPI_IOC_WR_* ioctls; never the
  *     setup of the probe's own device).
- *   - gpio_fail_errno, gpio_fail_offset, gpio_fail_op (CCB_GPIO_* op, 0 any), gpio_fail_count:
- *     a line operation fails (a get by the kernel's own edge handler is never failed).
+ *   - gpio_fail_errno, gpio_fail_offset, gpio_fail_op (CCB_GPIO_* op, 0 any), gpio_fail_count,
+ *     gpio_fail_skip: after gpio_fail_skip matching operations, a line operation fails (errno
+ *     0: a GET reads low); a get by the kernel's own edge handler is never failed.
  *
  * Protocol: sim/kernel_bridge_abi.h and docs/kernel-bridge.md. One request is in flight
  * at a time; with no server attached every request fails with -ENXIO, and a server that
@@ -93,6 +94,8 @@ static int gpio_fail_op;
 module_param(gpio_fail_op, int, 0644);
 static int gpio_fail_count;
 module_param(gpio_fail_count, int, 0644);
+static int gpio_fail_skip;
+module_param(gpio_fail_skip, int, 0644);
 
 /* True (and one fewer left) when this request is to fail. */
 static bool ccb_take_fault(int *count, bool match)
@@ -601,16 +604,41 @@ static const char *const ccb_names[CCB_NGPIO] = {
 	"GPIO19", "GPIO20", "GPIO21", "GPIO22", "GPIO23", "GPIO24", "GPIO25", "GPIO26", "GPIO27",
 };
 
+/* The injected result of this line operation: -errno, or 0 (a GET reads low) when it is to
+ * fail; 1 when it goes on as usual. */
+static int ccb_gpio_fault(unsigned int offset, u16 op)
+{
+	int fop = READ_ONCE(gpio_fail_op), foff = READ_ONCE(gpio_fail_offset);
+	unsigned long flags;
+	bool take = false;
+
+	if ((fop && fop != op) || (foff >= 0 && foff != offset))
+		return 1;
+	spin_lock_irqsave(&ccb_fault_lock, flags);
+	if (gpio_fail_count > 0) {
+		if (gpio_fail_skip > 0) {
+			gpio_fail_skip--;
+		} else {
+			gpio_fail_count--;
+			take = true;
+		}
+	}
+	spin_unlock_irqrestore(&ccb_fault_lock, flags);
+	if (!take)
+		return 1;
+	return gpio_fail_errno ? -abs(gpio_fail_errno) : 0;
+}
+
 static int ccb_gpio_op(unsigned int offset, u16 op, u32 value, u32 flags)
 {
 	struct {
 		struct ccb_header h;
 		struct ccb_gpio g;
 	} req = { .g = { .offset = offset, .value = value, .flags = flags } };
-	int fop = READ_ONCE(gpio_fail_op), foff = READ_ONCE(gpio_fail_offset);
+	int fault = ccb_gpio_fault(offset, op);
 
-	if (ccb_take_fault(&gpio_fail_count, (fop == 0 || fop == op) && (foff < 0 || foff == offset)))
-		return -abs(gpio_fail_errno);
+	if (fault <= 0)
+		return fault;
 	return ccb_transact(&req, sizeof(req), CCB_GPIO, op, NULL, 0, NULL);
 }
 
@@ -660,12 +688,13 @@ static int ccb_gpio_get(struct gpio_chip *gc, unsigned int offset)
 		v = ccb_level[offset];
 	spin_unlock_irqrestore(&ccb_gpio_lock, flags);
 	if (v >= 0) {
-		int fop = READ_ONCE(gpio_fail_op), foff = READ_ONCE(gpio_fail_offset);
-
 		/* The edge handler (inside the server's write) reads too: only a reader's get fails. */
-		if (READ_ONCE(ccb_level_task) != current &&
-		    ccb_take_fault(&gpio_fail_count, (fop == 0 || fop == CCB_GPIO_GET) && (foff < 0 || foff == offset)))
-			return -abs(gpio_fail_errno);
+		if (READ_ONCE(ccb_level_task) != current) {
+			int fault = ccb_gpio_fault(offset, CCB_GPIO_GET);
+
+			if (fault <= 0)
+				return fault;
+		}
 		return v;
 	}
 	return ccb_gpio_op(offset, CCB_GPIO_GET, 0, 0);
