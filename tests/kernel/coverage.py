@@ -32,8 +32,8 @@ WHY = [
     (r"", r"^caracara::GpioLine::(event_fd|drain_events|set_in_signal_handler)\(",
      "GpioLine's default, emitted with the backend's classes; every line of this backend overrides it"),
     (r"", r"^caracara::(GpioLine|GpioBackend|DeviceIo)::~(GpioLine|GpioBackend|DeviceIo)\(\)",
-     "the interface's inline destructor as GCC emits it in this file: the objects destroyed are of the "
-     "derived classes, whose destructors (executed) have it inlined"),
+     "the interface's inline destructor, a copy GCC emits in this file: the objects are destroyed "
+     "through their own classes' destructors"),
     (r"libgpiod2?_backend|libgpiod2_line", r"Libgpiod2?Line::set\(",
      "an input line's set (EPERM, as the kernel would answer): nothing sets an input"),
 ]

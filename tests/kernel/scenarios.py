@@ -639,8 +639,8 @@ def bind_driver(driver, bound):
 
 
 def sc_spi_refused(rig):
-    """SPI messages the module refuses (EIO): the Teensy reads offline until a poll gets
-    through, no kill. Then the SPI controller's driver unbound under the open spidev (spidev
+    """SPI messages the module refuses (EIO): the Teensy reads offline as long as they are
+    refused, no kill, and online again after. Then the SPI controller's driver unbound under the open spidev (spidev
     answers ESHUTDOWN): the Teensy is gone, the vehicle killed with source "device"; bound again,
     the first reopen is refused (the controller refuses the mode: SPI_IOC_WR_MODE), the next
     one brings the Teensy back."""

@@ -45,9 +45,9 @@ def main():
            "| scenario | result | what it proves |",
            "| --- | --- | --- |"]
     for name, what in scenarios:
+        # Without the seconds: the section changes when a result does, not at every run.
         r = results.get(name, "no result")
-        m = re.match(r"PASS \S+ \(([\d.]+ s)\)", r)
-        shown = "pass (%s)" % m.group(1) if m else r.replace("|", "/")
+        shown = "pass" if r.startswith("PASS") else r.replace("|", "/")
         out.append("| `%s` | %s | %s |" % (name, shown, what.replace("|", "/")))
     out.append("")
     if cov:
