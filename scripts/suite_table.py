@@ -110,7 +110,7 @@ def inner_counts(text):
         counts.append(("python tests", int(m.group(1)), int(m.group(1))))
     for m in re.finditer(r"^(?:OK|FAILED) \(.*skipped=(\d+)", text, re.M):
         skips += int(m.group(1))
-    for m in re.finditer(r"^(system|kernel): (\d+) of (\d+) (checks|scenarios) passed", text, re.M):
+    for m in re.finditer(r"^(system|kernel)(?: \(debian13\))?: (\d+) of (\d+) (checks|scenarios) passed", text, re.M):
         counts.append((m.group(4), int(m.group(2)), int(m.group(3))))
     for m in re.finditer(r"^(system|kernel|debian13): not run \((.*)\)", text, re.M):
         reason = m.group(2)

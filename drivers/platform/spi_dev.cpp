@@ -55,6 +55,10 @@ void SpiDev::close() {
 }
 
 int SpiDev::fail(int neg_errno) {
+    // spidev answers ESHUTDOWN on a descriptor whose device was removed (its controller's driver
+    // unbound): gone, as ENODEV says, so the node is closed and opened anew when it is back.
+    if (neg_errno == -ESHUTDOWN)
+        neg_errno = -ENODEV;
     last_errno_ = -neg_errno;
     return neg_errno;
 }

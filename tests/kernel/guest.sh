@@ -11,7 +11,9 @@ fi
 ls -l /dev/caracara-bridge /dev/i2c-* /dev/spidev* /dev/gpiochip* 2>&1
 export TMPDIR=/run/tmp HOME=/run/tmp
 export GCOV_PREFIX="$OUT/gcov" GCOV_PREFIX_STRIP=0
+# A caracarad that dies of its fatal signal writes its counters too (tests/kernel/gcov_flush.c).
+export LD_PRELOAD="$WORK/gcov_flush.so"
 export CARACARA_BUILD_DIR="$COV" PYTHONDONTWRITEBYTECODE=1
 cd "$TOP/tests/kernel"
-timeout 300 /usr/bin/python3 scenarios.py "$OUT/results.txt" ${SCENARIOS:-}
+timeout 600 /usr/bin/python3 scenarios.py "$OUT/results.txt" ${SCENARIOS:-}
 echo "guest: scenarios exited $?"

@@ -6,11 +6,16 @@
 # the scenarios (tests/kernel/scenarios.py) judge it from the simulator's wire log.
 #
 #   tests/kernel/run.sh [WORK_DIR]     (default: build-kernel in the source tree)
-#   CARACARA_KERNEL_SCENARIOS='start kill' tests/kernel/run.sh    only those scenarios
-#   CARACARA_KERNEL_ROOT=DIR CARACARA_KERNEL_BUILD=BUILD tests/kernel/run.sh WORK_DIR
+#   CARACARA_KERNEL_SCENARIOS='start kill' tests/kernel/run.sh    only those scenarios (not under CI)
+#   CARACARA_KERNEL_ROOT=DIR CARACARA_KERNEL_BUILD=BUILD CARACARA_KERNEL_LABEL=debian13 \
+#     tests/kernel/run.sh WORK_DIR
 #       the guest runs in the root DIR instead of the host's (tests/system/debian13.sh: a Debian
-#       13 root with libgpiod 2) with the binaries of BUILD (not rebuilt, no coverage); the
-#       source tree, BUILD and WORK_DIR must be at the same paths in DIR as on the host.
+#       13 root with libgpiod 2) with the binaries of BUILD, a --coverage build made in DIR (not
+#       rebuilt here; gcov is DIR's); the source tree, BUILD and WORK_DIR must be at the same
+#       paths in DIR as on the host. The label names the run in its summary line and in
+#       docs/kernel-bridge.md.
+#   CARACARA_KERNEL_DOC=0: leave docs/kernel-bridge.md alone (by default the run writes its
+#       scenario list and coverage table there, tests/kernel/write_doc.py).
 #
 # Fetches the kernel, headers and kbuild .debs with apt-get download into
 # /var/cache/caracara-kernel/VERSION (unpacked there, never installed), builds the module
@@ -18,18 +23,38 @@
 # boots the VM with the host root shared read-only over 9p (the guest chroots into it, so
 # the host's binaries run unchanged) and WORK_DIR/out shared writable for the results, and
 # prints the scenario results and the line coverage of the kernel-facing files.
-# Exit: 0 all scenarios passed, 1 a failure, 77 skipped (not root).
+#
+# Every scenario or none: the scenario list is taken before the guest boots (scenarios.py
+# --list), and the run passes only with every one of them passed; it ends with the line
+# "LABEL: P of N scenarios passed" (scripts/test.sh reads it). A file of the kernel-facing set
+# without coverage data fails the run too (tests/kernel/coverage.py); the percentage does not.
+# Exit: 0 every scenario passed, 1 a failure, 77 cannot run here (not root, no QEMU...) outside
+# CI; under CI (CI=true) a run that cannot happen fails with its reason.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/../.." && pwd)
 cache=/var/cache/caracara-kernel
 t0=$(date +%s)
+label=${CARACARA_KERNEL_LABEL:-kernel}
+[ "$label" = kernel ] || label="kernel ($label)"
 
-if [ "$(id -u)" -ne 0 ]; then
-  echo "kernel: needs root (apt-get download into $cache, packages for QEMU); skipped"
+# What stops the run before any scenario: a skip outside CI, a failure under it.
+cannot_run() {
+  if [ "${CI:-}" = true ]; then
+    echo "$label: FAIL: cannot run under CI: $*"
+    exit 1
+  fi
+  echo "$label: SKIP: $*"
   exit 77
+}
+if [ "$(id -u)" -ne 0 ]; then
+  cannot_run "needs root (apt-get download into $cache, packages for QEMU)"
+fi
+if [ -n "${CARACARA_KERNEL_SCENARIOS:-}" ] && [ "${CI:-}" = true ]; then
+  echo "$label: FAIL: CARACARA_KERNEL_SCENARIOS under CI (CI runs every scenario)"
+  exit 1
 fi
 work=$(mkdir -p "${1:-$top/build-kernel}" && cd "${1:-$top/build-kernel}" && pwd)
-step() { echo "== kernel: $* ($(( $(date +%s) - t0 )) s)"; }
+step() { echo "== $label: $* ($(( $(date +%s) - t0 )) s)"; }
 
 # --- tools ---------------------------------------------------------------------------------
 pkgs=(qemu-system-x86 busybox-static i2c-tools python3-dbus python3-gi dbus make gcc-12 kmod cpio)
@@ -39,9 +64,13 @@ for p in "${pkgs[@]}"; do
 done
 if ((${#missing[@]})); then
   step "installing ${missing[*]}"
-  apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  apt-get update -qq || true
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null ||
+    cannot_run "cannot install ${missing[*]}"
 fi
+# The scenarios to run, known before the guest boots: each must come back PASS.
+mapfile -t scenario_list < <(/usr/bin/python3 "$top/tests/kernel/scenarios.py" --list ${CARACARA_KERNEL_SCENARIOS:-})
+((${#scenario_list[@]})) || { echo "$label: FAIL: no scenario list (scenarios.py --list)"; exit 1; }
 
 # --- kernel, headers -----------------------------------------------------------------------
 # Nothing cached yet: fresh package lists, so the version asked for can still be downloaded.
@@ -51,7 +80,7 @@ if [ -z "$kver" ] || { [ ! -f "$cache/$kver/.ok" ] && ! apt-cache show "linux-im
   # No package lists: whatever was cached last.
   kver=$(ls -t "$cache" 2>/dev/null | head -1)
 fi
-[ -n "$kver" ] || { echo "kernel: cannot tell which kernel to fetch (apt-get update?)"; exit 1; }
+[ -n "$kver" ] || cannot_run "cannot tell which kernel to fetch (apt-get update?)"
 kdir=$cache/$kver
 if [ ! -f "$kdir/.ok" ]; then
   step "fetching linux-image-$kver and its headers"
@@ -59,8 +88,7 @@ if [ ! -f "$kdir/.ok" ]; then
   kbuild=$(apt-cache depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-kbuild-.*\)$/\1/p' | head -1)
   common=$(apt-cache depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-headers-.*-common\)$/\1/p' | head -1)
   if ! (cd "$kdir/debs" && apt-get download -qq "linux-image-$kver" "linux-headers-$kver" "$common" "$kbuild" 2>/dev/null); then
-    echo "kernel: apt-get download of linux-image-$kver and its headers failed"
-    exit 1
+    cannot_run "apt-get download of linux-image-$kver and its headers failed"
   fi
   for d in "$kdir"/debs/*.deb; do dpkg-deb -x "$d" "$kdir/root"; done
   # The headers' Makefile includes the common tree by its installed path; point it here.
@@ -78,13 +106,17 @@ mod=$work/module
 rm -rf "$mod" && mkdir -p "$mod"
 cp "$top/tests/kernel/module/caracara_bridge.c" "$top/tests/kernel/module/Kbuild" "$top/sim/kernel_bridge_abi.h" "$mod/"
 nice -n 10 make -s -C "$kroot/usr/src/linux-headers-$kver" M="$mod" -j2 modules 2>&1 | grep -v 'Skipping BTF generation' || true
-[ -f "$mod/caracara_bridge.ko" ] || { echo "kernel: module build failed"; exit 1; }
+[ -f "$mod/caracara_bridge.ko" ] || { echo "$label: FAIL: module build failed"; exit 1; }
+
+# --- gcov_flush.so: a caracarad dying of its fatal signal still writes its counters ----------
+nice -n 10 gcc -O2 -Wall -Werror -shared -fPIC "$top/tests/kernel/gcov_flush.c" -o "$work/gcov_flush.so" -ldl
 
 # --- caracarad and caracara-sim with coverage ----------------------------------------------
 guest_root=${CARACARA_KERNEL_ROOT:-/}
 if [ -n "${CARACARA_KERNEL_BUILD:-}" ]; then
   cov=$CARACARA_KERNEL_BUILD
   step "using caracarad and caracara-sim of $cov in the guest root $guest_root"
+  find "$cov" -name '*.gcda' -delete
 else
   step "building caracarad and caracara-sim with --coverage"
   cov=$work/cov
@@ -105,7 +137,7 @@ order=()
 add_mod() {
   local rel deps d
   rel=$(grep -E "^kernel/.*/$1\.ko:" "$modroot/modules.dep" | head -1 | cut -d: -f1)
-  [ -n "$rel" ] || { echo "kernel: module $1 not in modules.dep"; exit 1; }
+  [ -n "$rel" ] || { echo "$label: FAIL: module $1 not in modules.dep"; exit 1; }
   [ -z "${seen[$rel]:-}" ] || return 0
   seen[$rel]=1
   deps=$(grep -E "^$rel:" "$modroot/modules.dep" | cut -d: -f2)
@@ -125,8 +157,9 @@ TOP='$top'
 WORK='$work'
 OUT='$out'
 COV='$cov'
-SCENARIOS='${CARACARA_KERNEL_SCENARIOS:-}'
+SCENARIOS='$(printf '%s\n' "${scenario_list[@]}" | cut -f1 | tr '\n' ' ')'
 EOF
+printf '%s\n' "${scenario_list[@]}" > "$out/scenarios.tsv"
 cp "$top/tests/kernel/guest-init.sh" "$ird/init"
 chmod +x "$ird/init"
 (cd "$ird" && find . | cpio -o -H newc --quiet | gzip -1) > "$work/initramfs.gz"
@@ -135,7 +168,7 @@ chmod +x "$ird/init"
 step "booting $kver under QEMU (TCG)"
 boot0=$(date +%s)
 set +e
-timeout 600 nice -n 10 qemu-system-x86_64 -machine q35 -accel tcg -cpu max -m 768 -smp 1 \
+timeout 900 nice -n 10 qemu-system-x86_64 -machine q35 -accel tcg -cpu max -m 768 -smp 1 \
   -kernel "$kroot/boot/vmlinuz-$kver" -initrd "$work/initramfs.gz" \
   -append "console=ttyS0 panic=-1 quiet loglevel=4" \
   -nographic -no-reboot -nic none \
@@ -146,24 +179,45 @@ qemu_rc=$?
 set -e
 step "VM exited with $qemu_rc after $(( $(date +%s) - boot0 )) s"
 
-if [ ! -f "$out/results.txt" ]; then
-  echo "kernel: the guest left no results; console log:"
+touch "$out/results.txt"
+if [ ! -s "$out/results.txt" ]; then
+  echo "$label: the guest left no results; console log:"
   tail -60 "$work/console.log"
   [ -f "$out/guest.log" ] && tail -80 "$out/guest.log"
-  exit 1
 fi
 [ -f "$out/dmesg.txt" ] && grep -iE 'caracara|BUG|WARNING|Oops|i2c|spi' "$out/dmesg.txt" | tail -20 || true
 
 # --- coverage of the kernel-facing files, from this run alone -------------------------------
-if [ -d "$out/gcov" ]; then
-  step "coverage"
-  python3 "$top/tests/kernel/coverage.py" "$top" "$cov" "$out/gcov" | tee "$out/coverage.txt" || true
+# Read with the gcov of the compiler that built them: the guest root's.
+step "coverage"
+cov_rc=0
+if [ "$guest_root" = / ]; then
+  /usr/bin/python3 "$top/tests/kernel/coverage.py" "$top" "$cov" "$out/gcov" "$out/coverage.json" >"$out/coverage.txt" || cov_rc=$?
+else
+  chroot "$guest_root" /usr/bin/python3 "$top/tests/kernel/coverage.py" "$top" "$cov" "$out/gcov" "$out/coverage.json" \
+    >"$out/coverage.txt" || cov_rc=$?
 fi
+cat "$out/coverage.txt"
 
-echo "== kernel: scenarios"
+# --- every scenario listed, each passed ------------------------------------------------------
+echo "== $label: scenarios"
 cat "$out/results.txt"
-pass=$(grep -c '^PASS' "$out/results.txt" || true)
-fail=$(grep -c '^FAIL' "$out/results.txt" || true)
-echo "kernel: $pass passed, $fail failed"
-echo "kernel: whole run $(( $(date +%s) - t0 )) s"
-[ "$fail" -eq 0 ] && [ "$pass" -gt 0 ]
+pass=0
+for entry in "${scenario_list[@]}"; do
+  name=${entry%%$'\t'*}
+  if grep -qE "^PASS $name \(" "$out/results.txt"; then
+    pass=$((pass + 1))
+  elif ! grep -qE "^FAIL $name( |:)" "$out/results.txt"; then
+    echo "FAIL $name: no result (the guest stopped before it)"
+  fi
+done
+total=${#scenario_list[@]}
+if [ "${CARACARA_KERNEL_DOC:-1}" != 0 ]; then
+  /usr/bin/python3 "$top/tests/kernel/write_doc.py" "$top/docs/kernel-bridge.md" "${CARACARA_KERNEL_LABEL:-debian12}" \
+    "$out/scenarios.tsv" "$out/results.txt" "$out/coverage.json" "$kver" ||
+    echo "$label: could not write docs/kernel-bridge.md"
+fi
+echo "$label: whole run $(( $(date +%s) - t0 )) s"
+[ "$cov_rc" -eq 0 ] || echo "$label: FAIL: a kernel-facing file has no coverage data (above)"
+echo "$label: $pass of $total scenarios passed"
+[ "$pass" -eq "$total" ] && [ "$cov_rc" -eq 0 ]

@@ -5,13 +5,20 @@ GPIO chip); caracarad runs with its default --hardware=linux on /dev/i2c-1, /dev
 and /dev/gpiochip0. Each scenario is judged from the simulator's wire log and inspection API.
 
     python3 scenarios.py RESULTS_FILE [SCENARIO...]
+    python3 scenarios.py --list [SCENARIO...]
 
 writes one line per scenario, "PASS name (seconds)" or "FAIL name: reason", to RESULTS_FILE.
+--list prints the scenarios that a run would take, "name<TAB>what it proves" (the first line
+of its docstring), one a line: tests/kernel/run.sh counts them before the guest boots, and a
+scenario without a result line is a failure. An unknown name is an error.
 """
 
+import errno
+import fcntl
 import os
 import re
 import signal
+import struct
 import subprocess
 import sys
 import time
@@ -45,6 +52,9 @@ GPIO = {
     "scl": {"chip": "gpiochip0", "line": "GPIO3"},
     "sda": {"chip": "gpiochip0", "line": "GPIO2"},
 }
+# The test module's injected faults (tests/kernel/module/caracara_bridge.c, at its top).
+PARAMS = "/sys/module/caracara_bridge/parameters/"
+GPIO_OP_REQUEST, GPIO_OP_GET = 1, 6
 RECOVERY = {"enabled": True, "attempts": 3, "backoff_ms": 50, "driver_id": DRIVER_ID,
             "unbind_path": DRIVER + "/unbind", "bind_path": DRIVER + "/bind", "device_wait_ms": 3000}
 
@@ -161,6 +171,7 @@ def mux_selected_before(rig, since, idx):
 
 
 def sc_set_thrust(rig):
+    """Per-thruster orders reach the wire through the real adapter, thrusters 6 and 7 with their mux channel selected first."""
     values = [1500, 0, -1500, 0, 0, 0, 2500, -2500]
     since = rig.wire_next()
     rig.thrust(values)
@@ -176,6 +187,7 @@ def sc_set_thrust(rig):
 
 
 def sc_set_motion(rig):
+    """SetMotion(y) mixes to the four forward thrusters (one behind the mux); the wire matches MotorValues."""
     rig.thrust([0] * MOTORS)
     rig.wait_sim_zero(20)
     since = rig.wire_next()
@@ -193,6 +205,7 @@ def sc_set_motion(rig):
 
 
 def sc_kill(rig):
+    """Kill: zero orders on the wire and the kill output high (a real GPIO line) by the reply; orders stay zero while killed; ClearKill drops the output."""
     rig.thrust([2000] * 4 + [0] * 4)
     rig.wait_sim_speeds([speed_byte(2000)] * 4 + [ZERO] * 4, 20)
     since = rig.wire_next()
@@ -218,6 +231,7 @@ def sc_kill(rig):
 
 
 def sc_kill_switch(rig):
+    """A kill switch edge (a real GPIO line event) kills with source "switch", zeroes the thrusters, asserts the kill output; ClearKill is refused while set."""
     rig.thrust([1800] + [0] * 7)
     rig.wait_sim_speeds([speed_byte(1800)] + [ZERO] * 7, 20)
     since = rig.wire_next()
@@ -243,6 +257,7 @@ def sc_kill_switch(rig):
 
 
 def sc_thruster_faults(rig):
+    """A NACKing thruster (-EREMOTEIO through i2c-dev) is counted, named, and once unreachable kills with source "device"; corrupted replies are counted as bad-checksum."""
     rig.thrust([0] * MOTORS)
     n0 = int(rig.vget("Nacks", harness.thruster_path(5), harness.THRUSTER_IFACE))
     since = rig.wire_next()
@@ -268,6 +283,7 @@ def sc_thruster_faults(rig):
 
 
 def sc_teensy(rig):
+    """The Teensy over spidev: frames, busy answers retried and counted, a Turn acknowledged."""
     tget = lambda n: rig.vget(n, TEENSY_PATH, TEENSY_IFACE)  # noqa: E731
     poll(lambda: bool(tget("Online")), 15, message="Teensy not online over spidev")
     since = rig.wire_next()
@@ -288,6 +304,7 @@ def sc_teensy(rig):
 
 
 def sc_bus_hang(rig):
+    """A slave holding SDA: the daemon unbinds the adapter's driver, clocks SCL through the GPIO lines, sends a STOP, binds again and resumes the orders."""
     values = [0, 1700, 0, 0, 0, 0, -1700, 0]
     rig.thrust(values)
     rig.wait_sim_speeds([speed_byte(v) for v in values], 20)
@@ -317,6 +334,7 @@ def sc_bus_hang(rig):
 
 
 def sc_scl_low(rig):
+    """SCL held low cannot be cleared: the bus is lost, the vehicle killed with source "bus"; it stays killed after the bus returns until ClearKill."""
     rig.thrust([1200] + [0] * 7)
     rig.wait_sim_speeds([speed_byte(1200)] + [ZERO] * 7, 20)
     rig.sim_call("HoldScl")
@@ -335,6 +353,7 @@ def sc_scl_low(rig):
 
 
 def sc_power_off(rig):
+    """A new daemon zeroes the orders it finds standing before it takes its name; PowerOff needs its confirmation, then zeroes and raises the power-off line."""
     if rig._died("caracarad") or "caracarad" not in rig.procs:
         left = rig.sim_speeds()
         since = rig.wire_next()
@@ -357,6 +376,7 @@ def sc_power_off(rig):
 
 
 def sc_sigterm(rig):
+    """SIGTERM: exit status 0 with zero orders to all eight on the way out."""
     values = [4000, -4000, 4000, -4000, 0, 0, 0, 0]
     if rig.state() != "ready":
         rig.reset(30)
@@ -422,30 +442,36 @@ def sc_i2ctransfer(rig):
     check(nack and nack[-1].result == "nack", "no NACK of 0x11 in the wire log")
 
 
+def write_config(rig, **sections):
+    """Replaces some sections of the daemon's configuration file (read at its next start)."""
+    rig.extra_config = dict(rig.extra_config, **sections)
+    with open(rig.config_path, "w") as f:
+        f.write(rig.config_text())
+
+
 def restart_with(rig, **sections):
     """Stops caracarad and starts it again with some config sections replaced."""
     rig.terminate("caracarad")
-    cfg = dict(rig.extra_config)
-    cfg.update(sections)
-    rig.extra_config = cfg
-    with open(rig.config_path, "w") as f:
-        f.write(rig.config_text())
+    write_config(rig, **sections)
     rig.start_daemon()
     rig.arm(60)
+
+
+def kill_and_clear(rig, message):
+    """Kill raises the kill output (line 27) on the wire; ClearKill makes the vehicle ready."""
+    since = rig.wire_next()
+    rig.vcall("Kill")
+    wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5, message)
+    rig.vcall("ClearKill")
+    rig.wait_state("ready", 20)
 
 
 def sc_unwired_line(rig):
     """A line the kernel refuses (the bridge wires no GPIO5): the daemon names it and exits."""
     rig.terminate("caracarad")
-    gpio = dict(GPIO, kill_output={"chip": "gpiochip0", "line": "GPIO5"})
-    path = os.path.join(rig.dir, "unwired.toml")
-    cfg = dict(rig.extra_config, gpio=gpio)
-    with open(path, "w") as f:
-        f.write(harness.toml_dumps(dict({"control": rig.control}, **cfg)) + "\n" + rig.extra_toml)
-    r = subprocess.run([binary("caracarad"), "--bus-address", rig.address, "--config", path],
-                       capture_output=True, text=True, timeout=60)
-    out = r.stdout + r.stderr
-    check(r.returncode != 0, "caracarad started with an unwired kill output")
+    code, out = restart_refused(rig, os.path.join(rig.dir, "unwired.toml"),
+                                gpio=dict(GPIO, kill_output={"chip": "gpiochip0", "line": "GPIO5"}))
+    check(code != 0, "caracarad started with an unwired kill output")
     check("GPIO5" in out and "kill_output" in out, "the error does not name the line: %r" % out[-400:])
 
 
@@ -476,12 +502,7 @@ def sc_gpio_lookup(rig):
         for name, direction in (("GPIO17", "in"), ("GPIO27", "out"), ("GPIO22", "out")):
             check(used.get(name, ("", ""))[0] == "caracarad", "%s not requested by caracarad: %r" % (name, used))
             check(used[name][1] == direction, "%s is %s, not %s" % (name, used[name][1], direction))
-        since = rig.wire_next()
-        rig.vcall("Kill")
-        wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5,
-                  "the kill output found by label and offset did not go high")
-        rig.vcall("ClearKill")
-        rig.wait_state("ready", 20)
+        kill_and_clear(rig, "the kill output found by label and offset did not go high")
         rig.sim_call("SetKillSwitch", True, signature="b")
         try:
             rig.wait_state("killed", 10)
@@ -496,7 +517,8 @@ def sc_gpio_lookup(rig):
 
 def sc_per_byte_spi_active_low(rig):
     """Per-byte SPI transfers (one spi_ioc_transfer per byte with a delay) through spidev, and
-    an active-low kill output inverted by gpiolib: the wire shows the physical levels."""
+    an active-low kill output and kill switch inverted by gpiolib: the wire shows the physical
+    levels, and a switch physically low reads set."""
     gpio = dict(GPIO, kill_output={"chip": "gpiochip0", "line": "GPIO27", "active_low": True})
     restart_with(rig, gpio=gpio, spi={"per_byte_delay_us": 20})
     tget = lambda n: rig.vget(n, TEENSY_PATH, TEENSY_IFACE)  # noqa: E731
@@ -518,6 +540,425 @@ def sc_per_byte_spi_active_low(rig):
     rig.wait_state("ready", 20)
     wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5,
               "the active-low kill output did not go back high")
+    # An active-low kill switch, inverted by gpiolib too: at rest (physically low) it reads set.
+    rig.terminate("caracarad")
+    try:
+        write_config(rig, gpio=dict(gpio, kill_switch=dict(GPIO["kill_switch"], active_low=True)))
+        rig.start_daemon()
+        rig.wait_state("killed", 10)
+        # The start kill stands (source "start"); the switch read set keeps it from being cleared.
+        check(rig.vget("KillSource") in ("start", "switch"), "KillSource %r" % rig.vget("KillSource"))
+        poll(lambda: error_name(rig.vcall, "ClearKill") == ERR + "KillSwitchSet", 10,
+             message="ClearKill not refused with an active-low switch at rest")
+        rig.sim_call("SetKillSwitch", True, signature="b")  # physically high: released
+        poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10, message="ClearKill refused once released")
+        rig.wait_state("ready", 20)
+        rig.sim_call("SetKillSwitch", False, signature="b")  # physically low: set
+        rig.wait_state("killed", 10)
+        check(rig.vget("KillSource") == "switch", "KillSource %r" % rig.vget("KillSource"))
+    finally:
+        rig.sim_call("SetKillSwitch", False, signature="b")
+        restart_with(rig, gpio=gpio)
+
+
+# --- the kernel's own errors: injected by the test module, judged from the daemon -----------
+
+def inject(**params):
+    """Writes the test module's fault parameters (a count arms a fault for that many requests)."""
+    for k, v in params.items():
+        with open(PARAMS + k, "w") as f:
+            f.write(str(v))
+
+
+def injected(name):
+    with open(PARAMS + name) as f:
+        return int(f.read())
+
+
+def clear_faults():
+    inject(i2c_fail_count=0, i2c_func_fail_count=0, i2c_probe_fail_count=0, spi_fail_count=0,
+           spi_setup_fail_count=0, gpio_fail_count=0, gpio_fail_skip=0, i2c_fail_addr=-1, gpio_fail_offset=-1,
+           gpio_fail_op=0, gpio_fail_errno=errno.EIO)
+
+
+def log_since(rig, mark):
+    return rig.log("caracarad")[mark:]
+
+
+def wait_log(rig, mark, pattern, timeout=15.0):
+    """The daemon's log since `mark` (a length of the log) comes to match `pattern`."""
+    return poll(lambda: re.search(pattern, log_since(rig, mark)), timeout,
+                message="caracarad never logged /%s/" % pattern)
+
+
+def tget(rig, name):
+    return rig.vget(name, TEENSY_PATH, TEENSY_IFACE)
+
+
+def thruster(rig, i, name):
+    return rig.vget(name, harness.thruster_path(i), harness.THRUSTER_IFACE)
+
+
+def sc_i2c_kernel_errors(rig):
+    """A transfer that times out (ETIMEDOUT), loses arbitration (EAGAIN, also on the i2c
+    core's one retry: I2C_RETRIES 1), or comes back short (the adapter moved no message):
+    each is counted against that thruster under its own name, no kill for one failure, and
+    the next orders go out."""
+    i = 5
+    addr = DEFAULT_MT[i] >> 1
+    values = [0, 0, 0, 0, 0, 1600, 0, 0]
+    rig.thrust(values)
+    rig.wait_sim_speeds([speed_byte(v) for v in values], 20)
+    for what, err, count, name in (("timeout", errno.ETIMEDOUT, 1, "timeout"),
+                                   ("lost arbitration", errno.EAGAIN, 2, "arbitration-lost"),
+                                   ("short transfer", 0, 1, "clock-stretch")):
+        e0 = int(rig.bus("Errors"))
+        t0 = int(thruster(rig, i, "Timeouts"))
+        inject(i2c_fail_addr=addr, i2c_fail_errno=err, i2c_fail_count=count)
+        try:
+            poll(lambda: injected("i2c_fail_count") == 0, 10, message="%s: no transfer to 0x%02x" % (what, addr))
+            poll(lambda: thruster(rig, i, "LastError") == name, 10,
+                 message="%s: thruster %d LastError %r, not %r" % (what, i, thruster(rig, i, "LastError"), name))
+        finally:
+            inject(i2c_fail_count=0, i2c_fail_addr=-1)
+        check(int(rig.bus("Errors")) > e0, "%s: the bus's error count did not grow" % what)
+        if err == errno.ETIMEDOUT:
+            check(int(thruster(rig, i, "Timeouts")) > t0, "the timeout not counted")
+        since = rig.wire_next()
+        wait_wire(rig, since, lambda e: e.bus == "i2c" and e.result == "ack" and e.addr == addr and
+                  list(e.data) == order_bytes(DEFAULT_MT[i], 1600), 10, "%s: no order after it" % what)
+        check(rig.state() == "ready", "%s: one failed transfer made the vehicle %s (%s)"
+              % (what, rig.state(), rig.vget("KillSource")))
+        check(rig.bus("State") == "ok", "%s: bus %s" % (what, rig.bus("State")))
+
+
+def bind_driver(driver, bound):
+    """Binds or unbinds one of the test module's platform drivers (device = driver name)."""
+    with open("/sys/bus/platform/drivers/%s/%s" % (driver, "bind" if bound else "unbind"), "w") as f:
+        f.write(driver)
+
+
+def sc_spi_refused(rig):
+    """SPI messages the module refuses (EIO): the Teensy reads offline as long as they are
+    refused, no kill, and online again after. Then the SPI controller's driver unbound under the open spidev (spidev
+    answers ESHUTDOWN): the Teensy is gone, the vehicle killed with source "device"; bound again,
+    the first reopen is refused (the controller refuses the mode: SPI_IOC_WR_MODE), the next
+    one brings the Teensy back."""
+    poll(lambda: bool(tget(rig, "Online")), 15, message="Teensy not online")
+    refusals = 1000000
+    inject(spi_fail_errno=errno.EIO, spi_fail_count=refusals)
+    try:
+        # Every message refused: the Teensy reads offline, and stays so; no kill for EIO.
+        poll(lambda: not tget(rig, "Online"), 15, message="refused SPI messages left the Teensy online")
+        check(injected("spi_fail_count") < refusals, "no SPI message refused")
+        time.sleep(1.0)
+        check(not tget(rig, "Online"), "the Teensy reads online while every message is refused")
+        check(rig.state() == "ready", "an SPI EIO killed: %s (%s)" % (rig.state(), rig.vget("KillSource")))
+    finally:
+        inject(spi_fail_count=0)
+    poll(lambda: bool(tget(rig, "Online")), 15, message="Teensy not back online after EIO")
+    mark = len(rig.log("caracarad"))
+    bound = True
+    try:
+        bind_driver("caracara-spi", False)
+        bound = False
+        rig.wait_state("killed", 15)
+        check(rig.vget("KillSource") == "device", "KillSource %r" % rig.vget("KillSource"))
+        wait_log(rig, mark, r"Teensy SPI /dev/spidev0\.0 went away \(ENODEV")
+        check(not os.path.exists("/dev/spidev0.0"), "/dev/spidev0.0 still there with its controller unbound")
+        time.sleep(1.5)  # a reopen or two find no node
+        check(not tget(rig, "Online"), "the Teensy reads online without its controller")
+        inject(spi_setup_fail_count=1)
+        bind_driver("caracara-spi", True)
+        bound = True
+        poll(lambda: injected("spi_setup_fail_count") == 0, 10, message="no reopen set the mode")
+        wait_log(rig, mark, r"Teensy SPI /dev/spidev0\.0 is back", 15)
+    finally:
+        inject(spi_setup_fail_count=0)
+        if not bound:
+            bind_driver("caracara-spi", True)
+    check(log_since(rig, mark).count("Teensy SPI") == 2, "not one line when it went, one when back: %r"
+          % [line for line in log_since(rig, mark).splitlines() if "Teensy SPI" in line])
+    poll(lambda: bool(tget(rig, "Online")), 15, message="Teensy not online after the reopen")
+    rig.vcall("ClearKill")
+    rig.wait_state("ready", 20)
+
+
+def sc_recovery_driver_path_missing(rig):
+    """A recovery whose driver's sysfs files do not exist (a driver name that is not there): the
+    unbind and the bind fail with ENOENT and are named; the bus clear takes SCL and SDA away from
+    the controller, and with no probe to give them back (as on a Raspberry Pi) no transfer gets
+    through: the bus is lost, the vehicle killed with source "bus". With the right paths again, a
+    new daemon's recovery rebinds the adapter and the bus comes back."""
+    missing = "/sys/bus/platform/drivers/caracara-nosuch/"
+    restart_with(rig, recovery=dict(RECOVERY, unbind_path=missing + "unbind", bind_path=missing + "bind"))
+    try:
+        mark = len(rig.log("caracarad"))
+        rig.sim_call("HangBus", dbus.UInt32(2), signature="u")
+        rig.wait_state("killed", 60)
+        check(rig.vget("KillSource") == "bus", "KillSource %r" % rig.vget("KillSource"))
+        check(rig.bus("State") == "lost", "bus state %s" % rig.bus("State"))
+        text = log_since(rig, mark)
+        for what, node in (("unbinding", "unbind"), ("binding", "bind")):
+            check(re.search(r"\b%s caracara-i2c via %s%s: ENOENT" % (what, re.escape(missing), node), text),
+                  "the failed %s is not named: %r" % (what, text[-600:]))
+    finally:
+        rig.terminate("caracarad")
+        write_config(rig, recovery=RECOVERY)
+        rig.start_daemon()
+    poll(lambda: rig.bus("State") == "ok", 60, interval=0.2, message="the bus never came back")
+    rig.arm(60)
+
+
+def sc_adapter_lost_without_recovery(rig):
+    """Recovery not configured: every transfer failing (EIO) loses the bus and kills with source
+    "bus"; the adapter is closed and opened again once a second, the first reopens refused
+    (I2C_FUNCS without plain I2C) with the transfers in between failing as no device, until
+    the adapter answers again: the bus is back, the vehicle stays killed until ClearKill."""
+    restart_with(rig, recovery=dict(RECOVERY, enabled=False))
+    mark = len(rig.log("caracarad"))
+    try:
+        inject(i2c_fail_addr=-1, i2c_fail_errno=errno.EIO, i2c_fail_count=1000000, i2c_func_fail_count=2)
+        rig.wait_state("killed", 30)
+        check(rig.vget("KillSource") == "bus", "KillSource %r" % rig.vget("KillSource"))
+        check(rig.bus("State") == "lost", "bus state %s" % rig.bus("State"))
+        wait_log(rig, mark, r"recovery is not configured: reopening the adapter once a second")
+        poll(lambda: injected("i2c_func_fail_count") == 0, 15, message="the adapter was not opened again")
+    finally:
+        clear_faults()
+    poll(lambda: rig.bus("State") == "ok", 30, interval=0.2, message="the bus never came back")
+    rig.wait_sim_zero(20)
+    check(rig.state() == "killed", "a bus kill cleared itself")
+    rig.vcall("ClearKill")
+    rig.wait_state("ready", 20)
+    restart_with(rig, recovery=RECOVERY)
+
+
+def sc_adapter_never_binds(rig):
+    """The adapter's driver refuses every bind after a bus recovery's unbind: the node does not
+    come back, each attempt says why, the bus is declared lost and the vehicle killed with source
+    "bus"; once the driver binds again the bus comes back on its own, and the vehicle stays
+    killed until ClearKill."""
+    values = [0, 0, 1500, 0, 0, 0, 0, 0]
+    rig.thrust(values)
+    rig.wait_sim_speeds([speed_byte(v) for v in values], 20)
+    mark = len(rig.log("caracarad"))
+    inject(i2c_probe_errno=errno.EIO, i2c_probe_fail_count=1000)
+    try:
+        rig.sim_call("HangBus", dbus.UInt32(2), signature="u")
+        rig.wait_state("killed", 60)
+        check(rig.vget("KillSource") == "bus", "KillSource %r" % rig.vget("KillSource"))
+        check(rig.bus("State") == "lost", "bus state %s" % rig.bus("State"))
+        check(not os.path.exists(I2C_DEV), I2C_DEV + " exists with its driver refusing to bind")
+        text = log_since(rig, mark)
+        check(re.search(r"binding caracara-i2c via .*: EIO", text), "the failed bind is not named")
+        check(re.search(r"the I2C device node did not come back", text), "the missing node is not named")
+    finally:
+        inject(i2c_probe_fail_count=0)
+    poll(lambda: rig.bus("State") == "ok", 60, interval=0.2, message="the bus never came back")
+    check(os.path.exists(I2C_DEV), I2C_DEV + " did not come back")
+    rig.wait_sim_zero(20)  # the zeros of the killed vehicle, once there is a bus to carry them
+    check(rig.state() == "killed", "a bus kill cleared itself")
+    rig.vcall("ClearKill")
+    rig.wait_state("ready", 20)
+
+
+def restart_refused(rig, path, gpio=None, **sections):
+    """caracarad with a configuration it must refuse: its exit status and its words."""
+    cfg = dict(rig.extra_config, **sections)
+    if gpio is not None:
+        cfg["gpio"] = gpio
+    with open(path, "w") as f:
+        f.write(harness.toml_dumps(dict({"control": rig.control}, **cfg)) + "\n" + rig.extra_toml)
+    r = subprocess.run([binary("caracarad"), "--bus-address", rig.address, "--config", path],
+                       capture_output=True, text=True, timeout=60)
+    return r.returncode, r.stdout + r.stderr
+
+
+# struct gpiohandle_request (linux/gpio.h, the v1 uAPI both libgpiod versions sit on):
+# lineoffsets[64], flags, default_values[64], consumer_label[32], lines, fd.
+GPIOHANDLE_FORMAT = "64I I 64B 32s I i"
+GPIO_GET_LINEHANDLE_IOCTL = (3 << 30) | (struct.calcsize(GPIOHANDLE_FORMAT) << 16) | (0xB4 << 8) | 0x03
+
+
+def hold_line(offset):
+    """Requests a line of gpiochip0 as an input for this process: (chip fd, line fd)."""
+    chip = os.open("/dev/gpiochip0", os.O_RDWR | os.O_CLOEXEC)
+    req = bytearray(struct.pack(GPIOHANDLE_FORMAT, *([offset] + [0] * 63), 1, *([0] * 64), b"kernel-test", 1, 0))
+    try:
+        fcntl.ioctl(chip, GPIO_GET_LINEHANDLE_IOCTL, req, True)
+    except OSError:
+        os.close(chip)
+        raise
+    return chip, struct.unpack_from("i", req, len(req) - 4)[0]
+
+
+def sc_gpio_refused(rig):
+    """A line another process holds (EBUSY), a chip that does not exist (or has no name), a line
+    name or offset the chip does not have, an adapter without plain I2C: caracarad names the line (or the
+    bus) and the kernel's reason, and does not start. Output and input lines both (libgpiod's
+    output and input request paths differ). Then it starts again on the real lines."""
+    rig.terminate("caracarad")
+    path = os.path.join(rig.dir, "refused.toml")
+    cases = []
+    for key, offset, line in (("kill_output", 27, "GPIO27"), ("kill_switch", 17, "GPIO17")):
+        held = hold_line(offset)
+        try:
+            code, out = restart_refused(rig, path, gpio=GPIO)
+        finally:
+            for fd in held:
+                os.close(fd)
+        cases.append(("%s held elsewhere" % key, code, out, ["gpio." + key, line, "busy"]))
+        for what, spec, words in (("on a missing chip", {"chip": "gpiochip9", "line": line}, ["gpiochip9"]),
+                                  ("a missing line name", {"chip": "gpiochip0", "line": "NOSUCH"}, ["NOSUCH"]),
+                                  ("a missing offset", {"chip": "gpiochip0", "line": 40}, ["gpiochip0 line 40"]),
+                                  ("an empty chip name", {"chip": "", "line": line}, [])):
+            code, out = restart_refused(rig, path, gpio=dict(GPIO, **{key: spec}))
+            cases.append(("%s %s" % (key, what), code, out, ["gpio." + key] + words))
+    inject(i2c_func_fail_count=1)
+    try:
+        code, out = restart_refused(rig, path, gpio=GPIO)
+    finally:
+        inject(i2c_func_fail_count=0)
+    cases.append(("an adapter without I2C_FUNC_I2C", code, out, [I2C_DEV, "EOPNOTSUPP"]))
+    code, out = restart_refused(rig, path, gpio=GPIO, i2c=dict(rig.extra_config["i2c"], device="/dev/i2c-9"))
+    cases.append(("a missing I2C adapter", code, out, ["/dev/i2c-9", "ENOENT"]))
+    for what, code, out, words in cases:
+        check(code != 0, "caracarad started with %s" % what)
+        low = out.lower()
+        missing = [w for w in words if w.lower() not in low]
+        check(not missing, "%s: the error lacks %s: %r" % (what, missing, out.strip().splitlines()[-3:]))
+    rig.start_daemon()
+    rig.arm(60)
+
+
+def sc_kill_switch_read_fails(rig):
+    """The kill switch's value read (after an edge) fails in the kernel, with EIO and with the
+    errnos libgpiod 2's C++ binding turns into exceptions of their own (E2BIG, EDOM, ENOMEM):
+    each time the switch counts as set (a kill, source "switch") under the kernel's errno, and
+    the line is asked for again; once it reads clear the vehicle can be armed."""
+    for err in (errno.EIO, errno.E2BIG, errno.EDOM, errno.ENOMEM):
+        name = errno.errorcode[err]
+        mark = len(rig.log("caracarad"))
+        inject(gpio_fail_offset=17, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=err, gpio_fail_count=1)
+        try:
+            rig.sim_call("SetKillSwitch", True, signature="b")
+            rig.sim_call("SetKillSwitch", False, signature="b")
+            rig.wait_state("killed", 10)
+            check(rig.vget("KillSource") == "switch", "%s: KillSource %r" % (name, rig.vget("KillSource")))
+            check(injected("gpio_fail_count") == 0, "%s: the read never failed" % name)
+            wait_log(rig, mark, r"kill switch gpiochip0:GPIO17 cannot be read \(%s" % name)
+            wait_log(rig, mark, r"kill switch gpiochip0:GPIO17 is back", 10)
+        finally:
+            clear_faults()
+        rig.vcall("ClearKill")
+        rig.wait_state("ready", 20)
+
+
+def sc_kill_switch_event_overflow(rig):
+    """More edges than the kernel's event buffer holds (16) while the daemon is stopped: it
+    drains what is left and the level decides: a switch left set kills, source "switch"."""
+    proc = rig.procs["caracarad"]
+    proc.send_signal(signal.SIGSTOP)
+    try:
+        for k in range(41):  # odd: ends set
+            rig.sim_call("SetKillSwitch", k % 2 == 0, signature="b")
+    finally:
+        proc.send_signal(signal.SIGCONT)
+    try:
+        rig.wait_state("killed", 10)
+        check(rig.vget("KillSource") == "switch", "KillSource %r" % rig.vget("KillSource"))
+        check(error_name(rig.vcall, "ClearKill") == ERR + "KillSwitchSet", "ClearKill not refused while set")
+    finally:
+        rig.sim_call("SetKillSwitch", False, signature="b")
+    poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10, message="ClearKill refused after the release")
+    rig.wait_state("ready", 20)
+
+
+def bind_gpio(bound):
+    bind_driver("caracara-gpio", bound)
+
+
+def sc_gpio_chip_gone(rig):
+    """The GPIO chip goes while caracarad holds its lines (its driver unbound: the module
+    cannot be unloaded while they are held): the daemon finds the kill switch unreadable and
+    the kill output unwritable, the vehicle is killed, the lines are asked for once a second,
+    and when the chip is bound again (found by its label, whatever number it comes back
+    under) the lines are back, the kill output works, and the vehicle can be armed. The
+    scenarios after this one find the chip by its label too."""
+    by_label = {k: dict(v, chip="caracara-gpio") for k, v in GPIO.items()}
+    restart_with(rig, gpio=by_label)
+    mark = len(rig.log("caracarad"))
+    bound = True
+    try:
+        bind_gpio(False)
+        bound = False
+        rig.wait_state("killed", 10)
+        check(rig.vget("KillSource") in ("switch", "device"), "KillSource %r" % rig.vget("KillSource"))
+        wait_log(rig, mark, r"kill switch caracara-gpio:GPIO17 cannot be read")
+        # The kill output is written at the kill: the kernel refuses it (the chip is gone).
+        wait_log(rig, mark, r"kill output cannot be written \(ENODEV")
+        time.sleep(1.5)
+        check(rig.state() == "killed", "a vehicle without its lines came back to %s" % rig.state())
+        bind_gpio(True)
+        bound = True
+        wait_log(rig, mark, r"kill output caracara-gpio:GPIO27 is back", 15)
+        wait_log(rig, mark, r"kill switch caracara-gpio:GPIO17 is back", 15)
+        check(bool(rig.sim_get("KillOutput")), "the kill output came back deasserted on a killed vehicle")
+        rig.vcall("ClearKill")
+        rig.wait_state("ready", 20)
+        kill_and_clear(rig, "the kill output on the chip bound again did not go high")
+    finally:
+        if not bound:
+            bind_gpio(True)
+        restart_with(rig, gpio=by_label)
+
+
+def sc_bus_clear_faults(rig):
+    """Bus recoveries the kernel makes harder: the SCL line refused at its request and the
+    adapter's driver refusing to bind (attempt 1 fails and names both), the node back without
+    plain I2C once, then SDA, then SCL unreadable, the SDA line busy, SCL read low after a
+    pulse, SDA read low through all nine pulses in the next hangs: each time the next attempt clears
+    the bus, the adapter comes back, and the orders resume without a kill."""
+    values = [0, 1700, 0, 0, 0, 0, 0, 0]
+    rig.thrust(values)
+    rig.wait_sim_speeds([speed_byte(v) for v in values], 20)
+    for round_, faults, words in (
+            (1, dict(gpio_fail_offset=3, gpio_fail_op=GPIO_OP_REQUEST, gpio_fail_errno=errno.EIO, gpio_fail_count=1,
+                     i2c_probe_errno=errno.EIO, i2c_probe_fail_count=1, i2c_func_fail_count=1),
+             [r"SCL: gpiochip0:GPIO3", r"binding caracara-i2c via .*: EIO"]),
+            (2, dict(gpio_fail_offset=2, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=errno.EIO, gpio_fail_count=1),
+             [r"reading SDA: EIO"]),
+            (3, dict(gpio_fail_offset=3, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=errno.EIO, gpio_fail_count=1),
+             [r"reading SCL: EIO"]),
+            (4, dict(gpio_fail_offset=2, gpio_fail_op=GPIO_OP_REQUEST, gpio_fail_errno=errno.EBUSY, gpio_fail_count=1),
+             [r"SDA: gpiochip0:GPIO2: .*busy"]),
+            # Levels, not errors: SCL read low after the first pulse, SDA low through all nine.
+            (5, dict(gpio_fail_offset=3, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=0, gpio_fail_skip=1,
+                     gpio_fail_count=1),
+             [r"SCL stayed low after a clock pulse"]),
+            (6, dict(gpio_fail_offset=2, gpio_fail_op=GPIO_OP_GET, gpio_fail_errno=0, gpio_fail_count=10),
+             [r"SDA still low after 9 clock pulses"])):
+        rec0 = int(rig.bus("Recoveries"))
+        bind0 = int(rig.sim_get("Binds"))
+        mark = len(rig.log("caracarad"))
+        inject(**faults)
+        try:
+            rig.sim_call("HangBus", dbus.UInt32(3), signature="u")
+            poll(lambda: int(rig.bus("Recoveries")) > rec0, 40, message="round %d: no recovery" % round_)
+            for k in faults:
+                if k.endswith("_count"):
+                    check(injected(k) == 0, "round %d: %s not taken" % (round_, k))
+        finally:
+            clear_faults()
+        for w in words:
+            check(re.search(w, log_since(rig, mark)), "round %d: the log does not name /%s/" % (round_, w))
+        check(int(rig.sim_get("Binds")) >= bind0 + 1, "round %d: the adapter was not bound again" % round_)
+        check(os.path.exists(I2C_DEV), I2C_DEV + " did not come back")
+        poll(lambda: rig.bus("State") == "ok", 15)
+        rig.wait_orders_refreshed()
+        check(rig.sim_speeds() == [speed_byte(v) for v in values], "round %d: orders not resumed" % round_)
+        check(rig.state() == "ready", "round %d: state %s (%s)" % (round_, rig.state(), rig.vget("KillSource")))
 
 
 def diagnose(rig):
@@ -556,10 +997,20 @@ SCENARIOS = [
     ("nacking_and_corrupt_thruster", sc_thruster_faults),
     ("teensy_busy_and_turn", sc_teensy),
     ("bus_hang_recovered_with_rebind", sc_bus_hang),
+    ("i2c_timeout_arbitration_short_transfer", sc_i2c_kernel_errors),
+    ("spi_message_and_mode_refused", sc_spi_refused),
+    ("bus_clear_gpio_faults_and_failed_bind", sc_bus_clear_faults),
+    ("adapter_never_binds_bus_lost", sc_adapter_never_binds),
+    ("adapter_lost_without_recovery_reopened", sc_adapter_lost_without_recovery),
+    ("recovery_driver_path_missing", sc_recovery_driver_path_missing),
     ("scl_held_low_bus_kill", sc_scl_low),
     ("per_byte_spi_and_active_low_output", sc_per_byte_spi_active_low),
     ("unwired_gpio_line_refused", sc_unwired_line),
     ("gpio_chip_by_number_label_path_line_by_offset", sc_gpio_lookup),
+    ("busy_missing_gpio_and_i2c_refused", sc_gpio_refused),
+    ("kill_switch_read_fails", sc_kill_switch_read_fails),
+    ("kill_switch_event_overflow", sc_kill_switch_event_overflow),
+    ("gpio_chip_gone_while_held", sc_gpio_chip_gone),
     # Restarted by the loop below (it died).
     ("fatal_signal_kill_output_first", sc_fatal_signal),
     ("sigterm", sc_sigterm),
@@ -572,9 +1023,22 @@ SCENARIOS = [
 NO_READY_CHECK = {"start", "i2ctransfer_reference", "restart_zeroes_then_power_off", "sigterm"}
 
 
+def selected(names):
+    known = {n for n, _ in SCENARIOS}
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise SystemExit("scenarios.py: unknown scenario(s) %s" % " ".join(unknown))
+    return [(n, fn) for n, fn in SCENARIOS if not names or n in names]
+
+
 def main():
+    if sys.argv[1:2] == ["--list"]:
+        for name, fn in selected(set(sys.argv[2:])):
+            print("%s\t%s" % (name, " ".join((fn.__doc__ or "").split("\n\n")[0].split())))
+        return 0
     results_path = sys.argv[1]
     only = set(sys.argv[2:])
+    selected(only)
     out = open(results_path, "a")
     rig = KernelRig()
     try:

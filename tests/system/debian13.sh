@@ -18,7 +18,8 @@
 #    (check.sh, check-debs.sh) in a booted Debian 13 container that installs those packages
 #    with apt-get, upgrades them while the thrusters run, and purges them.
 # 4. tests/kernel/run.sh with CARACARA_KERNEL_ROOT set to the Debian 13 root: the kernel test's
-#    scenarios under QEMU, caracarad's libgpiod 2 backend on the test module's GPIO chip.
+#    scenarios under QEMU, caracarad's libgpiod 2 backend on the test module's GPIO chip, with
+#    caracarad and caracara-sim built with --coverage in the root (GCC 14; its gcov reads them).
 #    CARACARA_DEBIAN13_KERNEL=0 leaves this step out, and says so ("kernel: not run (...)");
 #    under CI that fails.
 #
@@ -209,19 +210,34 @@ if [ "$kernel_rc" = skipped ] && [ "${CARACARA_DEBIAN13_KERNEL:-1}" = 0 ]; then
   echo "kernel: not run (CARACARA_DEBIAN13_KERNEL=0)"
   if [ "${CI:-}" = true ]; then
     say "FAIL: under CI (CI=true) the Debian 13 kernel test must run"
-    failed=1
+    kernel_rc=1; failed=1
   fi
 fi
 if [ "$kernel_rc" = skipped ] && [ "${CARACARA_DEBIAN13_KERNEL:-1}" != 0 ]; then
   say "kernel test with the Debian 13 build (tests/kernel/run.sh, guest root: the Debian 13 root)"
-  # The guest chroots into this root over 9p: the source, the build and the kernel test's work
-  # directory must be where the host has them.
-  mount --bind -o ro "$src" "$root$src"
-  mount --bind "$build" "$root$build"
-  mount --bind "$kwork" "$root$kwork"
   t3=$(date +%s)
   kernel_rc=0
-  CARACARA_KERNEL_ROOT=$root CARACARA_KERNEL_BUILD=$build "$src/tests/kernel/run.sh" "$kwork" || kernel_rc=$?
+  # caracarad and caracara-sim with --coverage by the root's GCC 14 (kept with the kernel work
+  # directory, so a rerun rebuilds only what changed).
+  kcov=$kwork/cov
+  mkdir -p "$kcov"
+  timeout --kill-after=20 "$build_timeout_s" \
+    systemd-nspawn --quiet --keep-unit --register=no --directory="$root" --private-network \
+      --bind-ro="$src" --bind="$kwork" --setenv=HOME=/root \
+      sh -c "cmake -S '$src' -B '$kcov' -DCMAKE_BUILD_TYPE=Debug -DCARACARA_WERROR=ON -DCMAKE_CXX_FLAGS=--coverage >/dev/null &&
+             cmake --build '$kcov' -j2 --target caracarad caracara-sim >/dev/null" >"$work/kcov.log" 2>&1 || kernel_rc=$?
+  if [ "$kernel_rc" -ne 0 ]; then
+    tail -n 40 "$work/kcov.log"
+    say "FAIL: the coverage build for the kernel test failed in the Debian 13 root"
+  else
+    # The guest chroots into this root over 9p: the source, the build and the kernel test's work
+    # directory must be where the host has them.
+    mount --bind -o ro "$src" "$root$src"
+    mount --bind "$build" "$root$build"
+    mount --bind "$kwork" "$root$kwork"
+    CARACARA_KERNEL_ROOT=$root CARACARA_KERNEL_BUILD=$kcov CARACARA_KERNEL_LABEL=debian13 \
+      "$src/tests/kernel/run.sh" "$kwork" || kernel_rc=$?
+  fi
   kernel_s=$(($(date +%s) - t3))
   [ "$kernel_rc" -eq 0 ] || failed=1
 fi

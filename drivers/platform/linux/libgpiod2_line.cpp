@@ -43,14 +43,8 @@ int Libgpiod2Line::get() {
     }
 }
 
-int Libgpiod2Line::set(int value) {
-    try {
-        request_.set_value(offset_, value ? gpiod::line::value::ACTIVE : gpiod::line::value::INACTIVE);
-        return 0;
-    } catch (const std::exception& e) {
-        return -errno_of(e);
-    }
-}
+// An input: the kernel refuses a value for it with EPERM; nothing in the daemon asks.
+int Libgpiod2Line::set(int) { return -EPERM; }
 
 int Libgpiod2Line::event_fd() const {
     if (!edges_)

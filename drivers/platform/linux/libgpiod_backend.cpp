@@ -35,14 +35,8 @@ public:
             return -errno_of(e);
         }
     }
-    int set(int value) override {
-        try {
-            line_.set_value(value ? 1 : 0);
-            return 0;
-        } catch (const std::exception& e) {
-            return -errno_of(e);
-        }
-    }
+    // An input: the kernel refuses a value for it with EPERM; nothing in the daemon asks.
+    int set(int) override { return -EPERM; }
     int event_fd() const override {
         if (!edges_)
             return -1;
@@ -84,17 +78,11 @@ public:
                 error = spec.describe() + ": no such line";
                 return nullptr;
             }
+            // Inputs only: outputs are LibgpiodOutputLine's (returned above).
             gpiod::line_request req;
             req.consumer = consumer_;
-            switch (mode) {
-            case GpioMode::Input: req.request_type = gpiod::line_request::DIRECTION_INPUT; break;
-            case GpioMode::InputEdges: req.request_type = gpiod::line_request::EVENT_BOTH_EDGES; break;
-            case GpioMode::Output: req.request_type = gpiod::line_request::DIRECTION_OUTPUT; break;
-            case GpioMode::OpenDrain:
-                req.request_type = gpiod::line_request::DIRECTION_OUTPUT;
-                req.flags |= gpiod::line_request::FLAG_OPEN_DRAIN;
-                break;
-            }
+            req.request_type = mode == GpioMode::InputEdges ? gpiod::line_request::EVENT_BOTH_EDGES
+                                                            : gpiod::line_request::DIRECTION_INPUT;
             if (spec.active_low)
                 req.flags |= gpiod::line_request::FLAG_ACTIVE_LOW;
             line.request(req, initial);

@@ -12,6 +12,21 @@
  *   - GPIO: a 28-line chip (GPIO0..GPIO27, like a Raspberry Pi header) whose lines can
  *     raise edge interrupts (nested, threaded), so GPIO v1 line events work.
  *
+ * Faults the kernel itself reports (tests/kernel/scenarios.py writes them to
+ * /sys/module/caracara_bridge/parameters/): each *_fail_count requests fail, then the part
+ * works again.
+ *   - i2c_fail_errno, i2c_fail_addr (-1 any), i2c_fail_count: a transfer to that address
+ *     fails with -i2c_fail_errno without reaching the server; errno 0 = a short transfer
+ *     (one message fewer than asked, as a controller that stopped early reports it).
+ *   - i2c_func_fail_count: I2C_FUNCS answers without I2C_FUNC_I2C.
+ *   - i2c_probe_errno, i2c_probe_fail_count: binding the adapter's driver fails.
+ *   - spi_fail_errno, spi_fail_count: an SPI message refused; spi_setup_fail_count: the
+ *     controller refuses a mode/word size/speed (spidev's SPI_IOC_WR_* ioctls; never the
+ *     setup of the probe's own device).
+ *   - gpio_fail_errno, gpio_fail_offset, gpio_fail_op (CCB_GPIO_* op, 0 any), gpio_fail_count,
+ *     gpio_fail_skip: after gpio_fail_skip matching operations, a line operation fails (errno
+ *     0: a GET reads low); a get by the kernel's own edge handler is never failed.
+ *
  * Protocol: sim/kernel_bridge_abi.h and docs/kernel-bridge.md. One request is in flight
  * at a time; with no server attached every request fails with -ENXIO, and a server that
  * does not answer within 5 s fails it with -ETIMEDOUT.
@@ -26,6 +41,8 @@
 #include <linux/module.h>
 #include <linux/mutex.h>
 #include <linux/platform_device.h>
+#include <linux/property.h>
+#include <linux/sched.h>
 #include <linux/poll.h>
 #include <linux/slab.h>
 #include <linux/spi/spi.h>
@@ -47,6 +64,53 @@ module_param(timeout_ms, uint, 0644);
 MODULE_PARM_DESC(timeout_ms, "how long a request waits for the user-space server");
 
 #define CCB_NGPIO 28
+
+/* ---- injected faults (see the top of the file) ---- */
+
+static DEFINE_SPINLOCK(ccb_fault_lock);
+static int i2c_fail_errno;
+module_param(i2c_fail_errno, int, 0644);
+static int i2c_fail_addr = -1;
+module_param(i2c_fail_addr, int, 0644);
+static int i2c_fail_count;
+module_param(i2c_fail_count, int, 0644);
+static int i2c_func_fail_count;
+module_param(i2c_func_fail_count, int, 0644);
+static int i2c_probe_errno = EIO;
+module_param(i2c_probe_errno, int, 0644);
+static int i2c_probe_fail_count;
+module_param(i2c_probe_fail_count, int, 0644);
+static int spi_fail_errno = EIO;
+module_param(spi_fail_errno, int, 0644);
+static int spi_fail_count;
+module_param(spi_fail_count, int, 0644);
+static int spi_setup_fail_count;
+module_param(spi_setup_fail_count, int, 0644);
+static int gpio_fail_errno = EIO;
+module_param(gpio_fail_errno, int, 0644);
+static int gpio_fail_offset = -1;
+module_param(gpio_fail_offset, int, 0644);
+static int gpio_fail_op;
+module_param(gpio_fail_op, int, 0644);
+static int gpio_fail_count;
+module_param(gpio_fail_count, int, 0644);
+static int gpio_fail_skip;
+module_param(gpio_fail_skip, int, 0644);
+
+/* True (and one fewer left) when this request is to fail. */
+static bool ccb_take_fault(int *count, bool match)
+{
+	unsigned long flags;
+	bool take = false;
+
+	spin_lock_irqsave(&ccb_fault_lock, flags);
+	if (match && *count > 0) {
+		--*count;
+		take = true;
+	}
+	spin_unlock_irqrestore(&ccb_fault_lock, flags);
+	return take;
+}
 
 /* ---- the request slot and the character device ---- */
 
@@ -255,8 +319,10 @@ static int ccb_i2c_xfer(struct i2c_adapter *adap, struct i2c_msg *msgs, int num)
 	size_t len = sizeof(struct ccb_header) + sizeof(u32), rlen = 0, got = 0, off;
 	void *req, *reply;
 	u8 *p;
-	int i, ret;
+	int i, ret, fail_addr = READ_ONCE(i2c_fail_addr);
 
+	if (ccb_take_fault(&i2c_fail_count, fail_addr < 0 || (num > 0 && msgs[0].addr == fail_addr)))
+		return i2c_fail_errno ? -abs(i2c_fail_errno) : num - 1;
 	for (i = 0; i < num; i++) {
 		len += sizeof(struct ccb_i2c_msg);
 		if (msgs[i].flags & I2C_M_RD)
@@ -309,6 +375,8 @@ out:
 
 static u32 ccb_i2c_func(struct i2c_adapter *adap)
 {
+	if (ccb_take_fault(&i2c_func_fail_count, true))
+		return I2C_FUNC_SMBUS_EMUL;
 	return I2C_FUNC_I2C | I2C_FUNC_SMBUS_EMUL;
 }
 
@@ -330,6 +398,8 @@ static int ccb_i2c_probe(struct platform_device *pdev)
 	struct i2c_adapter *adap;
 	int ret;
 
+	if (ccb_take_fault(&i2c_probe_fail_count, true))
+		return -abs(i2c_probe_errno);
 	adap = devm_kzalloc(&pdev->dev, sizeof(*adap), GFP_KERNEL);
 	if (!adap)
 		return -ENOMEM;
@@ -373,6 +443,10 @@ static int ccb_spi_transfer_one_message(struct spi_controller *ctlr, struct spi_
 	u8 *p;
 	int ret;
 
+	if (ccb_take_fault(&spi_fail_count, true)) {
+		ret = -abs(spi_fail_errno);
+		goto done;
+	}
 	list_for_each_entry(t, &m->transfers, transfer_list) {
 		len += sizeof(struct ccb_spi_xfer) + (t->tx_buf ? t->len : 0);
 		rlen += t->rx_buf ? t->len : 0;
@@ -441,8 +515,12 @@ done:
 	return ret;
 }
 
+static bool ccb_spi_probing; /* the controller's own device being added: never failed */
+
 static int ccb_spi_setup(struct spi_device *spi)
 {
+	if (!READ_ONCE(ccb_spi_probing) && ccb_take_fault(&spi_setup_fail_count, true))
+		return -EINVAL;
 	return 0;
 }
 
@@ -483,7 +561,9 @@ static int ccb_spi_probe(struct platform_device *pdev)
 	strscpy(spi->modalias, "spidev", sizeof(spi->modalias));
 	/* spidev refuses to be named by a board; driver_override binds it. */
 	spi->driver_override = kstrdup("spidev", GFP_KERNEL);
+	WRITE_ONCE(ccb_spi_probing, true);
 	ret = spi_add_device(spi);
+	WRITE_ONCE(ccb_spi_probing, false);
 	if (ret) {
 		spi_dev_put(spi);
 		spi_unregister_controller(ctlr);
@@ -512,6 +592,7 @@ static struct platform_driver ccb_spi_driver = {
 static struct gpio_chip ccb_gc;
 static DEFINE_SPINLOCK(ccb_gpio_lock);
 static u8 ccb_level[CCB_NGPIO];   /* last level user space reported */
+static struct task_struct *ccb_level_task; /* the server, inside its level write */
 static u8 ccb_out[CCB_NGPIO];     /* 1 = output (for get_direction) */
 static u8 ccb_od[CCB_NGPIO];      /* open drain configured */
 static u8 ccb_irq_on[CCB_NGPIO];  /* unmasked */
@@ -523,13 +604,41 @@ static const char *const ccb_names[CCB_NGPIO] = {
 	"GPIO19", "GPIO20", "GPIO21", "GPIO22", "GPIO23", "GPIO24", "GPIO25", "GPIO26", "GPIO27",
 };
 
+/* The injected result of this line operation: -errno, or 0 (a GET reads low) when it is to
+ * fail; 1 when it goes on as usual. */
+static int ccb_gpio_fault(unsigned int offset, u16 op)
+{
+	int fop = READ_ONCE(gpio_fail_op), foff = READ_ONCE(gpio_fail_offset);
+	unsigned long flags;
+	bool take = false;
+
+	if ((fop && fop != op) || (foff >= 0 && foff != offset))
+		return 1;
+	spin_lock_irqsave(&ccb_fault_lock, flags);
+	if (gpio_fail_count > 0) {
+		if (gpio_fail_skip > 0) {
+			gpio_fail_skip--;
+		} else {
+			gpio_fail_count--;
+			take = true;
+		}
+	}
+	spin_unlock_irqrestore(&ccb_fault_lock, flags);
+	if (!take)
+		return 1;
+	return gpio_fail_errno ? -abs(gpio_fail_errno) : 0;
+}
+
 static int ccb_gpio_op(unsigned int offset, u16 op, u32 value, u32 flags)
 {
 	struct {
 		struct ccb_header h;
 		struct ccb_gpio g;
 	} req = { .g = { .offset = offset, .value = value, .flags = flags } };
+	int fault = ccb_gpio_fault(offset, op);
 
+	if (fault <= 0)
+		return fault;
 	return ccb_transact(&req, sizeof(req), CCB_GPIO, op, NULL, 0, NULL);
 }
 
@@ -578,8 +687,16 @@ static int ccb_gpio_get(struct gpio_chip *gc, unsigned int offset)
 	if (ccb_irq_used[offset])
 		v = ccb_level[offset];
 	spin_unlock_irqrestore(&ccb_gpio_lock, flags);
-	if (v >= 0)
+	if (v >= 0) {
+		/* The edge handler (inside the server's write) reads too: only a reader's get fails. */
+		if (READ_ONCE(ccb_level_task) != current) {
+			int fault = ccb_gpio_fault(offset, CCB_GPIO_GET);
+
+			if (fault <= 0)
+				return fault;
+		}
 		return v;
+	}
 	return ccb_gpio_op(offset, CCB_GPIO_GET, 0, 0);
 }
 
@@ -620,8 +737,11 @@ static void ccb_gpio_level(u32 offset, u32 value)
 	if (fire) {
 		unsigned int irq = irq_find_mapping(ccb_gc.irq.domain, offset);
 
-		if (irq)
+		if (irq) {
+			WRITE_ONCE(ccb_level_task, current);
 			handle_nested_irq(irq);
+			WRITE_ONCE(ccb_level_task, NULL);
+		}
 	}
 }
 
@@ -683,12 +803,18 @@ static int ccb_gpio_probe(struct platform_device *pdev)
 {
 	struct gpio_irq_chip *girq;
 
+	/* Unbind and bind again (a chip that goes while its lines are held): a clean chip. */
+	memset(&ccb_gc, 0, sizeof(ccb_gc));
+	memset(ccb_irq_on, 0, sizeof(ccb_irq_on));
+	memset(ccb_irq_used, 0, sizeof(ccb_irq_used));
 	ccb_gc.label = "caracara-gpio";
 	ccb_gc.parent = &pdev->dev;
 	ccb_gc.owner = THIS_MODULE;
 	ccb_gc.base = -1;
 	ccb_gc.ngpio = CCB_NGPIO;
-	ccb_gc.names = ccb_names;
+	/* The line names come from the device's "gpio-line-names" property, not gc.names: with
+	 * gc.names, Linux 6.1 looks every name up in all chips, and a chip removed while its lines
+	 * were held stays in that list without its gpio_chip (a NULL dereference at the next add). */
 	ccb_gc.can_sleep = true;
 	ccb_gc.request = ccb_gpio_request;
 	ccb_gc.free = ccb_gpio_free;
@@ -712,6 +838,17 @@ static struct platform_driver ccb_gpio_driver = {
 };
 
 /* ---- module ---- */
+
+static const struct property_entry ccb_gpio_props[] = {
+	PROPERTY_ENTRY_STRING_ARRAY("gpio-line-names", ccb_names),
+	{}
+};
+
+static const struct platform_device_info ccb_gpio_info = {
+	.name = "caracara-gpio",
+	.id = PLATFORM_DEVID_NONE,
+	.properties = ccb_gpio_props,
+};
 
 static struct platform_device *ccb_i2c_pdev, *ccb_spi_pdev, *ccb_gpio_pdev;
 
@@ -745,7 +882,7 @@ static int __init ccb_init(void)
 		goto fail;
 	ccb_i2c_pdev = platform_device_register_simple("caracara-i2c", PLATFORM_DEVID_NONE, NULL, 0);
 	ccb_spi_pdev = platform_device_register_simple("caracara-spi", PLATFORM_DEVID_NONE, NULL, 0);
-	ccb_gpio_pdev = platform_device_register_simple("caracara-gpio", PLATFORM_DEVID_NONE, NULL, 0);
+	ccb_gpio_pdev = platform_device_register_full(&ccb_gpio_info);
 	if (IS_ERR(ccb_i2c_pdev) || IS_ERR(ccb_spi_pdev) || IS_ERR(ccb_gpio_pdev)) {
 		ret = -ENODEV;
 		if (IS_ERR(ccb_i2c_pdev))
