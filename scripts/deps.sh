@@ -8,7 +8,7 @@ catch2=libcatch2-dev
 [ "$(. /etc/os-release && echo "${VERSION_CODENAME:-}")" = bookworm ] && catch2=catch2
 pkgs=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev "$catch2" libtomlplusplus-dev
       dbus python3 python3-dbus python3-gi systemd debootstrap systemd-container valgrind
-      clang libclang-rt-dev python3-matplotlib ccache)
+      clang libclang-rt-dev python3-matplotlib ccache libboost-dev nlohmann-json3-dev openssh-client)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
