@@ -113,6 +113,11 @@ std::vector<uint8_t> dive_to_mcap(const dive::Dive& d) {
         put(id(ChannelKind::Attitude), attitude_json(ns, s.orientation[0], s.orientation[1], s.orientation[2]));
     }
     events_until(UINT32_MAX);
+    if (d.ended) {
+        // What closed the dive, as caracaractl export --events lists it last.
+        const uint64_t ns = at(d.end.t_100us);
+        w.add_message(id(ChannelKind::Events), ns, ns, to_json(LogEvent{ns, LogLevel::Info, "end", "dive ended: " + d.end.reason}));
+    }
     return w.finish();
 }
 
