@@ -124,7 +124,9 @@ void McapWriter::flush_chunk() {
     });
     index.length = file_.size() - index.offset;
     const std::size_t indexes_start = file_.size();
-    for (auto& [channel, entries] : chunk_index_) {
+    for (auto& item : chunk_index_) {
+        const uint16_t channel = item.first;
+        auto& entries = item.second;
         // The entries sorted by time, as the specification asks.
         std::stable_sort(entries.begin(), entries.end(),
                          [](const auto& a, const auto& b) { return a.first < b.first; });
