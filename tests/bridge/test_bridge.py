@@ -173,6 +173,30 @@ class BridgeTest(unittest.TestCase):
         self.node("bridge.test.mjs", CARACARA_WS_URL="ws://127.0.0.1:%d" % self.port)
         self.assertIsNone(self.bridge.poll(), "the bridge survived every test")
 
+    def test_2_caracaractl_bridge_forwards_and_prints_the_address(self):
+        cfg = os.path.join(self.sshd.dir, "ssh_config")
+        with open(cfg, "w") as f:
+            f.write(f"Host vehicle\n  HostName 127.0.0.1\n  Port {self.sshd.port}\n  User root\n"
+                    f"  IdentityFile {self.sshd.dir}/client_key\n  IdentitiesOnly yes\n  UserKnownHostsFile /dev/null\n"
+                    "  StrictHostKeyChecking no\n  BatchMode yes\n  LogLevel ERROR\n")
+        port = free_port()
+        p = subprocess.Popen(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "caracaractl"), "-H", "vehicle",
+                              "bridge", "--port", str(port), "--socket", self.socket, "--ssh-config", cfg],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            self.assertEqual(p.stdout.readline().strip(), "ws://localhost:%d" % port)
+            # A WebSocket upgrade with the Foxglove subprotocol through the forward.
+            with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+                s.sendall(b"GET / HTTP/1.1\r\nHost: localhost\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                          b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+                          b"Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n")
+                head = s.recv(4096).decode(errors="replace")
+            self.assertIn("101", head.splitlines()[0])
+            self.assertIn("sec-websocket-protocol: foxglove.websocket.v1", head.lower())
+        finally:
+            p.send_signal(2)
+            self.assertEqual(p.wait(15), 0, p.stderr.read())
+
     def test_2_socket_is_for_the_group_only(self):
         st = os.stat(self.socket)
         self.assertEqual(st.st_mode & 0o777, 0o660)
