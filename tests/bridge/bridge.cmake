@@ -7,4 +7,4 @@ add_test(NAME e2e_bridge
 set_tests_properties(e2e_bridge PROPERTIES
                      ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
                      TIMEOUT 600
-                     LABELS e2e)
+                     LABELS "e2e;bridge")
