@@ -125,6 +125,7 @@ test("kill from a client, a refused command as a status with the daemon's error 
   const leds = c.publisher("/command/leds");
   c.publish(leds, { red: 1, green: 2, blue: 3 });
   await poll(() => JSON.stringify(vget("Leds")) === "[1,2,3]", 5000, "the LEDs");
+  await c.waitFor("/vehicle/state", (s) => JSON.stringify(s.leds) === "[1,2,3]");
   const profile = c.publisher("/command/profile");
   c.publish(profile, { name: "no-such-profile" });
   await c.waitStatus((s) => s.message.includes(ERR + "UnknownProfile"));

@@ -251,7 +251,10 @@ void Telemetry::build(std::size_t channel, uint64_t now) {
         const Props& p = props(kRoot, caracara::dbus::kVehicleIface);
         fg::VehicleState s{text(p, "State"), text(p, "KillSource"), text(p, "Profile"),
                            get(p, "ProfileFactor").number(), get(p, "BudgetLimit").integer(),
-                           get(p, "Saturated").boolean(), get(p, "CommandAgeMs").integer(), text(p, "Controller")};
+                           get(p, "Saturated").boolean(), get(p, "CommandAgeMs").integer(), text(p, "Controller"), {}};
+        const Value& leds = get(p, "Leds");
+        for (std::size_t i = 0; i < 3 && i < leds.items.size(); ++i)
+            s.leds[i] = leds.items[i].integer();
         json = fg::to_json(s);
         break;
     }

@@ -53,7 +53,8 @@ std::vector<ChannelInfo> make_channels() {
                            {"budget_limit", integer()},
                            {"saturated", boolean()},
                            {"command_age_ms", integer()},
-                           {"controller", string()}})
+                           {"controller", string()},
+                           {"leds", fixed_array(integer(), 3)}})
                        .dump()});
     out.push_back({ChannelKind::Motors, 0, "/vehicle/motors", "caracara.Motors",
                    object("caracara.Motors", {{"applied", fixed_array(integer(), kThrusters)},
@@ -144,7 +145,8 @@ std::string to_json(const VehicleState& m) {
                 {"budget_limit", m.budget_limit},
                 {"saturated", m.saturated},
                 {"command_age_ms", m.command_age_ms},
-                {"controller", m.controller}}
+                {"controller", m.controller},
+                {"leds", m.leds}}
         .dump();
 }
 

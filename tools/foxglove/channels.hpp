@@ -43,6 +43,7 @@ struct VehicleState {
     bool saturated = false;
     int64_t command_age_ms = -1; // -1: no motion command yet, or not recorded
     std::string controller;      // the commanding client's unique bus name
+    std::array<int64_t, 3> leds{}; // red, green, blue (not recorded in a dive: 0)
 };
 
 struct Motors {

@@ -64,7 +64,7 @@ std::vector<uint8_t> dive_to_mcap(const dive::Dive& d) {
     const uint64_t start_ns = d.header.start_unix_ms * 1'000'000u;
     auto at = [&](uint32_t t_100us) { return start_ns + uint64_t{t_100us} * 100'000u; };
 
-    VehicleState state{"arming", "", d.header.profile, 1.0, 0, false, -1, ""};
+    VehicleState state{"arming", "", d.header.profile, 1.0, 0, false, -1, "", {}};
     std::size_t next_event = 0;
     auto events_until = [&](uint32_t t) {
         for (; next_event < d.events.size() && d.events[next_event].t_100us <= t; ++next_event) {
