@@ -195,7 +195,11 @@ class BridgeTest(unittest.TestCase):
             self.assertIn("sec-websocket-protocol: foxglove.websocket.v1", head.lower())
         finally:
             p.send_signal(2)
-            self.assertEqual(p.wait(15), 0, p.stderr.read())
+            code = p.wait(15)
+            err = p.stderr.read()
+            p.stdout.close()
+            p.stderr.close()
+            self.assertEqual(code, 0, err)
 
     def test_2_socket_is_for_the_group_only(self):
         st = os.stat(self.socket)
@@ -203,6 +207,19 @@ class BridgeTest(unittest.TestCase):
         self.assertEqual(connect_as(self.socket, "--reuid=nobody", "--regid=nogroup", "--clear-groups"), "EACCES")
         # The same user in the socket's group gets in.
         self.assertEqual(connect_as(self.socket, "--reuid=nobody", "--regid=nogroup", "--groups=%d" % st.st_gid), "ok")
+
+    def test_4_a_restarted_daemon_is_followed(self):
+        # The bridge keeps its socket; the new daemon's objects are loaded again (it starts killed).
+        self.rig.stop_daemon()
+        self.rig.start_daemon()
+        script = ("import { connect } from './lib.mjs';"
+                  "const c = await connect(process.env.CARACARA_WS_URL); c.subscribeAll();"
+                  "const s = await c.waitFor('/vehicle/state', (m) => m.state === 'killed' && m.kill_source === 'start');"
+                  "await c.close(); console.log(JSON.stringify(s));")
+        r = subprocess.run(["node", "--input-type=module", "-e", script], cwd=HERE, capture_output=True, text=True,
+                           timeout=60, env={**os.environ, "CARACARA_WS_URL": "ws://127.0.0.1:%d" % self.port})
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIsNone(self.bridge.poll())
 
     def test_3_dive_exported_to_mcap_reads_back(self):
         # test_1 armed and killed: the first dive of the rig is closed by that kill.

@@ -92,9 +92,17 @@ std::string advertise() {
 } // namespace
 
 Session::Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry)
-    : io_(io), ws_(std::move(socket)), config_(config), telemetry_(telemetry), protocol_(fg::channels().size()) {}
+    : io_(io), ws_(std::move(socket)), handshake_timer_(io), config_(config), telemetry_(telemetry), protocol_(fg::channels().size()) {}
 
 void Session::start() {
+    handshake_timer_.expires_after(std::chrono::seconds(10));
+    handshake_timer_.async_wait([weak = weak_from_this()](boost::system::error_code ec) {
+        if (auto self = weak.lock(); self && !ec && !self->open_) {
+            boost::system::error_code ignored;
+            self->ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
+            self->ws_.next_layer().close(ignored);
+        }
+    });
     http::async_read(ws_.next_layer(), buffer_, request_,
                      [self = shared_from_this()](boost::system::error_code ec, std::size_t) { self->on_request(ec); });
 }
@@ -147,6 +155,7 @@ void Session::on_accept(boost::system::error_code ec) {
     if (ec)
         return end("handshake failed");
     open_ = true;
+    handshake_timer_.cancel();
     send_text(server_info());
     send_text(advertise());
     read();
@@ -250,6 +259,7 @@ void Session::end(const char* why) {
     (void)why;
     // The pilot's D-Bus connection goes now: caracarad zeroes what this client commanded.
     link_.reset();
+    handshake_timer_.cancel();
     boost::system::error_code ignored;
     ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
 }

@@ -11,6 +11,7 @@
 #include "tools/bridge/telemetry.hpp"
 
 #include <boost/asio/generic/stream_protocol.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core/flat_buffer.hpp>
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
@@ -58,6 +59,7 @@ private:
 
     boost::asio::io_context& io_;
     boost::beast::websocket::stream<Socket> ws_;
+    boost::asio::steady_timer handshake_timer_; // a connection that never upgrades is closed
     const SessionConfig& config_;
     Telemetry& telemetry_;
     boost::beast::flat_buffer buffer_;

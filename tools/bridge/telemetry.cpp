@@ -99,6 +99,11 @@ bool Telemetry::connect() {
                                 caracara::dbus::kVehicleIface, "Failsafe", on_vehicle_signal, this) < 0)
             return false;
         slots_.emplace_back(slot);
+        // A restarted caracarad: its objects are loaded again (the old values are gone).
+        if (sd_bus_match_signal(bus, &slot, "org.freedesktop.DBus", "/org/freedesktop/DBus", "org.freedesktop.DBus",
+                                "NameOwnerChanged", on_owner_changed, this) < 0)
+            return false;
+        slots_.emplace_back(slot);
         objects_ = client_->get_objects();
     } catch (const caracaractl::Failure& f) {
         std::fprintf(stderr, "caracara-bridge: caracarad not reachable (%s); retrying\n", f.message.c_str());
@@ -166,6 +171,35 @@ int Telemetry::on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error
                           (thruster >= 0 ? " (thruster " + std::to_string(thruster) + ")" : ""));
     }
     return 0;
+}
+
+int Telemetry::on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto* self = static_cast<Telemetry*>(userdata);
+    const char *name = nullptr, *old_owner = nullptr, *new_owner = nullptr;
+    if (sd_bus_message_read(m, "sss", &name, &old_owner, &new_owner) < 0 || !name ||
+        std::string_view(name) != caracara::dbus::kBusName || !new_owner || !*new_owner)
+        return 0;
+    // Not from inside this connection's processing: the call waits for its reply.
+    boost::asio::post(self->io_, [self, alive = self->alive_] {
+        if (*alive)
+            self->reload();
+    });
+    return 0;
+}
+
+void Telemetry::reload() {
+    if (!watch_ || !client_)
+        return; // reconnecting: connect() loads the objects
+    try {
+        objects_ = client_->get_objects();
+    } catch (const caracaractl::Failure& f) {
+        std::fprintf(stderr, "caracara-bridge: reloading caracarad's objects failed (%s)\n", f.message.c_str());
+        return;
+    }
+    for (std::size_t i = 0; i < fg::channels().size(); ++i)
+        if (fg::channels()[i].kind != ChannelKind::Events)
+            mark(i);
+    watch_->kick();
 }
 
 void Telemetry::changed(const std::string& path, const std::string& iface, const Props& changes) {

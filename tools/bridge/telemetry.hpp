@@ -37,6 +37,8 @@ public:
 private:
     static int on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
     static int on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error* error);
+    static int on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
+    void reload();
     bool connect();
     void retry();
     void changed(const std::string& path, const std::string& iface, const caracaractl::Props& props);
