@@ -4,6 +4,7 @@
 // private bus, caracara-sim, caracarad, the bridge, a private sshd and the forward.
 import { test, after } from "node:test";
 import assert from "node:assert/strict";
+import net from "node:net";
 import WebSocket from "ws";
 import {
   DEFAULT_MT, ERR, MOTORS, MOTOR_MAX, X_AXIS, ZERO, connect, hold, poll, simSpeeds, simThruster, sleep, speedByte,
@@ -190,6 +191,25 @@ test("bad input: a status error or a close, never a crash, never a command", asy
   assert.deepEqual([...new Set(orders.map((e) => e.data[0]))].filter((s) => s !== ZERO), []);
   const d = await client();
   await d.waitFor("/vehicle/state");
+  // Malformed WebSocket framing (an unmasked client frame), and no HTTP at all: closed.
+  const where = new globalThis.URL(URL);
+  const rawSocket = async (request, then) => {
+    const sock = net.connect(Number(where.port), where.hostname);
+    let got = "";
+    sock.on("data", (d) => { got += d.toString("latin1"); });
+    const closed = new Promise((resolve) => sock.on("close", resolve));
+    sock.write(request);
+    if (then) {
+      await poll(() => got.includes("\r\n\r\n"), 5000, "the upgrade's answer");
+      assert.match(got, /^HTTP\/1\.1 101/);
+      sock.write(then);
+    }
+    await Promise.race([closed, sleep(5000).then(() => { throw new Error("not closed"); })]);
+  };
+  await rawSocket("GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n" +
+                  "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n" +
+                  "Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n", Buffer.from([0x81, 0x05, 104, 101, 108, 108, 111]));
+  await rawSocket("\x00\x01garbage that is no HTTP\r\n\r\n");
   // Not the protocol at all: refused at the upgrade.
   const plain = new WebSocket(URL, ["not-foxglove"]);
   await new Promise((resolve) => { plain.on("error", resolve); plain.on("unexpected-response", resolve); });
