@@ -84,9 +84,11 @@ void CommandLink::send(const Command& c) {
         on_refused_(command_topic_name(c.kind), "org.caracara.Bridge.Error.SendFailed", std::strerror(-r));
         return;
     }
-    // The slot floats (freed with the bus or after the reply) and frees `pending` with it.
+    // The slot floats (the bus owns it: freed after the reply or with the bus) and frees
+    // `pending` with it; the reference sd_bus_call_async gave us is dropped.
     sd_bus_slot_set_destroy_callback(slot, [](void* p) { delete static_cast<Pending*>(p); });
     sd_bus_slot_set_floating(slot, 1);
+    sd_bus_slot_unref(slot);
     watch_->kick();
 }
 
