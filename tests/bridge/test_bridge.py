@@ -22,7 +22,7 @@ sys.path.insert(0, os.path.join(SOURCE, "bench"))
 
 import harness  # noqa: E402
 from harness import BUILD_DIR, Rig, poll  # noqa: E402
-from ssh_bridge import find_sshd, free_port  # noqa: E402
+from ssh_bridge import free_port, private_sshd  # noqa: E402
 
 NPM_CACHE = "/var/cache/caracara-npm"
 CI = os.environ.get("CI") == "true"
@@ -48,32 +48,15 @@ def npm_ci():
 
 
 class Sshd:
-    """A private sshd on 127.0.0.1 (keys made for the run, keys only, no PAM) in a mount
-    namespace of its own, as bench/ssh_bridge.py runs it; ssh -L forwards a local port to the
-    bridge's Unix socket through it."""
+    """The private sshd of bench/ssh_bridge.py (127.0.0.1, keys made for the run, no PAM, a
+    mount namespace of its own); ssh -L forwards a local port to the bridge's socket through it."""
 
     def __init__(self, d):
         self.dir = d
         self.port = free_port()
-        self.sshd, env = find_sshd(lambda m: print(m, file=sys.stderr))
-        for key in ("host_key", "client_key"):
-            subprocess.run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f", os.path.join(d, key)], check=True)
-        shutil.copy(os.path.join(d, "client_key.pub"), os.path.join(d, "authorized_keys"))
-        with open(os.path.join(d, "sshd_config"), "w") as f:
-            f.write(f"ListenAddress 127.0.0.1\nPort {self.port}\nHostKey {d}/host_key\n"
-                    f"AuthorizedKeysFile {d}/authorized_keys\nPermitRootLogin prohibit-password\n"
-                    "PasswordAuthentication no\nKbdInteractiveAuthentication no\nUsePAM no\nStrictModes no\n"
-                    "PidFile none\nAllowStreamLocalForwarding yes\n")
-        with open("/etc/passwd") as src, open(os.path.join(d, "passwd"), "w") as dst:
-            text = src.read()
-            dst.write(text)
-            if "\nsshd:" not in "\n" + text:
-                dst.write("sshd:x:65534:65534::/run/sshd:/usr/sbin/nologin\n")
-        script = (f"set -e; mount --bind {d}/passwd /etc/passwd; mount -t tmpfs -o mode=0755 tmpfs /run; "
-                  f"mkdir -m 0755 /run/sshd; exec {self.sshd} -D -e -f {d}/sshd_config")
+        argv, env = private_sshd(d, self.port, lambda m: print(m, file=sys.stderr))
         self.log = open(os.path.join(d, "sshd.log"), "ab")
-        self.proc = subprocess.Popen(["unshare", "--mount", "--propagation", "private", "sh", "-c", script],
-                                     stdout=self.log, stderr=subprocess.STDOUT, env={**os.environ, **env})
+        self.proc = subprocess.Popen(argv, stdout=self.log, stderr=subprocess.STDOUT, env={**os.environ, **env})
         poll(self.listening, 10, message="the private sshd to listen")
 
     def listening(self):
