@@ -2,6 +2,7 @@
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/local/stream_protocol.hpp>
+#include <chrono>
 #include <cstdio>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -24,7 +25,7 @@ Generic::endpoint endpoint_of(const ListenConfig& l) {
 BridgeServer::BridgeServer(asio::io_context& io, const ListenConfig& listen, SessionConfig session)
     : io_(io), listen_(listen), session_(std::move(session)),
       telemetry_(io, session_.bus, [this](std::size_t c, uint64_t t, const Payload& p) { publish(c, t, p); }),
-      acceptor_(io) {
+      acceptor_(io), accept_retry_(io) {
     const Generic::endpoint ep = endpoint_of(listen_);
     acceptor_.open(ep.protocol());
     if (!listen_.unix_path.empty()) {
@@ -55,14 +56,24 @@ std::size_t BridgeServer::clients() {
 
 void BridgeServer::accept() {
     acceptor_.async_accept([this](boost::system::error_code ec, Generic::socket socket) {
-        if (!ec) {
-            if (clients() >= listen_.max_clients) {
-                std::fprintf(stderr, "caracara-bridge: refusing a client: %zu connected\n", listen_.max_clients);
-            } else {
-                auto s = std::make_shared<Session>(io_, std::move(socket), session_, telemetry_);
-                sessions_.push_back(s);
-                s->start();
-            }
+        if (ec == asio::error::operation_aborted)
+            return;
+        if (ec) {
+            // EMFILE and the like: try again shortly rather than spin.
+            std::fprintf(stderr, "caracara-bridge: accept: %s\n", ec.message().c_str());
+            accept_retry_.expires_after(std::chrono::milliseconds(200));
+            accept_retry_.async_wait([this](boost::system::error_code e) {
+                if (!e)
+                    accept();
+            });
+            return;
+        }
+        if (clients() >= listen_.max_clients) {
+            std::fprintf(stderr, "caracara-bridge: refusing a client: %zu connected\n", listen_.max_clients);
+        } else {
+            auto s = std::make_shared<Session>(io_, std::move(socket), session_, telemetry_);
+            sessions_.push_back(s);
+            s->start();
         }
         accept();
     });

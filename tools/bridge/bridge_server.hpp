@@ -9,6 +9,7 @@
 #include <boost/asio/basic_socket_acceptor.hpp>
 #include <boost/asio/generic/stream_protocol.hpp>
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <list>
 #include <memory>
 #include <string>
@@ -38,6 +39,7 @@ private:
     SessionConfig session_;
     Telemetry telemetry_;
     boost::asio::basic_socket_acceptor<boost::asio::generic::stream_protocol> acceptor_;
+    boost::asio::steady_timer accept_retry_; // after a failed accept (no descriptor left)
     std::list<std::weak_ptr<Session>> sessions_;
 };
 
