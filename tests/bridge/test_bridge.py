@@ -131,11 +131,7 @@ class BridgeTest(unittest.TestCase):
 
     @classmethod
     def forwarding(cls):
-        try:
-            with socket.create_connection(("127.0.0.1", cls.port), timeout=0.5):
-                return True
-        except OSError:
-            return False
+        return cls.listening(cls.port)
 
     @classmethod
     def tearDownClass(cls):
@@ -225,6 +221,48 @@ class BridgeTest(unittest.TestCase):
         n_events = len(events.strip().splitlines()) - 1
         self.assertGreater(n_samples, 0)
         self.node("mcap_check.mjs", CARACARA_MCAP=out, CARACARA_SAMPLES=str(n_samples), CARACARA_EVENTS=str(n_events))
+
+    def test_5_tcp_needs_its_token(self):
+        exe = harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge")]
+        port = free_port()
+        token_file = os.path.join(self.rig.dir, "token")
+        with open(token_file, "w") as f:
+            f.write("short\n")
+        for args in ([], ["--token-file", token_file]):  # no token; a token under 16 characters
+            r = subprocess.run(exe + ["--listen", "tcp:127.0.0.1:%d" % port, "--bus-address", self.rig.address] + args,
+                               capture_output=True, text=True, timeout=30)
+            self.assertEqual(r.returncode, 2, r.stderr)
+        token = "0123456789abcdef0123456789abcdef"
+        with open(token_file, "w") as f:
+            f.write(token + "\n")
+        p = subprocess.Popen(exe + ["--listen", "tcp:127.0.0.1:%d" % port, "--token-file", token_file,
+                                    "--bus-address", self.rig.address], stderr=subprocess.DEVNULL)
+        try:
+            poll(lambda: self.listening(port), 10, message="the TCP listener")
+
+            def status(target, header=b""):
+                with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+                    s.sendall(b"GET " + target + b" HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\n"
+                              b"Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                              b"Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: foxglove.websocket.v1\r\n" +
+                              header + b"\r\n")
+                    return s.recv(4096).split(b"\r\n")[0].decode()
+            self.assertIn("401", status(b"/"))
+            self.assertIn("401", status(b"/?token=" + token[:-1].encode() + b"x"))
+            self.assertIn("401", status(b"/?token=" + token.encode() + b"0"))
+            self.assertIn("101", status(b"/?token=" + token.encode()))
+            self.assertIn("101", status(b"/", b"Authorization: Bearer " + token.encode() + b"\r\n"))
+        finally:
+            p.terminate()
+            self.assertEqual(p.wait(20), 0)
+
+    @staticmethod
+    def listening(port):
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=0.5):
+                return True
+        except OSError:
+            return False
 
     def test_9_bridge_stops_cleanly(self):
         # SIGTERM: exit status 0, its socket removed (under ASan: no leak, which would make it non-zero).
