@@ -92,7 +92,8 @@ std::string advertise() {
 } // namespace
 
 Session::Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry)
-    : io_(io), ws_(std::move(socket)), handshake_timer_(io), config_(config), telemetry_(telemetry), protocol_(fg::channels().size()) {}
+    : io_(io), ws_(std::move(socket)), handshake_timer_(io), config_(config), telemetry_(telemetry),
+      protocol_(fg::channels().size()), queue_(config.max_queued) {}
 
 void Session::start() {
     handshake_timer_.expires_after(std::chrono::seconds(10));
@@ -219,32 +220,17 @@ void Session::send_text(std::string text) {
 }
 
 void Session::queue(Frame f) {
-    if (f.droppable && queued_data_ >= config_.max_queued) {
-        // Drop the oldest message waiting (never the one being written: it is at the front).
-        for (auto it = queue_.begin() + (writing_ ? 1 : 0); it != queue_.end(); ++it)
-            if (it->droppable) {
-                queue_.erase(it);
-                --queued_data_;
-                ++dropped_;
-                break;
-            }
-    }
-    queued_data_ += f.droppable ? 1 : 0;
-    queue_.push_back(std::move(f));
-    if (!writing_)
+    queue_.push(std::move(f));
+    if (!queue_.writing())
         write_next();
 }
 
 void Session::write_next() {
     if (queue_.empty() || ended_)
         return;
-    writing_ = true;
-    const Frame& f = queue_.front();
+    const Frame& f = queue_.start_front();
     ws_.text(f.text);
     ws_.async_write(boost::asio::buffer(*f.bytes), [self = shared_from_this()](boost::system::error_code ec, std::size_t) {
-        self->writing_ = false;
-        if (self->queue_.front().droppable)
-            --self->queued_data_;
         self->queue_.pop_front();
         if (ec)
             return self->end("write failed");

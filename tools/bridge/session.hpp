@@ -8,6 +8,7 @@
 
 #include "tools/bridge/client_protocol.hpp"
 #include "tools/bridge/command_link.hpp"
+#include "tools/bridge/send_queue.hpp"
 #include "tools/bridge/telemetry.hpp"
 
 #include <boost/asio/generic/stream_protocol.hpp>
@@ -16,7 +17,6 @@
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
 #include <boost/beast/websocket/stream.hpp>
-#include <deque>
 #include <memory>
 #include <string>
 
@@ -37,14 +37,10 @@ public:
     void start();
     // A channel's new message, sent to each of this client's subscriptions of it.
     void deliver(std::size_t channel, uint64_t time_ns, const Payload& json);
-    uint64_t dropped() const { return dropped_; }
+    uint64_t dropped() const { return queue_.dropped(); }
 
 private:
-    struct Frame {
-        bool text;
-        bool droppable;
-        std::shared_ptr<const std::string> bytes;
-    };
+    using Frame = SendQueue::Frame;
 
     void on_request(boost::system::error_code ec);
     void reject(boost::beast::http::status status, std::string body);
@@ -66,10 +62,8 @@ private:
     boost::beast::http::request<boost::beast::http::string_body> request_;
     ClientProtocol protocol_;
     std::unique_ptr<CommandLink> link_;
-    std::deque<Frame> queue_;
-    std::size_t queued_data_ = 0;
-    bool writing_ = false, open_ = false, ended_ = false;
-    uint64_t dropped_ = 0;
+    SendQueue queue_;
+    bool open_ = false, ended_ = false;
 };
 
 } // namespace caracara::bridge
