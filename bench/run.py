@@ -275,6 +275,53 @@ def phase_ssh(b, p, res):
         bridge.stop()
 
 
+def phase_bridge(b, p, res):
+    log("8. caracara-bridge: a property change to a client, a published motion to the wire vs SetMotion, CPU and RSS")
+    bridge_exe = os.path.join(b.build, "tools", "bridge", "caracara-bridge")
+    node_dir = os.path.join(os.path.dirname(HERE), "tests", "bridge")
+    if not shutil.which("node") or not os.path.isdir(os.path.join(node_dir, "node_modules")):
+        raise RuntimeError("node and tests/bridge/node_modules are needed (npm ci --cache /var/cache/caracara-npm there)")
+    b.start_sim(realistic=False)
+    b.start_daemon(b.daemon_config(50))
+    sock = os.path.join(b.dir, "bridge.sock")
+    br = b.spawn([bridge_exe, "--listen", "unix:" + sock, "--bus-address", b.bus], "caracara-bridge")
+    b.wait_for(lambda: os.path.exists(sock), 10, "the bridge's socket")
+    env = {**os.environ, "CARACARA_WS_URL": f"ws+unix://{sock}:/", "CARACARA_BUS_ADDRESS": b.bus,
+           "CARACARA_BENCH_SAMPLES": str(p["bridge_samples"])}
+
+    def node(*args, **kw):
+        return subprocess.Popen(["node", os.path.join(HERE, "bridge_bench.mjs"), *map(str, args)], env=env,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+
+    def run(*args):
+        n = node(*args)
+        out, err = n.communicate(timeout=600)
+        if n.returncode != 0:
+            raise RuntimeError(f"bridge_bench.mjs {' '.join(map(str, args))}: {err.strip()}")
+        return json.loads(out.strip().splitlines()[-1])
+
+    # start_daemon's wait-ready cleared the start kill: the vehicle is ready.
+    res["bridge"] = {**run("latency"), **run("motion"), "load": {}}
+    for k in (1, 4):
+        seconds = p["cpu_warm"] + p["cpu_window"]
+        n = node("load", k, seconds)
+        n.stderr.readline()  # "# loaded"
+        time.sleep(p["cpu_warm"])
+        c0, t0 = cpu_ns(br.pid), time.monotonic()
+        time.sleep(p["cpu_window"])
+        c1, t1 = cpu_ns(br.pid), time.monotonic()
+        rss = status_kib(br.pid, "VmRSS")
+        out, err = n.communicate(timeout=120)
+        if n.returncode != 0:
+            raise RuntimeError(f"bridge_bench.mjs load {k}: {err.strip()}")
+        res["bridge"]["load"][str(k)] = {"cpu_percent": 100.0 * (c1 - c0) / 1e9 / (t1 - t0), "rss_kib": rss,
+                                         **json.loads(out.strip().splitlines()[-1])}
+    res["bridge"]["rss_peak_kib"] = status_kib(br.pid, "VmHWM")
+    b.stop(br)
+    b.stop_daemon()
+    b.stop_sim()
+
+
 def pstats(v):
     """The same nearest-rank statistics as bench_common.hpp's stats_json."""
     if not v:
@@ -685,6 +732,21 @@ def rows_from(res, p):
         if "ssh_connect_ms" in res:
             row("   diagnostic: a whole busctl -H call (login, bridge, Hello, Ping), median", res["ssh_connect_ms"],
                 None, None, "info", None, "ms")
+    br = res.get("bridge")
+    if br:
+        lt = br["leds_to_state_us"]
+        row("8. bridge: property change to the client's message p50 (publish leds to /vehicle/state)", lt["p50"],
+            None, None, "info", None, "us")
+        row("8. bridge: property change to the client's message p99", lt["p99"], None, None, "info", None, "us")
+        mb, md = br["bridge_motion_to_wire_us"], br["dbus_setmotion_to_wire_us"]
+        row("8. bridge: published motion to the wire p50 (vs SetMotion over D-Bus)", mb["p50"], md["p50"],
+            mb["p50"] / md["p50"], "info", None, "us")
+        row("8. bridge: published motion to the wire p99 (vs SetMotion over D-Bus)", mb["p99"], md["p99"],
+            mb["p99"] / md["p99"], "info", None, "us")
+        for k, v in sorted(br["load"].items()):
+            row(f"8. bridge CPU, {k} client(s) subscribed to everything", v["cpu_percent"], None, None, "info", None,
+                "%")
+            row(f"8. bridge RSS, {k} client(s) subscribed to everything", v["rss_kib"], None, None, "info", None, "KiB")
     return rows
 
 
@@ -736,8 +798,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(HERE, "results.json"), help="JSON results (default bench/results.json)")
     ap.add_argument("--quick", action="store_true", help="shorten every phase (smoke run)")
     ap.add_argument("--rss-seconds", type=float, default=None, help="length of the RSS run (default 600, quick 20)")
-    ap.add_argument("--only", default="dbus,wire,faults,loop,cost,ssh",
-                    help="comma-separated phases: dbus,wire,faults,loop,cost,ssh")
+    ap.add_argument("--only", default="dbus,wire,faults,loop,cost,ssh,bridge",
+                    help="comma-separated phases: dbus,wire,faults,loop,cost,ssh,bridge")
     ap.add_argument("--keep", action="store_true", help="keep the temporary directory (logs, callgrind files)")
     ap.add_argument("--raw", action="store_true", help="keep every latency sample in the JSON (large)")
     ap.add_argument("--rt", action="store_true",
@@ -748,11 +810,11 @@ def main():
     if a.quick:
         p = dict(rtt_calls=2000, rtt_warmup=200, cmd_samples=100, kill_samples=40, burst_samples=40, wire_blocks=2,
                  loop_rounds=2, loop_window=2, cg_floor_cycles=(50, 250), cg_warm=3, cg_window=4, stream_hz=20,
-                 cpu_warm=3, cpu_window=5, rss_seconds=30)
+                 cpu_warm=3, cpu_window=5, rss_seconds=30, bridge_samples=100)
     else:
         p = dict(rtt_calls=10000, rtt_warmup=500, cmd_samples=1000, kill_samples=300, burst_samples=300, wire_blocks=10,
                  loop_rounds=6, loop_window=5, cg_floor_cycles=(200, 1200), cg_warm=5, cg_window=20, stream_hz=20,
-                 cpu_warm=10, cpu_window=30, rss_seconds=600)
+                 cpu_warm=10, cpu_window=30, rss_seconds=600, bridge_samples=1000)
     if a.rss_seconds is not None:
         p["rss_seconds"] = a.rss_seconds
     p["rss_seconds"] = max(p["rss_seconds"], p["cpu_warm"] + p["cpu_window"] * 4 + 10)
@@ -769,7 +831,7 @@ def main():
     res = {"quick": a.quick, "rt": a.rt, "params": p, "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
            "host": {"nproc": os.cpu_count(), "uname": " ".join(os.uname())}}
     phases = {"dbus": phase_dbus, "wire": phase_wire, "faults": phase_faults, "loop": phase_loop, "cost": phase_cost,
-              "ssh": phase_ssh}
+              "ssh": phase_ssh, "bridge": phase_bridge}
     try:
         b.start_bus()
         for name in a.only.split(","):

@@ -55,20 +55,18 @@ def free_port():
         return s.getsockname()[1]
 
 
-class SshBridge:
-    def __init__(self, bench, log):
-        self.b = bench
-        self.dir = os.path.join(bench.dir, "ssh")
-        os.makedirs(self.dir, exist_ok=True)
-        self.port = free_port()
-        self.sshd, env = find_sshd(log)
-        d = self.dir
-        for key in ("host_key", "client_key"):
-            subprocess.run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f", os.path.join(d, key)], check=True)
-        shutil.copy(os.path.join(d, "client_key.pub"), os.path.join(d, "authorized_keys"))
-        with open(os.path.join(d, "sshd_config"), "w") as f:
-            f.write(f"""ListenAddress 127.0.0.1
-Port {self.port}
+def private_sshd(d, port, log):
+    """Makes a private sshd's files in d (host and client keys, authorized_keys, sshd_config
+    for 127.0.0.1:port, keys only, no PAM, stream-local forwarding allowed, a passwd with its
+    privilege-separation user); returns (argv, extra environment) that run it in a mount
+    namespace of its own (e2e_bridge runs it too)."""
+    sshd, env = find_sshd(log)
+    for key in ("host_key", "client_key"):
+        subprocess.run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f", os.path.join(d, key)], check=True)
+    shutil.copy(os.path.join(d, "client_key.pub"), os.path.join(d, "authorized_keys"))
+    with open(os.path.join(d, "sshd_config"), "w") as f:
+        f.write(f"""ListenAddress 127.0.0.1
+Port {port}
 HostKey {d}/host_key
 AuthorizedKeysFile {d}/authorized_keys
 PermitRootLogin prohibit-password
@@ -77,12 +75,26 @@ KbdInteractiveAuthentication no
 UsePAM no
 StrictModes no
 PidFile none
+AllowStreamLocalForwarding yes
 """)
-        with open("/etc/passwd") as src, open(os.path.join(d, "passwd"), "w") as dst:
-            text = src.read()
-            dst.write(text)
-            if not re.search(r"^sshd:", text, re.M):
-                dst.write("sshd:x:65534:65534::/run/sshd:/usr/sbin/nologin\n")
+    with open("/etc/passwd") as src, open(os.path.join(d, "passwd"), "w") as dst:
+        text = src.read()
+        dst.write(text)
+        if not re.search(r"^sshd:", text, re.M):
+            dst.write("sshd:x:65534:65534::/run/sshd:/usr/sbin/nologin\n")
+    script = (f"set -e; mount --bind {d}/passwd /etc/passwd; mount -t tmpfs -o mode=0755 tmpfs /run; "
+              f"mkdir -m 0755 /run/sshd; exec {sshd} -D -e -f {d}/sshd_config")
+    return ["unshare", "--mount", "--propagation", "private", "sh", "-c", script], env
+
+
+class SshBridge:
+    def __init__(self, bench, log):
+        self.b = bench
+        self.dir = os.path.join(bench.dir, "ssh")
+        os.makedirs(self.dir, exist_ok=True)
+        self.port = free_port()
+        d = self.dir
+        argv, env = private_sshd(d, self.port, log)
         with open(os.path.join(d, "ssh_config"), "w") as f:
             f.write(f"""Host bench
   HostName 127.0.0.1
@@ -96,10 +108,7 @@ PidFile none
   BatchMode yes
   LogLevel ERROR
 """)
-        script = (f"set -e; mount --bind {d}/passwd /etc/passwd; mount -t tmpfs -o mode=0755 tmpfs /run; "
-                  f"mkdir -m 0755 /run/sshd; exec {self.sshd} -D -e -f {d}/sshd_config")
-        self.proc = bench.spawn(["unshare", "--mount", "--propagation", "private", "sh", "-c", script], "sshd",
-                                env={**os.environ, **env})
+        self.proc = bench.spawn(argv, "sshd", env={**os.environ, **env})
         bench.wait_for(self.listening, 10, "the benchmark's sshd")
         # What sd_bus_open_system_remote() runs, plus this run's ssh config and the private bus.
         argv = ["-F", os.path.join(d, "ssh_config"), "-xT", "--", "bench", "systemd-stdio-bridge",

@@ -292,6 +292,27 @@ def sim_request_seeds():
     write("sim_request", "reply-too-long", big)
 
 
+def bridge_seeds():
+    def frame(data, binary=False):
+        data = data if isinstance(data, bytes) else data.encode()
+        return struct.pack("<BH", 1 if binary else 0, len(data)) + data
+
+    def message(channel, body):
+        return frame(struct.pack("<BI", 1, channel) + body.encode(), True)
+
+    adv = frame('{"op":"advertise","channels":[{"id":1,"topic":"/command/motion","encoding":"json","schemaName":"m"},'
+                '{"id":2,"topic":"/command/thrust","encoding":"json","schemaName":"t"},'
+                '{"id":3,"topic":"/command/leds","encoding":"json","schemaName":"l"},'
+                '{"id":4,"topic":"/command/profile","encoding":"json","schemaName":"p"},'
+                '{"id":5,"topic":"/command/kill","encoding":"json","schemaName":"k"}]}')
+    write("bridge", "subscribe-all", frame('{"op":"subscribe","subscriptions":[' +
+                                           ",".join('{"id":%d,"channelId":%d}' % (i, i) for i in range(1, 15)) + "]}"))
+    write("bridge", "commands", adv + message(1, '{"x":0.5,"yaw":-0.25}') + message(2, '{"values":[1,2,3,4,5,6,7,8]}') +
+          message(3, '{"red":1,"green":2,"blue":3}') + message(4, '{"name":"water"}') + message(5, "{}"))
+    write("bridge", "bad", frame("not json") + frame('{"op":"nope"}') + frame(b"\x09\x00", True) +
+          message(9, "{}") + adv + message(2, '{"values":[1]}') + frame('{"op":"unsubscribe","subscriptionIds":[7]}'))
+
+
 def main():
     shutil.rmtree(os.path.join(HERE, "corpus"), ignore_errors=True)
     packet_seeds()
@@ -299,6 +320,7 @@ def main():
     teensy_seeds()
     config_seeds()
     sim_request_seeds()
+    bridge_seeds()
 
 
 if __name__ == "__main__":

@@ -8,7 +8,13 @@ catch2=libcatch2-dev
 [ "$(. /etc/os-release && echo "${VERSION_CODENAME:-}")" = bookworm ] && catch2=catch2
 pkgs=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev "$catch2" libtomlplusplus-dev
       dbus python3 python3-dbus python3-gi systemd debootstrap systemd-container valgrind
-      clang libclang-rt-dev python3-matplotlib ccache openssh-client)
+      clang libclang-rt-dev python3-matplotlib ccache libboost-dev nlohmann-json3-dev openssh-client)
+# Node.js and npm for the bridge's tests (tests/bridge: the Foxglove and MCAP reference
+# implementations): Debian's only when no node with npm is there, since Debian's npm conflicts
+# with other nodejs builds (NodeSource's bundles its own npm).
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  pkgs+=(nodejs npm)
+fi
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,11 +1,13 @@
 // caracaractl: query and command caracarad (org.caracara.Vehicle1) from the shell, in the style
 // of timedatectl. Arguments are parsed completely before anything is sent; value ranges are the
 // daemon's business (it answers with named errors), only the D-Bus wire types are checked here.
+#include "tools/bridge_forward.hpp"
 #include "tools/client.hpp"
 #include "tools/dives.hpp"
 #include "tools/hold.hpp"
 #include "tools/monitor.hpp"
 #include "tools/render.hpp"
+#include "tools/ssh_target.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -264,6 +266,7 @@ void print_help() {
         std::cout << strf("  %-32s %s\n", synopsis(c).c_str(), c.help);
     }
     std::cout << dive_help();
+    std::cout << bridge_forward_help();
     std::cout << "\nOptions (before the command):\n"
                  "  --system                         Connect to the system bus (default)\n"
                  "  --user                           Connect to the user's session bus\n"
@@ -339,8 +342,8 @@ int main(int argc, char** argv) {
                     host = i + 1 < argc ? argv[++i] : "";
                 else
                     host = a.starts_with("--host=") ? a.substr(7) : a.substr(2);
-                if (host.empty() || host[0] == '-')
-                    usage_error("-H needs [USER@]HOST[:PORT], not '" + host + "'");
+                if (!parse_ssh_target(host))
+                    usage_error("-H needs [USER@]HOST[:PORT] (PORT a number 1..65535), not '" + host + "'");
                 choice = {caracara::dbus::BusChoice::Kind::Remote, host};
             } else if (a == "--yes-power-off") {
                 options.yes_power_off = true;
@@ -359,6 +362,8 @@ int main(int argc, char** argv) {
         const std::string name = i < argc ? argv[i++] : "status";
         if (is_dive_command(name))
             return run_dive_command(name, Args(argv + i, argv + argc));
+        if (name == "bridge")
+            return run_bridge_forward(choice, Args(argv + i, argv + argc));
         command = find_command(name);
         if (!command)
             usage_error("unknown command '" + name + "'");

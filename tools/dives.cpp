@@ -5,6 +5,7 @@
 #include "drivers/platform/dive_files.hpp"
 #include "drivers/protocol/seabotix.hpp"
 #include "tools/client.hpp"
+#include "tools/foxglove/dive_mcap.hpp"
 #include "tools/render.hpp"
 
 #include <cerrno>
@@ -36,6 +37,7 @@ struct DiveOptions {
     std::string out;
     bool events = false;
     bool partial = false;
+    bool mcap = false;          // export --format mcap
     std::vector<std::string> positional;
 };
 
@@ -52,10 +54,16 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
         };
         if (a == "--dir")
             o.dir = value("--dir");
-        else if (a == "--out" && name == "plot")
+        else if (a == "--out" && (name == "plot" || name == "export"))
             o.out = value("--out");
         else if (a == "--events" && name == "export")
             o.events = true;
+        else if (a == "--format" && name == "export") {
+            const std::string f = value("--format");
+            if (f != "csv" && f != "mcap")
+                usage("--format takes csv or mcap, not '" + f + "'");
+            o.mcap = f == "mcap";
+        }
         else if (a == "--partial" && name != "dives")
             o.partial = true;
         else if (a.starts_with("--"))
@@ -63,6 +71,10 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
         else
             o.positional.push_back(a);
     }
+    if (name == "export" && o.mcap && o.events)
+        usage("--events applies to --format csv (in MCAP the events are the /events channel)");
+    if (name == "export" && !o.mcap && !o.out.empty())
+        usage("--out applies to --format mcap");
     const std::size_t want = name == "dives" ? 0 : 1;
     if (o.positional.size() != want)
         usage(strf("%s takes %zu argument%s, got %zu", name.c_str(), want, want == 1 ? "" : "s", o.positional.size()));
@@ -222,8 +234,29 @@ int cmd_dives(const DiveOptions& o) {
     return kExitOk;
 }
 
+// The dive as MCAP on the live bridge's channels, to --out or to stdout when it is no terminal.
+int export_mcap(const dive::Dive& d, const std::string& out) {
+    if (out.empty() && ::isatty(STDOUT_FILENO))
+        usage("MCAP is binary: give --out FILE or redirect the output");
+    const std::vector<uint8_t> bytes = caracara::foxglove::dive_to_mcap(d);
+    std::ofstream file;
+    if (!out.empty()) {
+        file.open(out, std::ios::binary | std::ios::trunc);
+        if (!file)
+            throw Failure{kExitRefused, "cannot write " + out + ": " + std::strerror(errno)};
+    }
+    std::ostream& s = out.empty() ? std::cout : file;
+    s.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    s.flush();
+    if (!s)
+        throw Failure{kExitRefused, "writing the MCAP file failed"};
+    return kExitOk;
+}
+
 int cmd_export(const DiveOptions& o) {
     const dive::Dive d = load(resolve(o), o.partial);
+    if (o.mcap)
+        return export_mcap(d, o.out);
     if (o.events)
         write_events(std::cout, d);
     else
@@ -315,6 +348,9 @@ const char* dive_help() {
            "                                   marked; FILE ends in .png (default), .svg or .html\n"
            "  export DIVE [--events] [--dir DIR] [--partial]\n"
            "                                   Print the samples (or the events) as CSV\n"
+           "  export DIVE --format mcap [--out FILE] [--dir DIR] [--partial]\n"
+           "                                   Write the dive as MCAP on the channels of\n"
+           "                                   caracara-bridge, for Foxglove (docs/foxglove.md)\n"
            "  DIVE is a path, a file name in DIR, or \"last\". A truncated or corrupt file is refused\n"
            "  (status 1, the problem and its byte offset named); --partial uses what came before it.\n";
 }

@@ -278,7 +278,10 @@ class CaracaractlRemoteArgumentsTest(unittest.TestCase):
         # An option for ssh is never taken as the host; sd_bus_open_system_remote's own check
         # of [USER@]HOST[:PORT] ends as a usage error too (before ssh runs).
         for args in (("-H", "-oProxyCommand=touch /tmp/caracara-pwned", "status"), ("--host=a@b@c", "status"),
-                     ("--host=", "status"), ("-Hhost:1:2", "kill"), ("-H",)):
+                     ("--host=", "status"), ("-Hhost:1:2", "kill"), ("-H",),
+                     # systemd's HOST:CONTAINER form is not taken: the port must be a port.
+                     ("-H", "pilot@host:notaport", "kill"), ("-H", "host:0", "status"),
+                     ("-H", "host:65536", "status"), ("-H", "user@[fd00::1]x", "status")):
             with self.subTest(args=args):
                 r = self.ctl(*args)
                 self.assertEqual(r.returncode, USAGE, r.stderr)

@@ -146,12 +146,13 @@ for f in /usr/lib/systemd/system/caracarad.service /usr/lib/systemd/system/carac
          /usr/share/dbus-1/system.d/org.caracara.Vehicle1.conf /usr/share/dbus-1/system.d/org.caracara.Simulator1.conf \
          /usr/lib/sysusers.d/caracara.conf /usr/lib/udev/rules.d/60-caracara.rules \
          /usr/lib/modules-load.d/caracara.conf "$dropin" /usr/share/caracara/caracarad.toml.example $conf_file \
-         /usr/sbin/caracarad /usr/bin/caracara-sim /usr/bin/caracaractl; do
+         /usr/sbin/caracarad /usr/bin/caracara-sim /usr/bin/caracaractl \
+         /usr/lib/systemd/system/caracara-bridge.service /usr/bin/caracara-bridge; do
   [ -e "$f" ] || { fail "$how: $f is missing"; missing=1; }
 done
 [ -n "${missing:-}" ] || pass "$how put the binaries, units, policies, rules${conf_file:+ and $conf_file} in place"
 # (--man=no: the container has no man-db to look the units' Documentation= pages up with.)
-verify=$(systemd-analyze verify --man=no caracarad.service caracara-sim.service 2>&1)
+verify=$(systemd-analyze verify --man=no caracarad.service caracara-sim.service caracara-bridge.service 2>&1)
 echo "$verify" | sed 's/^/  verify: /'
 check "systemd-analyze verify: no complaint about the units" bash -c '! grep -qi caracara <<<"$1"' _ "$verify"
 
@@ -366,6 +367,24 @@ check "pilot: GetDistance 0 answered" allowed pilot $V $VP/teensy $VT GetDistanc
 check "pilot: SetThrust accepted" allowed pilot $V $VP $V SetThrust ai 8 500 0 0 0 0 0 0 0
 check "pilot: Simulator1.ClearWireLog accepted (the simulator's policy)" allowed pilot $S $SP $S ClearWireLog
 
+# --- 7a. caracara-bridge: its unit, its socket for the group only (docs/foxglove.md) -----------------
+# A Foxglove client's first request on the socket: the WebSocket upgrade with the subprotocol.
+# In perl (perl-base is in every Debian root; the container has no python3).
+WS_UPGRADE='use IO::Socket::UNIX;
+my $s = IO::Socket::UNIX->new(Peer => "/run/caracara-bridge/bridge.sock") or die "connect: $!\n";
+print $s "GET / HTTP/1.1\r\nHost: localhost\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n" .
+         "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n" .
+         "Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n";
+my $head = "";
+while (my $line = <$s>) { last if $line eq "\r\n"; $head .= lc $line; }
+exit($head =~ m{^http/1.1 101} && $head =~ /sec-websocket-protocol: foxglove.websocket.v1/ ? 0 : 1);'
+check "systemctl start caracara-bridge (Type=notify: returns once it listens)" timeout 30 systemctl start caracara-bridge
+check "the bridge's socket is caracara:caracara, mode 0660" \
+  bash -c '[ "$(stat -c %U:%G:%a /run/caracara-bridge/bridge.sock)" = caracara:caracara:660 ]'
+check "pilot (group caracara): a Foxglove WebSocket upgrade on the socket answers 101" as pilot perl -e "$WS_UPGRADE"
+denied_socket() { local err; err=$(runuser -u tester -- perl -e "$WS_UPGRADE" 2>&1) && return 1; echo "$err" | grep -q "Permission denied"; }
+check "tester (not in the group): the socket refuses the connection (Permission denied)" denied_socket
+
 # --- 7b. the topside: caracaractl -H, busctl -H and a python3-dbus script over SSH (check-topside.sh)
 . "$(dirname "$0")/check-topside.sh"
 topside_checks
@@ -454,9 +473,9 @@ check "with the configuration fixed it starts again" timeout 60 systemctl start 
 check "and is ready once armed" arm
 
 # --- 12. exposure -----------------------------------------------------------------------------------------
-# The bound issue 11 set for both units (systemd-analyze security: 0.0 safest .. 10.0).
+# The bound issue 11 set for the units (systemd-analyze security: 0.0 safest .. 10.0).
 EXPOSURE_MAX=1.0
-for u in caracarad caracara-sim; do
+for u in caracarad caracara-sim caracara-bridge; do
   sec=$(systemd-analyze security --no-pager "$u.service" 2>&1)
   echo "$sec" | grep -E '^✗' | sed "s/^/  $u: /"
   overall=$(echo "$sec" | sed -n 's/.*Overall exposure level for .*: \([0-9.]*\) .*/\1/p')
@@ -472,8 +491,8 @@ if [ -d "$DEBS" ]; then
 fi
 
 # --- done -------------------------------------------------------------------------------------------------
-systemctl stop caracarad caracara-sim 2>/dev/null
-journalctl -b --no-pager -o short-monotonic -u caracarad -u caracara-sim -u dbus -u caracara-systest \
+systemctl stop caracara-bridge caracarad caracara-sim 2>/dev/null
+journalctl -b --no-pager -o short-monotonic -u caracarad -u caracara-sim -u caracara-bridge -u dbus -u caracara-systest \
   >"$out/journal.txt" 2>&1
 echo "== $(grep -c '^PASS' "$out/results.txt") passed, $(grep -c '^FAIL' "$out/results.txt") failed"
 touch "$out/done"

@@ -1,0 +1,112 @@
+// caracara-bridge's figures (bench/run.py phase "bridge"), with the reference client of
+// tests/bridge (its pinned npm packages). Prints one JSON object.
+//   latency: a property change to its message at a client: a client publishes /command/leds,
+//            the bridge calls SetLeds on the client's connection, caracarad announces Leds, the
+//            bridge sends /vehicle/state: from the publish to the message (an upper bound of
+//            the change-to-message time, the SetLeds call included)
+//   motion:  a motion published by a client to the simulator's wire, against SetMotion over
+//            D-Bus from a python3-dbus client, alternating in the same run
+//   load N S: N clients subscribed to every channel for S seconds (run.py reads the bridge's
+//            CPU and RSS meanwhile)
+import { spawn } from "node:child_process";
+import { createInterface } from "node:readline";
+import { BUS, DEFAULT_MT, MOTOR_MAX, X_AXIS, connect, poll, sleep, speedByte, wireLog, wireNext } from "../tests/bridge/lib.mjs";
+
+const url = process.env.CARACARA_WS_URL;
+const samples = Number(process.env.CARACARA_BENCH_SAMPLES ?? 200);
+const mode = process.argv[2];
+
+function stats(v) {
+  const s = [...v].sort((a, b) => a - b);
+  const pct = (q) => s[Math.min(Math.max(Math.ceil((q * s.length) / 100), 1), s.length) - 1];
+  return { n: s.length, min: s[0], p50: pct(50), p90: pct(90), p99: pct(99), max: s[s.length - 1] };
+}
+
+async function latency() {
+  const c = await connect(url);
+  c.subscribeAll();
+  await c.waitFor("/vehicle/state");
+  const leds = c.publisher("/command/leds");
+  const out = [];
+  let waiting = null;
+  c.client.on("message", ({ subscriptionId, data }) => {
+    if (!waiting || c.subs.get(subscriptionId)?.topic !== "/vehicle/state") return;
+    const m = JSON.parse(new TextDecoder().decode(data));
+    if (m.leds[0] === waiting.value) { waiting.resolve(process.hrtime.bigint()); waiting = null; }
+  });
+  for (let i = 0; i < samples; i++) {
+    const value = (i % 250) + 1;
+    const arrived = new Promise((resolve) => { waiting = { value, resolve }; });
+    const t0 = process.hrtime.bigint();
+    c.publish(leds, { red: value, green: 0, blue: 0 });
+    const t1 = await arrived;
+    out.push(Number(t1 - t0) / 1000);
+    await sleep(5 + Math.random() * 15);
+  }
+  await c.close();
+  return { leds_to_state_us: stats(out) };
+}
+
+// A python3-dbus client holding its own connection: each line "x" -> SetMotion(x, 0...), prints t0.
+const SETMOTION = `
+import sys, time, dbus
+bus = dbus.bus.BusConnection(sys.argv[1])
+v = bus.get_object("org.caracara.Vehicle1", "/org/caracara/Vehicle1", introspect=False)
+for line in sys.stdin:
+    x = float(line)
+    t0 = time.monotonic_ns()
+    v.SetMotion(x, 0.0, 0.0, 0.0, 0.0, 0.0, dbus_interface="org.caracara.Vehicle1")
+    print(t0, flush=True)
+`;
+
+async function motion() {
+  const c = await connect(url);
+  const pub = c.publisher("/command/motion");
+  const py = spawn("/usr/bin/python3", ["-c", SETMOTION, BUS], { stdio: ["pipe", "pipe", "inherit"] });
+  const lines = createInterface({ input: py.stdout })[Symbol.asyncIterator]();
+  const addr = DEFAULT_MT[2] >> 1; // motor 2 drives +x
+  const viaBridge = [], viaDbus = [];
+  for (let i = 0; i < samples; i++) {
+    // Even samples through the bridge, odd ones over D-Bus; each value differs from the one
+    // before, so the order that carries it is new on the wire (not the loop's refresh).
+    const value = [0.2, -0.2, 0.3, -0.3][i % 4];
+    const speed = speedByte(X_AXIS[2] * Math.round(value * MOTOR_MAX));
+    const since = wireNext();
+    let t0;
+    if (i % 2 === 0) {
+      t0 = process.hrtime.bigint();
+      c.publish(pub, { x: value });
+    } else {
+      py.stdin.write(`${value}\n`);
+      t0 = BigInt((await lines.next()).value);
+    }
+    const at = await poll(() => wireLog(since).find((e) => e.bus === "i2c" && !e.read && e.addr === addr &&
+                                                         e.data[0] === speed && e.time_ns > t0), 2000, "the order");
+    (i % 2 === 0 ? viaBridge : viaDbus).push(Number(at.time_ns - t0) / 1000);
+    await sleep(10 + Math.random() * 20);
+  }
+  py.stdin.end();
+  await c.close();
+  return { bridge_motion_to_wire_us: stats(viaBridge), dbus_setmotion_to_wire_us: stats(viaDbus) };
+}
+
+async function load(n, seconds) {
+  const clients = [];
+  for (let i = 0; i < n; i++) {
+    const c = await connect(url);
+    c.subscribeAll();
+    clients.push(c);
+  }
+  console.error("# loaded");
+  await sleep(seconds * 1000);
+  const counts = clients.map((c) => [...c.counts.values()].reduce((a, b) => a + b, 0));
+  for (const c of clients) await c.close();
+  return { clients: n, seconds, messages_per_client: counts };
+}
+
+let result;
+if (mode === "latency") result = await latency();
+else if (mode === "motion") result = await motion();
+else if (mode === "load") result = await load(Number(process.argv[3]), Number(process.argv[4]));
+else throw new Error("mode: latency | motion | load N SECONDS");
+console.log(JSON.stringify(result));

@@ -1,0 +1,216 @@
+// caracara-bridge against the Foxglove WebSocket protocol's reference client
+// (@foxglove/ws-protocol), through a real `ssh -L` forward of its Unix socket, judged on the
+// simulator's side (its inspection API and wire log). Run by test_bridge.py, which starts the
+// private bus, caracara-sim, caracarad, the bridge, a private sshd and the forward.
+import { test, after } from "node:test";
+import assert from "node:assert/strict";
+import net from "node:net";
+import WebSocket from "ws";
+import {
+  DEFAULT_MT, ERR, MOTORS, MOTOR_MAX, X_AXIS, ZERO, connect, hold, poll, simSpeeds, simThruster, sleep, speedByte,
+  URL, vget, wireLog, wireNext,
+} from "./lib.mjs";
+
+const TOPICS = ["/vehicle/state", "/vehicle/motors", ...[...Array(MOTORS).keys()].map((i) => `/thruster/${i}`),
+  "/teensy", "/i2c", "/events", "/tf"];
+
+const clients = [];
+async function client() {
+  const c = await connect();
+  clients.push(c);
+  c.subscribeAll();
+  return c;
+}
+after(async () => {
+  for (const c of clients) {
+    if (!c.closed) await c.close().catch(() => {});
+    assert.deepEqual(c.invalid, [], "messages that do not validate against their channel's schema");
+  }
+});
+
+// Holds a motion from a client: the bridge re-sends nothing by itself, the pilot does (as
+// Foxglove's publish panel does), well inside CommandTimeoutMs.
+function keepPublishing(c, id, msg, everyMs = 100) {
+  c.publish(id, msg);
+  const timer = setInterval(() => { if (!c.closed) c.publish(id, msg); }, everyMs);
+  return () => clearInterval(timer);
+}
+
+const xMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in X_AXIS ? speedByte(X_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
+
+test("serverInfo, the subprotocol, and every channel advertised with a JSON Schema", async () => {
+  const c = await client();
+  assert.equal(c.ws.protocol, "foxglove.websocket.v1");
+  assert.equal(c.serverInfo.name, "caracara-bridge");
+  assert.ok(c.serverInfo.capabilities.includes("clientPublish"));
+  assert.deepEqual([...c.channels.keys()].sort(), [...TOPICS].sort());
+  for (const ch of c.channels.values()) {
+    assert.equal(ch.encoding, "json");
+    assert.equal(ch.schemaEncoding, "jsonschema");
+    assert.equal(JSON.parse(ch.schema).type, "object", ch.topic);
+  }
+  assert.equal(c.channels.get("/events").schemaName, "foxglove.Log");
+  assert.equal(c.channels.get("/tf").schemaName, "foxglove.FrameTransform");
+  // Every channel but /events (nothing has happened yet) sends its current state at once.
+  for (const topic of TOPICS.filter((t) => t !== "/events")) await c.waitFor(topic);
+  const state = await c.waitFor("/vehicle/state");
+  assert.equal(state.state, vget("State"));
+});
+
+test("a thrust set over D-Bus shows on /vehicle/motors; thruster telemetry equals the simulator's", async () => {
+  const c = await client();
+  const values = [1000, -1000, 0, 0, 0, 0, 0, 500];
+  const p = hold("thrust", ...values, "--for", 20);
+  try {
+    await c.waitFor("/vehicle/motors", (m) => JSON.stringify(m.applied) === JSON.stringify(values) &&
+                                               JSON.stringify(m.requested) === JSON.stringify(values));
+    await poll(() => simSpeeds().every((s, i) => s === speedByte(values[i])), 10000, "the wire to carry the thrust");
+    for (let i = 0; i < MOTORS; i++) {
+      await poll(() => {
+        const t = c.latest.get(`/thruster/${i}`)?.msg;
+        return t && t.index === i && t.reachable && t.ordered_value === values[i] &&
+          speedByte(t.speed) === simThruster(i, "ActualSpeed") &&
+          Math.abs(t.temperature - simThruster(i, "Temperature")) < 1 &&
+          Math.abs(t.current - simThruster(i, "Current")) < 0.11;
+      }, 10000, `/thruster/${i} to equal the simulator's thruster`);
+    }
+  } finally {
+    p.kill("SIGTERM");
+  }
+  await poll(() => simSpeeds().every((s) => s === ZERO), 10000, "zero after the holder left");
+});
+
+test("a published motion reaches the wire as the mixing says; a closed client zeroes it within the client-loss bound", async () => {
+  const c = await client();
+  const id = c.publisher("/command/motion");
+  const stop = keepPublishing(c, id, { x: 0.2 });
+  try {
+    await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(0.2)), 10000, "the motion on the wire");
+    const state = await c.waitFor("/vehicle/state", (s) => s.controller !== "");
+    assert.ok(state.command_age_ms >= 0);
+  } finally {
+    stop();
+  }
+  const since = wireNext();
+  const closedAt = process.hrtime.bigint(); // CLOCK_MONOTONIC, as the wire log's times
+  await c.close();
+  const driven = new Set(Object.keys(X_AXIS).map((i) => DEFAULT_MT[i] >> 1)); // 7-bit addresses
+  const zeroTimes = await poll(() => {
+    const firstZero = new Map();
+    for (const e of wireLog(since))
+      if (e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] === ZERO && driven.has(e.addr) &&
+          !firstZero.has(e.addr))
+        firstZero.set(e.addr, e.time_ns);
+    return firstZero.size === driven.size ? [...firstZero.values()] : null;
+  }, 5000, "zero orders to the four motors it drove");
+  const worstMs = Number(zeroTimes.reduce((a, b) => (a > b ? a : b)) - closedAt) / 1e6;
+  console.log(`# close to the last zero order: ${worstMs.toFixed(1)} ms`);
+  assert.ok(worstMs <= 250, `zeroed ${worstMs} ms after the close (bound 250 ms, docs/topside.md)`);
+});
+
+test("kill from a client, a refused command as a status with the daemon's error name, events as foxglove.Log", async () => {
+  const c = await client();
+  const kill = c.publisher("/command/kill");
+  const clear = c.publisher("/command/clear_kill");
+  const motion = c.publisher("/command/motion");
+  c.publish(kill, {});
+  await c.waitFor("/vehicle/state", (s) => s.state === "killed" && s.kill_source === "dbus");
+  await c.waitFor("/events", (l) => l.name === "kill" && l.level === 3);
+  c.publish(motion, { y: 0.1 });
+  const refused = await c.waitStatus((s) => s.level === 2 && s.message.includes(ERR + "Killed"));
+  assert.match(refused.message, /\/command\/motion/);
+  assert.equal(vget("State"), "killed");
+  c.publish(clear, {});
+  await c.waitFor("/events", (l) => l.name === "arming");
+  await c.waitFor("/vehicle/state", (s) => s.state === "ready", 20000);
+  const leds = c.publisher("/command/leds");
+  c.publish(leds, { red: 1, green: 2, blue: 3 });
+  await poll(() => JSON.stringify(vget("Leds")) === "[1,2,3]", 5000, "the LEDs");
+  await c.waitFor("/vehicle/state", (s) => JSON.stringify(s.leds) === "[1,2,3]");
+  const profile = c.publisher("/command/profile");
+  c.publish(profile, { name: "no-such-profile" });
+  await c.waitStatus((s) => s.message.includes(ERR + "UnknownProfile"));
+});
+
+test("a second client keeps its own pilot rules", async () => {
+  const a = await client();
+  const b = await client();
+  const stopA = keepPublishing(a, a.publisher("/command/motion"), { x: 0.2 });
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(0.2)), 10000, "A's motion");
+  const controllerA = (await a.waitFor("/vehicle/state", (s) => s.controller !== "")).controller;
+  stopA();
+  const stopB = keepPublishing(b, b.publisher("/command/motion"), { x: -0.2 });
+  try {
+    await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(-0.2)), 10000, "B's motion");
+    const controllerB = (await b.waitFor("/vehicle/state", (s) => s.controller !== "" && s.controller !== controllerA)).controller;
+    assert.notEqual(controllerA, controllerB, "each client has its own connection to caracarad");
+    // A leaves: it no longer commands, so B's thrust stays.
+    await a.close();
+    await sleep(700); // past CommandTimeoutMs: B's re-sends keep it alive
+    assert.deepEqual(simSpeeds(), xMotion(-0.2));
+  } finally {
+    stopB();
+  }
+  await b.close();
+  await poll(() => simSpeeds().every((s) => s === ZERO), 2000, "zero once B left");
+});
+
+test("bad input: a status error or a close, never a crash, never a command", async () => {
+  const since = wireNext();
+  const c = await client();
+  const raw = c.ws;
+  const errors = () => c.statuses.filter((s) => s.level === 2).length;
+  let n = errors();
+  for (const frame of ["not json", "[]", "{}", '{"op":42}', '{"op":"nope"}', '{"op":"subscribe"}',
+                       '{"op":"subscribe","subscriptions":[{"id":1,"channelId":9999}]}',
+                       '{"op":"advertise","channels":[{"id":7,"topic":"/etc/passwd","encoding":"json"}]}',
+                       '{"op":"unsubscribe","subscriptionIds":["x"]}']) {
+    raw.send(frame);
+    await poll(() => errors() > n, 5000, `a status error for ${frame}`);
+    n = errors();
+  }
+  for (const frame of [Buffer.from([1]), Buffer.from([9, 0, 0, 0, 0]), Buffer.from([1, 99, 0, 0, 0, 123])]) {
+    raw.send(frame);
+    await poll(() => errors() > n, 5000, "a status error for a bad binary frame");
+    n = errors();
+  }
+  // A command with a body that is not its JSON: refused by the bridge, nothing sent.
+  const thrust = c.publisher("/command/thrust");
+  c.publish(thrust, { values: [8850, 8850] });
+  await poll(() => errors() > n, 5000, "a status error for a short thrust");
+  // A subscription flood: past the limit each is refused.
+  const flood = [];
+  for (let i = 0; i < 400; i++) flood.push({ id: 100000 + i, channelId: 1 });
+  raw.send(JSON.stringify({ op: "subscribe", subscriptions: flood }));
+  await c.waitStatus((s) => s.message.includes("more than 256 subscriptions"));
+  // Oversized: closed.
+  raw.send("x".repeat(200 * 1024));
+  await poll(() => c.closed, 5000, "the close of an oversized message");
+  // Nothing was commanded, and the bridge still serves.
+  const orders = wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3);
+  assert.deepEqual([...new Set(orders.map((e) => e.data[0]))].filter((s) => s !== ZERO), []);
+  const d = await client();
+  await d.waitFor("/vehicle/state");
+  // Malformed WebSocket framing (an unmasked client frame), and no HTTP at all: closed.
+  const where = new globalThis.URL(URL);
+  const rawSocket = async (request, then) => {
+    const sock = net.connect(Number(where.port), where.hostname);
+    let got = "";
+    sock.on("data", (d) => { got += d.toString("latin1"); });
+    const closed = new Promise((resolve) => sock.on("close", resolve));
+    sock.write(request);
+    if (then) {
+      await poll(() => got.includes("\r\n\r\n"), 5000, "the upgrade's answer");
+      assert.match(got, /^HTTP\/1\.1 101/);
+      sock.write(then);
+    }
+    await Promise.race([closed, sleep(5000).then(() => { throw new Error("not closed"); })]);
+  };
+  await rawSocket("GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n" +
+                  "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n" +
+                  "Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n", Buffer.from([0x81, 0x05, 104, 101, 108, 108, 111]));
+  await rawSocket("\x00\x01garbage that is no HTTP\r\n\r\n");
+  // Not the protocol at all: refused at the upgrade.
+  const plain = new WebSocket(URL, ["not-foxglove"]);
+  await new Promise((resolve) => { plain.on("error", resolve); plain.on("unexpected-response", resolve); });
+});

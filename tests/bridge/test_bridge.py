@@ -1,0 +1,275 @@
+"""caracara-bridge end to end: a private bus, caracara-sim, caracarad (tests/e2e/harness.py), the
+bridge on a Unix socket, a private sshd and a real `ssh -L PORT:SOCKET` forward, then the
+reference client's tests (bridge.test.mjs, node --test) through it; the socket's group rule;
+and a recorded dive exported to MCAP and read back by the reference reader (mcap_check.mjs).
+
+The npm packages are pinned in package-lock.json and installed with `npm ci`, cached under
+/var/cache/caracara-npm. Under CI (CI=true) a missing node, npm or sshd fails the test.
+"""
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
+sys.path.insert(0, os.path.join(SOURCE, "bench"))
+
+import harness  # noqa: E402
+from harness import BUILD_DIR, Rig, poll  # noqa: E402
+from ssh_bridge import free_port, private_sshd  # noqa: E402
+
+NPM_CACHE = "/var/cache/caracara-npm"
+CI = os.environ.get("CI") == "true"
+
+
+def missing(what):
+    """Fails under CI, skips elsewhere."""
+    if CI:
+        raise AssertionError("cannot run under CI: " + what)
+    raise unittest.SkipTest(what)
+
+
+def npm_ci():
+    """node_modules as package-lock.json pins them (once per lock)."""
+    if not shutil.which("node") or not shutil.which("npm"):
+        missing("node and npm are needed (scripts/deps.sh)")
+    stamp = os.path.join(HERE, "node_modules", ".package-lock.json")
+    lock = os.path.join(HERE, "package-lock.json")
+    if os.path.exists(stamp) and os.path.getmtime(stamp) >= os.path.getmtime(lock):
+        return
+    subprocess.run(["npm", "ci", "--cache", NPM_CACHE, "--no-audit", "--no-fund", "--prefer-offline"], cwd=HERE,
+                   check=True, stdout=subprocess.DEVNULL)
+
+
+class Sshd:
+    """The private sshd of bench/ssh_bridge.py (127.0.0.1, keys made for the run, no PAM, a
+    mount namespace of its own); ssh -L forwards a local port to the bridge's socket through it."""
+
+    def __init__(self, d):
+        self.dir = d
+        self.port = free_port()
+        argv, env = private_sshd(d, self.port, lambda m: print(m, file=sys.stderr))
+        self.log = open(os.path.join(d, "sshd.log"), "ab")
+        self.proc = subprocess.Popen(argv, stdout=self.log, stderr=subprocess.STDOUT, env={**os.environ, **env})
+        poll(self.listening, 10, message="the private sshd to listen")
+
+    def listening(self):
+        if self.proc.poll() is not None:
+            raise AssertionError("sshd exited; see %s/sshd.log" % self.dir)
+        try:
+            with socket.create_connection(("127.0.0.1", self.port), timeout=0.5):
+                return True
+        except OSError:
+            return False
+
+    def forward(self, local_port, socket_path):
+        """ssh -N -L local_port:socket_path, as caracaractl bridge runs it."""
+        argv = ["ssh", "-N", "-o", "ExitOnForwardFailure=yes", "-o", "BatchMode=yes", "-o", "StrictHostKeyChecking=no",
+                "-o", "UserKnownHostsFile=/dev/null", "-o", "LogLevel=ERROR", "-i", os.path.join(self.dir, "client_key"),
+                "-p", str(self.port), "-L", f"127.0.0.1:{local_port}:{socket_path}", "root@127.0.0.1"]
+        return subprocess.Popen(argv, stdin=subprocess.DEVNULL, stderr=self.log)
+
+    def stop(self):
+        self.proc.terminate()
+        self.proc.wait(10)
+        self.log.close()
+
+
+def connect_as(path, *setpriv):
+    """Connects to a Unix socket as another user; the errno name or 'ok'."""
+    code = ("import socket,sys\ns=socket.socket(socket.AF_UNIX)\n"
+            "try:\n s.connect(sys.argv[1]); print('ok')\nexcept OSError as e:\n import errno; print(errno.errorcode[e.errno])")
+    r = subprocess.run(["setpriv", *setpriv, "/usr/bin/python3", "-c", code, path], capture_output=True, text=True,
+                       timeout=30)
+    return r.stdout.strip() or r.stderr.strip()
+
+
+class BridgeTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        npm_ci()
+        if not os.access(os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge"), os.X_OK):
+            raise AssertionError("caracara-bridge is not built in %s" % BUILD_DIR)
+        if not shutil.which("ssh") or not shutil.which("ssh-keygen"):
+            missing("the OpenSSH client is needed")
+        cls.rig = Rig(control={"arming_delay_ms": 300})
+        cls.procs = []
+        cls.sshd = None
+        try:
+            cls.rig.start()
+            cls.rig.arm()
+            # The socket's directory is open to all (0755): only the socket's own mode decides.
+            cls.sockdir = tempfile.mkdtemp(prefix="caracara-bridge-")
+            os.chmod(cls.sockdir, 0o755)
+            cls.socket = os.path.join(cls.sockdir, "bridge.sock")
+            cls.bridge_log = open(os.path.join(cls.rig.dir, "caracara-bridge.log"), "ab")
+            cls.bridge = subprocess.Popen(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge"),
+                                           "--listen", "unix:" + cls.socket, "--bus-address", cls.rig.address],
+                                          stdout=cls.bridge_log, stderr=subprocess.STDOUT)
+            cls.procs.append(cls.bridge)
+            poll(lambda: os.path.exists(cls.socket) or cls.bridge.poll() is not None, 10, message="the bridge's socket")
+            if cls.bridge.poll() is not None:
+                raise AssertionError("caracara-bridge exited: " + cls.bridge_output())
+            cls.sshd = Sshd(tempfile.mkdtemp(prefix="caracara-bridge-sshd-"))
+            cls.port = free_port()
+            cls.procs.append(cls.sshd.forward(cls.port, cls.socket))
+            poll(cls.forwarding, 15, message="the ssh -L forward")
+        except BaseException:
+            cls.tearDownClass()
+            raise
+
+    @classmethod
+    def bridge_output(cls):
+        with open(os.path.join(cls.rig.dir, "caracara-bridge.log"), errors="replace") as f:
+            return f.read()[-3000:]
+
+    @classmethod
+    def forwarding(cls):
+        return cls.listening(cls.port)
+
+    @classmethod
+    def tearDownClass(cls):
+        for p in reversed(cls.procs):
+            p.terminate()
+            try:
+                p.wait(10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+        if cls.sshd:
+            cls.sshd.stop()
+        cls.rig.stop()
+
+    def node(self, script, **env):
+        r = subprocess.run(["node", "--test", "--test-reporter=spec", script], cwd=HERE, capture_output=True, text=True,
+                           timeout=300, env={**os.environ, "CARACARA_BUILD_DIR": BUILD_DIR,
+                                             "CARACARA_BUS_ADDRESS": self.rig.address, **env})
+        print(r.stdout, r.stderr, sep="\n", file=sys.stderr)
+        self.assertEqual(r.returncode, 0, "node --test %s failed" % script)
+        return r.stdout
+
+    def test_1_reference_client_through_ssh_forward(self):
+        self.node("bridge.test.mjs", CARACARA_WS_URL="ws://127.0.0.1:%d" % self.port)
+        self.assertIsNone(self.bridge.poll(), "the bridge survived every test")
+
+    def test_2_caracaractl_bridge_forwards_and_prints_the_address(self):
+        cfg = os.path.join(self.sshd.dir, "ssh_config")
+        with open(cfg, "w") as f:
+            f.write(f"Host vehicle\n  HostName 127.0.0.1\n  Port {self.sshd.port}\n  User root\n"
+                    f"  IdentityFile {self.sshd.dir}/client_key\n  IdentitiesOnly yes\n  UserKnownHostsFile /dev/null\n"
+                    "  StrictHostKeyChecking no\n  BatchMode yes\n  LogLevel ERROR\n")
+        port = free_port()
+        p = subprocess.Popen(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "caracaractl"), "-H", "vehicle",
+                              "bridge", "--port", str(port), "--socket", self.socket, "--ssh-config", cfg],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            self.assertEqual(p.stdout.readline().strip(), "ws://localhost:%d" % port)
+            # A WebSocket upgrade with the Foxglove subprotocol through the forward.
+            with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+                s.sendall(b"GET / HTTP/1.1\r\nHost: localhost\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                          b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+                          b"Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n")
+                head = s.recv(4096).decode(errors="replace")
+            self.assertIn("101", head.splitlines()[0])
+            self.assertIn("sec-websocket-protocol: foxglove.websocket.v1", head.lower())
+        finally:
+            p.send_signal(2)
+            code = p.wait(15)
+            err = p.stderr.read()
+            p.stdout.close()
+            p.stderr.close()
+            self.assertEqual(code, 0, err)
+
+    def test_2_socket_is_for_the_group_only(self):
+        st = os.stat(self.socket)
+        self.assertEqual(st.st_mode & 0o777, 0o660)
+        self.assertEqual(connect_as(self.socket, "--reuid=nobody", "--regid=nogroup", "--clear-groups"), "EACCES")
+        # The same user in the socket's group gets in.
+        self.assertEqual(connect_as(self.socket, "--reuid=nobody", "--regid=nogroup", "--groups=%d" % st.st_gid), "ok")
+
+    def test_4_a_restarted_daemon_is_followed(self):
+        # The bridge keeps its socket; the new daemon's objects are loaded again (it starts killed).
+        self.rig.stop_daemon()
+        self.rig.start_daemon()
+        script = ("import { connect } from './lib.mjs';"
+                  "const c = await connect(process.env.CARACARA_WS_URL); c.subscribeAll();"
+                  "const s = await c.waitFor('/vehicle/state', (m) => m.state === 'killed' && m.kill_source === 'start');"
+                  "await c.close(); console.log(JSON.stringify(s));")
+        r = subprocess.run(["node", "--input-type=module", "-e", script], cwd=HERE, capture_output=True, text=True,
+                           timeout=60, env={**os.environ, "CARACARA_WS_URL": "ws://127.0.0.1:%d" % self.port})
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIsNone(self.bridge.poll())
+
+    def test_3_dive_exported_to_mcap_reads_back(self):
+        # test_1 armed and killed: the first dive of the rig is closed by that kill.
+        self.rig.vcall("Kill")
+        dives = sorted(f for f in os.listdir(self.rig.dives_dir) if f.endswith(".cdive"))
+        self.assertTrue(dives, "no dive recorded")
+        dive = os.path.join(self.rig.dives_dir, dives[0])
+        out = os.path.join(self.rig.dir, "dive.mcap")
+        ctl = [os.path.join(BUILD_DIR, "tools", "caracaractl")]
+        r = subprocess.run(ctl + ["export", dive, "--format", "mcap", "--out", out], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        samples = subprocess.run(ctl + ["export", dive], capture_output=True, text=True, check=True).stdout
+        events = subprocess.run(ctl + ["export", dive, "--events"], capture_output=True, text=True, check=True).stdout
+        n_samples = len(samples.strip().splitlines()) - 1
+        n_events = len(events.strip().splitlines()) - 1
+        self.assertGreater(n_samples, 0)
+        self.node("mcap_check.mjs", CARACARA_MCAP=out, CARACARA_SAMPLES=str(n_samples), CARACARA_EVENTS=str(n_events))
+
+    def test_5_tcp_needs_its_token(self):
+        exe = harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge")]
+        port = free_port()
+        token_file = os.path.join(self.rig.dir, "token")
+        with open(token_file, "w") as f:
+            f.write("short\n")
+        for args in ([], ["--token-file", token_file]):  # no token; a token under 16 characters
+            r = subprocess.run(exe + ["--listen", "tcp:127.0.0.1:%d" % port, "--bus-address", self.rig.address] + args,
+                               capture_output=True, text=True, timeout=30)
+            self.assertEqual(r.returncode, 2, r.stderr)
+        token = "0123456789abcdef0123456789abcdef"
+        with open(token_file, "w") as f:
+            f.write(token + "\n")
+        p = subprocess.Popen(exe + ["--listen", "tcp:127.0.0.1:%d" % port, "--token-file", token_file,
+                                    "--bus-address", self.rig.address], stderr=subprocess.DEVNULL)
+        try:
+            poll(lambda: self.listening(port), 10, message="the TCP listener")
+
+            def status(target, header=b""):
+                with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+                    s.sendall(b"GET " + target + b" HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\n"
+                              b"Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                              b"Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: foxglove.websocket.v1\r\n" +
+                              header + b"\r\n")
+                    return s.recv(4096).split(b"\r\n")[0].decode()
+            self.assertIn("401", status(b"/"))
+            self.assertIn("401", status(b"/?token=" + token[:-1].encode() + b"x"))
+            self.assertIn("401", status(b"/?token=" + token.encode() + b"0"))
+            self.assertIn("101", status(b"/?token=" + token.encode()))
+            self.assertIn("101", status(b"/", b"Authorization: Bearer " + token.encode() + b"\r\n"))
+        finally:
+            p.terminate()
+            self.assertEqual(p.wait(20), 0)
+
+    @staticmethod
+    def listening(port):
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=0.5):
+                return True
+        except OSError:
+            return False
+
+    def test_9_bridge_stops_cleanly(self):
+        # SIGTERM: exit status 0, its socket removed (under ASan: no leak, which would make it non-zero).
+        self.bridge.terminate()
+        self.assertEqual(self.bridge.wait(20), 0, "caracara-bridge: " + self.bridge_output())
+        self.assertFalse(os.path.exists(self.socket))
+
+
+if __name__ == "__main__":
+    unittest.main()

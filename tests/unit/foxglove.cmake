@@ -1,0 +1,2 @@
+# The MCAP writer, the Foxglove channel catalogue, the bridge's client protocol and send queue (tools/foxglove, tools/bridge).
+caracara_unit_test(test_foxglove SOURCES unit/test_mcap_writer.cpp unit/test_send_queue.cpp LIBS caracara_foxglove caracara_bridge_protocol)

@@ -1,0 +1,219 @@
+// The MCAP writer (tools/foxglove/mcap_writer.hpp), read back by a reader written here from the
+// MCAP specification: the layout (magic, header, data section, Data End, summary, Summary
+// Offsets, footer, magic), every CRC, the statistics, and that every index points where it
+// says. The reference reader (@mcap/core) judges real exports in e2e_bridge. Also the channel
+// catalogue shared with the bridge: every message's JSON has exactly its schema's fields.
+#include "core/crc32.hpp"
+#include "tests/catch.hpp"
+#include "tools/bridge/client_protocol.hpp"
+#include "tools/foxglove/channels.hpp"
+#include "tools/foxglove/mcap_writer.hpp"
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+using caracara::foxglove::McapWriter;
+namespace fg = caracara::foxglove;
+
+namespace {
+
+struct Record {
+    uint8_t op;
+    std::size_t at;       // offset of the opcode
+    std::size_t body;     // offset of the content
+    uint64_t length;
+};
+
+struct Reader {
+    const std::vector<uint8_t>& b;
+    uint64_t u(std::size_t at, int n) const {
+        uint64_t v = 0;
+        for (int i = 0; i < n; ++i)
+            v |= uint64_t{b.at(at + static_cast<std::size_t>(i))} << (8 * i);
+        return v;
+    }
+    Record record(std::size_t at) const { return {b.at(at), at, at + 9, u(at + 1, 8)}; }
+    std::string str(std::size_t& at) const {
+        const auto n = static_cast<std::size_t>(u(at, 4));
+        std::string s(b.begin() + static_cast<long>(at + 4), b.begin() + static_cast<long>(at + 4 + n));
+        at += 4 + n;
+        return s;
+    }
+};
+
+const std::vector<uint8_t> kMagic = {0x89, 'M', 'C', 'A', 'P', 0x30, '\r', '\n'};
+
+uint32_t crc(const std::vector<uint8_t>& b, std::size_t from, std::size_t to) {
+    return caracara::crc32(std::span<const uint8_t>(b.data() + from, to - from));
+}
+
+} // namespace
+
+TEST_CASE("an MCAP file: layout, CRCs, statistics and indexes as the specification has them", "[mcap]") {
+    McapWriter w("", "test", 200); // small chunks: several of them
+    const uint16_t s = w.add_schema("caracara.Motors", "jsonschema", R"({"type":"object"})");
+    const uint16_t a = w.add_channel(s, "/a", "json");
+    const uint16_t c = w.add_channel(s, "/b", "json");
+    CHECK(s == 1);
+    CHECK(a == 1);
+    CHECK(c == 2);
+    for (uint64_t t = 0; t < 40; ++t)
+        w.add_message(t % 3 ? a : c, 1000 + t, 1000 + t, R"({"applied":[1,2,3]})");
+    CHECK(w.message_count() == 40);
+    const std::vector<uint8_t> f = w.finish();
+    const Reader r{f};
+
+    REQUIRE(f.size() > 2 * kMagic.size());
+    CHECK(std::vector<uint8_t>(f.begin(), f.begin() + 8) == kMagic);
+    CHECK(std::vector<uint8_t>(f.end() - 8, f.end()) == kMagic);
+
+    // The footer: opcode 0x02, 20 bytes of content, right before the closing magic.
+    const std::size_t footer = f.size() - 8 - 29;
+    const Record fr = r.record(footer);
+    REQUIRE(fr.op == 0x02);
+    REQUIRE(fr.length == 20);
+    const std::size_t summary_start = r.u(fr.body, 8), offsets_start = r.u(fr.body + 8, 8);
+    CHECK(r.u(fr.body + 16, 4) == crc(f, summary_start, footer + 9 + 16));
+
+    // The data section: header first, records end to end up to Data End, whose CRC covers all before it.
+    std::size_t at = 8;
+    Record hr = r.record(at);
+    CHECK(hr.op == 0x01);
+    std::size_t chunks = 0;
+    std::map<std::size_t, Record> by_offset;
+    while (true) {
+        const Record rec = r.record(at);
+        by_offset[at] = rec;
+        if (rec.op == 0x0F) {
+            CHECK(r.u(rec.body, 4) == crc(f, 0, at));
+            at = rec.body + rec.length;
+            break;
+        }
+        if (rec.op == 0x06) {
+            ++chunks;
+            // Chunk: start, end, uncompressed size, CRC of the records, compression "", records.
+            std::size_t p = rec.body + 28;
+            CHECK(r.str(p).empty());
+            const uint64_t size = r.u(p, 8);
+            CHECK(size == r.u(rec.body + 16, 8));
+            CHECK(r.u(rec.body + 24, 4) == crc(f, p + 8, p + 8 + size));
+        }
+        at = rec.body + rec.length;
+        REQUIRE(at < f.size());
+    }
+    CHECK(chunks > 1);
+    CHECK(at == summary_start);
+
+    // The summary: groups of Schema, Channel, Statistics, Chunk Index, each named by a Summary Offset.
+    std::map<uint8_t, std::pair<uint64_t, uint64_t>> groups;
+    for (std::size_t p = offsets_start; p < footer;) {
+        const Record rec = r.record(p);
+        REQUIRE(rec.op == 0x0E);
+        groups[f[rec.body]] = {r.u(rec.body + 1, 8), r.u(rec.body + 9, 8)};
+        p = rec.body + rec.length;
+    }
+    CHECK(groups.size() == 4);
+    for (const auto& [op, g] : groups)
+        CHECK(r.record(g.first).op == op);
+    const Record stats = r.record(groups.at(0x0B).first);
+    CHECK(r.u(stats.body, 8) == 40);           // messages
+    CHECK(r.u(stats.body + 8, 2) == 1);        // schemas
+    CHECK(r.u(stats.body + 10, 4) == 2);       // channels
+    CHECK(r.u(stats.body + 22, 4) == chunks);  // chunks
+    CHECK(r.u(stats.body + 26, 8) == 1000);    // first time
+    CHECK(r.u(stats.body + 34, 8) == 1039);    // last time
+
+    // Every chunk index points at its chunk, and each message index entry at a message of its channel.
+    std::size_t indexed = 0;
+    for (std::size_t p = groups.at(0x08).first; p < groups.at(0x08).first + groups.at(0x08).second;) {
+        const Record ci = r.record(p);
+        REQUIRE(ci.op == 0x08);
+        const std::size_t chunk_at = r.u(ci.body + 16, 8);
+        const Record chunk = r.record(chunk_at);
+        REQUIRE(chunk.op == 0x06);
+        CHECK(r.u(ci.body + 24, 8) == 9 + chunk.length);
+        const std::size_t records = chunk.body + 28 + 4 + 8; // after the empty compression string and size
+        const std::size_t map_bytes = r.u(ci.body + 32, 4);
+        for (std::size_t m = ci.body + 36; m < ci.body + 36 + map_bytes; m += 10) {
+            const auto channel = static_cast<uint16_t>(r.u(m, 2));
+            const Record mi = r.record(r.u(m + 2, 8));
+            REQUIRE(mi.op == 0x07);
+            CHECK(r.u(mi.body, 2) == channel);
+            const std::size_t entries = r.u(mi.body + 2, 4) / 16;
+            for (std::size_t e = 0; e < entries; ++e) {
+                const Record msg = r.record(records + r.u(mi.body + 6 + e * 16 + 8, 8));
+                REQUIRE(msg.op == 0x05);
+                CHECK(r.u(msg.body, 2) == channel);
+                CHECK(r.u(msg.body + 6, 8) == r.u(mi.body + 6 + e * 16, 8)); // the log time
+                ++indexed;
+            }
+        }
+        p = ci.body + ci.length;
+    }
+    CHECK(indexed == 40);
+}
+
+TEST_CASE("an MCAP file without messages is still whole", "[mcap]") {
+    McapWriter w("", "test");
+    w.add_channel(w.add_schema("x", "jsonschema", "{}"), "/x", "json");
+    const std::vector<uint8_t> f = w.finish();
+    CHECK(std::vector<uint8_t>(f.end() - 8, f.end()) == kMagic);
+}
+
+TEST_CASE("every channel's message has exactly its schema's fields", "[foxglove]") {
+    std::map<fg::ChannelKind, std::string> sample = {
+        {fg::ChannelKind::VehicleState, fg::to_json(fg::VehicleState{})},
+        {fg::ChannelKind::Motors, fg::to_json(fg::Motors{})},
+        {fg::ChannelKind::Thruster, fg::to_json(fg::Thruster{})},
+        {fg::ChannelKind::Teensy, fg::to_json(fg::Teensy{})},
+        {fg::ChannelKind::I2cBus, fg::to_json(fg::I2cBus{})},
+        {fg::ChannelKind::Events, fg::to_json(fg::LogEvent{})},
+        {fg::ChannelKind::Attitude, fg::attitude_json(0, 0, 0, 0)},
+    };
+    CHECK(fg::channels().size() == 14);
+    for (const fg::ChannelInfo& c : fg::channels()) {
+        const auto schema = nlohmann::json::parse(c.schema);
+        const auto msg = nlohmann::json::parse(sample.at(c.kind));
+        std::vector<std::string> fields, required;
+        for (const auto& [k, _] : msg.items())
+            fields.push_back(k);
+        for (const auto& k : schema["required"])
+            required.push_back(k);
+        std::sort(required.begin(), required.end());
+        INFO(c.topic);
+        CHECK(fields == required);
+    }
+}
+
+TEST_CASE("the attitude quaternion: identity at rest, yaw clockwise from above is a turn about -z", "[foxglove]") {
+    const auto rest = nlohmann::json::parse(fg::attitude_json(0, 0, 0, 0))["rotation"];
+    CHECK(rest["w"].get<double>() == Approx(1.0));
+    const auto yaw = nlohmann::json::parse(fg::attitude_json(0, 3.14159265358979 / 2, 0, 0))["rotation"];
+    CHECK(yaw["z"].get<double>() == Approx(-0.70710678).margin(1e-6));
+    CHECK(yaw["w"].get<double>() == Approx(0.70710678).margin(1e-6));
+}
+
+TEST_CASE("the bridge's client protocol: commands only from advertised command topics, errors named", "[bridge]") {
+    using caracara::bridge::ClientProtocol;
+    ClientProtocol p(fg::channels().size());
+    auto binary = [](uint32_t id, std::string body) {
+        std::vector<uint8_t> b = {1, uint8_t(id), uint8_t(id >> 8), uint8_t(id >> 16), uint8_t(id >> 24)};
+        b.insert(b.end(), body.begin(), body.end());
+        return b;
+    };
+    CHECK_FALSE(p.on_binary(binary(5, R"({"x":0.5})")).command); // not advertised
+    CHECK(p.on_text(R"({"op":"advertise","channels":[{"id":5,"topic":"/command/motion","encoding":"json"}]})").replies.empty());
+    const auto o = p.on_binary(binary(5, R"({"x":0.5,"yaw":-1})"));
+    REQUIRE(o.command);
+    CHECK(o.command->axes[0] == 0.5);
+    CHECK(o.command->axes[3] == -1);
+    CHECK_FALSE(p.on_binary(binary(5, R"({"x":"fast"})")).command);
+    CHECK_FALSE(p.on_binary(binary(5, "{")).command);
+    CHECK(p.on_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":1},{"id":1,"channelId":2}]})").replies.size() == 1);
+    CHECK(p.subscribers(1) == std::vector<uint32_t>{1});
+    CHECK(p.on_text(R"({"op":"unsubscribe","subscriptionIds":[1]})").replies.empty());
+    CHECK(p.subscribers(1).empty());
+    CHECK(p.on_text(R"({"op":"getParameters"})").replies.size() == 1);
+}

@@ -1,0 +1,41 @@
+// One pilot's own connection to caracarad: each WebSocket client gets one, so the daemon's
+// per-client rules hold per pilot (its thrust goes to zero when this connection closes; the
+// command timeout runs per client). Commands are sent asynchronously and in order; a refusal
+// comes back with the daemon's error name.
+#pragma once
+
+#include "drivers/sdbus/sdbus.hpp"
+#include "tools/bridge/bus_watch.hpp"
+#include "tools/bridge/command.hpp"
+
+#include <boost/asio/io_context.hpp>
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace caracara::bridge {
+
+class CommandLink {
+public:
+    // on_refused(command topic, D-Bus error name, message); on_lost: the connection closed.
+    using Refused = std::function<void(std::string_view topic, const std::string& name, const std::string& message)>;
+
+    // Connects at once; throws std::runtime_error when the bus cannot be reached.
+    CommandLink(boost::asio::io_context& io, const caracara::dbus::BusChoice& bus, Refused on_refused,
+                std::function<void()> on_lost);
+    ~CommandLink();
+
+    void send(const Command& c);
+    // The connection's unique bus name (the daemon's Controller when this client commands).
+    std::string unique_name() const;
+
+private:
+    struct Pending;
+    static int on_reply(sd_bus_message* m, void* userdata, sd_bus_error* error);
+
+    caracara::dbus::BusPtr bus_;
+    std::unique_ptr<BusWatch> watch_;
+    Refused on_refused_;
+};
+
+} // namespace caracara::bridge

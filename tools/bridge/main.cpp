@@ -1,0 +1,113 @@
+// caracara-bridge: the vehicle live in Foxglove. Serves the Foxglove WebSocket protocol v1 on
+// a Unix socket (default /run/caracara-bridge/bridge.sock, reached with ssh -L) or, when asked,
+// on TCP with a token; a client of caracarad's D-Bus API and of nothing else (docs/foxglove.md).
+#include "tools/bridge/bridge_server.hpp"
+
+#include <boost/asio/signal_set.hpp>
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <systemd/sd-daemon.h>
+
+namespace {
+
+constexpr const char* kDefaultSocket = "/run/caracara-bridge/bridge.sock";
+
+void help() {
+    std::cout << "caracara-bridge [OPTIONS...]\n\n"
+                 "Serve caracarad (org.caracara.Vehicle1) to Foxglove: the Foxglove WebSocket protocol v1\n"
+                 "(foxglove.websocket.v1), channels and commands as docs/foxglove.md lists them.\n\n"
+                 "  --listen unix:PATH         Listen on a Unix socket, mode 0660 (default " << kDefaultSocket << ")\n"
+                 "  --listen tcp:ADDRESS:PORT  Listen on TCP instead; needs --token-file (docs/topside.md)\n"
+                 "  --token-file FILE          The token every TCP client must bring (?token= or\n"
+                 "                             Authorization: Bearer)\n"
+                 "  --max-clients N            Clients at once (default 16)\n"
+                 "  --system | --user | --bus-address ADDR   The bus caracarad is on (default: system)\n"
+                 "  -h --help                  Show this help\n";
+}
+
+int usage(const std::string& m) {
+    std::cerr << "caracara-bridge: " << m << "\nTry 'caracara-bridge --help'.\n";
+    return 2;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    caracara::bridge::ListenConfig listen{kDefaultSocket, "", 0, 16};
+    caracara::bridge::SessionConfig session;
+    std::string token_file;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+        if (a == "-h" || a == "--help") {
+            help();
+            return 0;
+        } else if (a == "--listen") {
+            const std::string l = value();
+            if (l.starts_with("unix:") && l.size() > 5) {
+                listen.unix_path = l.substr(5);
+            } else if (l.starts_with("tcp:") && l.rfind(':') > 4) {
+                const auto colon = l.rfind(':');
+                listen.unix_path.clear();
+                listen.tcp_host = l.substr(4, colon - 4);
+                const std::string port = l.substr(colon + 1);
+                const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), listen.tcp_port);
+                if (ec != std::errc() || end != port.data() + port.size() || listen.tcp_port == 0)
+                    return usage("bad TCP port in '" + l + "'");
+            } else {
+                return usage("--listen takes unix:PATH or tcp:ADDRESS:PORT, not '" + l + "'");
+            }
+        } else if (a == "--token-file") {
+            token_file = value();
+        } else if (a == "--max-clients") {
+            const std::string n = value();
+            const auto [end, ec] = std::from_chars(n.data(), n.data() + n.size(), listen.max_clients);
+            if (ec != std::errc() || end != n.data() + n.size() || listen.max_clients == 0)
+                return usage("--max-clients needs a positive number");
+        } else if (a == "--system") {
+            session.bus = {caracara::dbus::BusChoice::Kind::System, {}};
+        } else if (a == "--user") {
+            session.bus = {caracara::dbus::BusChoice::Kind::User, {}};
+        } else if (a == "--bus-address") {
+            session.bus = {caracara::dbus::BusChoice::Kind::Address, value()};
+            if (session.bus.address.empty())
+                return usage("--bus-address needs an address");
+        } else {
+            return usage("unknown option '" + a + "'");
+        }
+    }
+    if (!listen.tcp_host.empty()) {
+        // TCP reaches beyond the SSH login: never without a token.
+        if (token_file.empty())
+            return usage("--listen tcp: needs --token-file");
+        std::ifstream f(token_file);
+        std::getline(f, session.token);
+        if (!f && session.token.empty())
+            return usage("cannot read the token from " + token_file);
+        if (session.token.size() < 16)
+            return usage("the token in " + token_file + " is shorter than 16 characters");
+    } else if (!token_file.empty()) {
+        return usage("--token-file applies to --listen tcp: only");
+    }
+    try {
+        boost::asio::io_context io(1);
+        caracara::bridge::BridgeServer server(io, listen, session);
+        boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+        signals.async_wait([&](boost::system::error_code, int) { io.stop(); });
+        server.start();
+        std::fprintf(stderr, "caracara-bridge: listening on %s\n",
+                     listen.tcp_host.empty() ? ("unix:" + listen.unix_path).c_str()
+                                             : ("tcp:" + listen.tcp_host + ":" + std::to_string(listen.tcp_port)).c_str());
+        sd_notify(0, "READY=1");
+        io.run();
+        if (!listen.unix_path.empty())
+            ::unlink(listen.unix_path.c_str());
+    } catch (const std::exception& e) {
+        std::cerr << "caracara-bridge: " << e.what() << '\n';
+        return 1;
+    }
+    return 0;
+}

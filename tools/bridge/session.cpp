@@ -1,0 +1,253 @@
+#include "tools/bridge/session.hpp"
+
+#include "tools/foxglove/channels.hpp"
+
+#include <boost/algorithm/string/predicate.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/beast/http/read.hpp>
+#include <boost/beast/http/write.hpp>
+#include <boost/beast/websocket/rfc6455.hpp>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+namespace caracara::bridge {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace fg = caracara::foxglove;
+
+namespace {
+
+constexpr const char* kSubprotocol = "foxglove.websocket.v1";
+constexpr uint8_t kMessageData = 0x01;
+
+// The HTTP request's token: "Authorization: Bearer T" or "?token=T" (a browser's WebSocket
+// cannot set headers, so Foxglove's URL carries it).
+std::string_view view(beast::string_view s) { return {s.data(), s.size()}; }
+
+std::string token_of(const http::request<http::string_body>& req) {
+    const std::string_view auth = view(req[http::field::authorization]);
+    if (auth.starts_with("Bearer "))
+        return std::string(auth.substr(7));
+    const std::string_view target = view(req.target());
+    const auto q = target.find("token=");
+    if (q == std::string_view::npos || (q > 0 && target[q - 1] != '?' && target[q - 1] != '&'))
+        return "";
+    const auto end = target.find('&', q);
+    return std::string(target.substr(q + 6, end == std::string_view::npos ? std::string_view::npos : end - q - 6));
+}
+
+// Compares in a time that does not depend on where the first difference is.
+bool same(const std::string& a, const std::string& b) {
+    if (a.size() != b.size())
+        return false;
+    unsigned char diff = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+    return diff == 0;
+}
+
+bool offers_subprotocol(const http::request<http::string_body>& req) {
+    const std::string_view offered = view(req[http::field::sec_websocket_protocol]);
+    std::size_t at = 0;
+    while (at <= offered.size()) {
+        const auto comma = offered.find(',', at);
+        std::string_view item = offered.substr(at, comma == std::string_view::npos ? std::string_view::npos : comma - at);
+        while (!item.empty() && item.front() == ' ')
+            item.remove_prefix(1);
+        while (!item.empty() && item.back() == ' ')
+            item.remove_suffix(1);
+        if (item == kSubprotocol)
+            return true;
+        if (comma == std::string_view::npos)
+            break;
+        at = comma + 1;
+    }
+    return false;
+}
+
+std::string server_info() {
+    return nlohmann::json{{"op", "serverInfo"},
+                          {"name", "caracara-bridge"},
+                          {"capabilities", {"clientPublish"}},
+                          {"supportedEncodings", {"json"}},
+                          {"metadata", nlohmann::json::object()}}
+        .dump();
+}
+
+std::string advertise() {
+    nlohmann::json list = nlohmann::json::array();
+    const auto& all = fg::channels();
+    for (std::size_t i = 0; i < all.size(); ++i)
+        list.push_back({{"id", i + 1},
+                        {"topic", all[i].topic},
+                        {"encoding", fg::kEncoding},
+                        {"schemaName", all[i].schema_name},
+                        {"schema", all[i].schema},
+                        {"schemaEncoding", fg::kSchemaEncoding}});
+    return nlohmann::json{{"op", "advertise"}, {"channels", list}}.dump();
+}
+
+} // namespace
+
+Session::Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry)
+    : io_(io), ws_(std::move(socket)), handshake_timer_(io), config_(config), telemetry_(telemetry),
+      protocol_(fg::channels().size()), queue_(config.max_queued) {}
+
+void Session::start() {
+    handshake_timer_.expires_after(std::chrono::seconds(10));
+    handshake_timer_.async_wait([weak = weak_from_this()](boost::system::error_code ec) {
+        if (auto self = weak.lock(); self && !ec && !self->open_) {
+            boost::system::error_code ignored;
+            self->ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
+            self->ws_.next_layer().close(ignored);
+        }
+    });
+    http::async_read(ws_.next_layer(), buffer_, request_,
+                     [self = shared_from_this()](boost::system::error_code ec, std::size_t) { self->on_request(ec); });
+}
+
+void Session::reject(http::status status, std::string body) {
+    auto res = std::make_shared<http::response<http::string_body>>(status, request_.version());
+    res->set(http::field::content_type, "text/plain");
+    res->body() = std::move(body) + "\n";
+    res->keep_alive(false);
+    res->prepare_payload();
+    http::async_write(ws_.next_layer(), *res, [self = shared_from_this(), res](boost::system::error_code, std::size_t) {
+        boost::system::error_code ignored;
+        self->ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
+    });
+}
+
+void Session::on_request(boost::system::error_code ec) {
+    if (ec)
+        return; // not HTTP, or gone before the request
+    if (!config_.token.empty() && !same(token_of(request_), config_.token))
+        return reject(http::status::unauthorized, "caracara-bridge: a valid token is required");
+    if (!websocket::is_upgrade(request_))
+        return reject(http::status::bad_request, "caracara-bridge speaks the Foxglove WebSocket protocol (ws://)");
+    if (!offers_subprotocol(request_))
+        return reject(http::status::bad_request, std::string("caracara-bridge needs the subprotocol ") + kSubprotocol);
+    try {
+        link_ = std::make_unique<CommandLink>(
+            io_, config_.bus,
+            [this](std::string_view topic, const std::string& name, const std::string& message) {
+                send_text(status_json(2, std::string(topic) + " refused: " + name + (message.empty() ? "" : ": " + message)));
+            },
+            // Not from inside the link's own processing: the session ends on the next turn.
+            [this] { boost::asio::post(io_, [self = shared_from_this()] { self->end("the bus connection closed"); }); });
+    } catch (const std::exception& e) {
+        return reject(http::status::service_unavailable, std::string("caracara-bridge: ") + e.what());
+    }
+    ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& res) {
+        res.set(http::field::sec_websocket_protocol, kSubprotocol);
+        res.set(http::field::server, "caracara-bridge");
+    }));
+    websocket::stream_base::timeout timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
+    timeouts.idle_timeout = std::chrono::seconds(10);
+    timeouts.keep_alive_pings = true;
+    ws_.set_option(timeouts);
+    ws_.read_message_max(config_.max_message_bytes);
+    ws_.async_accept(request_, [self = shared_from_this()](boost::system::error_code e) { self->on_accept(e); });
+}
+
+void Session::on_accept(boost::system::error_code ec) {
+    if (ec)
+        return end("handshake failed");
+    open_ = true;
+    handshake_timer_.cancel();
+    send_text(server_info());
+    send_text(advertise());
+    read();
+}
+
+void Session::read() {
+    buffer_.clear();
+    ws_.async_read(buffer_, [self = shared_from_this()](boost::system::error_code ec, std::size_t) { self->on_frame(ec); });
+}
+
+void Session::on_frame(boost::system::error_code ec) {
+    if (ec == websocket::error::message_too_big) {
+        // Beast closes with "message too big" (1009); the client hears why.
+        return end("message too big");
+    }
+    if (ec)
+        return end("closed");
+    const auto data = buffer_.cdata();
+    const auto* bytes = static_cast<const uint8_t*>(data.data());
+    if (ws_.got_text())
+        handle(protocol_.on_text({reinterpret_cast<const char*>(bytes), data.size()}));
+    else
+        handle(protocol_.on_binary({bytes, data.size()}));
+    if (!ended_)
+        read();
+}
+
+void Session::handle(const Outcome& outcome) {
+    for (const std::string& reply : outcome.replies)
+        send_text(reply);
+    if (outcome.command && link_)
+        link_->send(*outcome.command);
+    for (const uint32_t channel : outcome.subscribed)
+        if (const Payload latest = telemetry_.latest(channel - 1))
+            deliver(channel - 1, 0, latest);
+}
+
+void Session::deliver(std::size_t channel, uint64_t time_ns, const Payload& json) {
+    if (!open_ || ended_)
+        return;
+    if (time_ns == 0) {
+        timespec t{};
+        clock_gettime(CLOCK_REALTIME, &t);
+        time_ns = static_cast<uint64_t>(t.tv_sec) * 1'000'000'000u + static_cast<uint64_t>(t.tv_nsec);
+    }
+    for (const uint32_t sub : protocol_.subscribers(static_cast<uint32_t>(channel + 1))) {
+        auto frame = std::make_shared<std::string>(13 + json->size(), '\0');
+        (*frame)[0] = static_cast<char>(kMessageData);
+        for (int i = 0; i < 4; ++i)
+            (*frame)[1 + static_cast<std::size_t>(i)] = static_cast<char>(sub >> (8 * i));
+        for (int i = 0; i < 8; ++i)
+            (*frame)[5 + static_cast<std::size_t>(i)] = static_cast<char>(time_ns >> (8 * i));
+        frame->replace(13, json->size(), *json);
+        queue({false, true, std::move(frame)});
+    }
+}
+
+void Session::send_text(std::string text) {
+    if (open_ && !ended_)
+        queue({true, false, std::make_shared<const std::string>(std::move(text))});
+}
+
+void Session::queue(Frame f) {
+    queue_.push(std::move(f));
+    if (!queue_.writing())
+        write_next();
+}
+
+void Session::write_next() {
+    if (queue_.empty() || ended_)
+        return;
+    const Frame& f = queue_.start_front();
+    ws_.text(f.text);
+    ws_.async_write(boost::asio::buffer(*f.bytes), [self = shared_from_this()](boost::system::error_code ec, std::size_t) {
+        self->queue_.pop_front();
+        if (ec)
+            return self->end("write failed");
+        self->write_next();
+    });
+}
+
+void Session::end(const char* why) {
+    if (ended_)
+        return;
+    ended_ = true;
+    (void)why;
+    // The pilot's D-Bus connection goes now: caracarad zeroes what this client commanded.
+    link_.reset();
+    handshake_timer_.cancel();
+    boost::system::error_code ignored;
+    ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
+}
+
+} // namespace caracara::bridge

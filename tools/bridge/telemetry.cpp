@@ -1,0 +1,364 @@
+#include "tools/bridge/telemetry.hpp"
+
+#include "drivers/protocol/seabotix.hpp"
+#include "tools/foxglove/channels.hpp"
+
+#include <boost/asio/post.hpp>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+
+namespace caracara::bridge {
+
+namespace fg = caracara::foxglove;
+using caracaractl::Props;
+using caracaractl::Value;
+using fg::ChannelKind;
+
+namespace {
+
+const std::string kRoot = caracara::dbus::kRootPath;
+const std::string kThrusterPrefix = kRoot + "/thruster/";
+
+uint64_t now_ns() {
+    timespec t{};
+    clock_gettime(CLOCK_REALTIME, &t);
+    return static_cast<uint64_t>(t.tv_sec) * 1'000'000'000u + static_cast<uint64_t>(t.tv_nsec);
+}
+
+const Value kNone;
+
+const Value& get(const Props& p, const char* name) {
+    const auto it = p.find(name);
+    return it == p.end() ? kNone : it->second;
+}
+
+std::string text(const Props& p, const char* name) { return get(p, name).s; }
+
+std::vector<int64_t> integers(const Value& v) {
+    std::vector<int64_t> out;
+    for (const Value& item : v.items)
+        out.push_back(item.integer());
+    return out;
+}
+
+// The thruster number of an object path, or -1.
+int thruster_of(const std::string& path) {
+    if (!path.starts_with(kThrusterPrefix))
+        return -1;
+    const std::string n = path.substr(kThrusterPrefix.size());
+    if (n.size() != 1 || n[0] < '0' || n[0] >= '0' + static_cast<int>(fg::kThrusters))
+        return -1;
+    return n[0] - '0';
+}
+
+} // namespace
+
+Telemetry::Telemetry(boost::asio::io_context& io, caracara::dbus::BusChoice bus, Publish publish)
+    : io_(io), choice_(std::move(bus)), publish_(std::move(publish)), retry_(io), latest_(fg::channels().size()) {}
+
+Telemetry::~Telemetry() {
+    *alive_ = false;
+    watch_.reset();
+    slots_.clear();
+}
+
+void Telemetry::start() {
+    if (!connect())
+        retry();
+}
+
+void Telemetry::retry() {
+    retry_.expires_after(std::chrono::seconds(1));
+    retry_.async_wait([this, alive = alive_](boost::system::error_code ec) {
+        if (!ec && *alive)
+            start();
+    });
+}
+
+bool Telemetry::connect() {
+    watch_.reset();
+    slots_.clear();
+    client_ = std::make_unique<caracaractl::Client>(choice_);
+    try {
+        sd_bus* bus = client_->bus();
+        // Subscribe before loading, so no change falls between the two.
+        sd_bus_slot* slot = nullptr;
+        if (sd_bus_match_signal(bus, &slot, caracara::dbus::kBusName, nullptr, "org.freedesktop.DBus.Properties",
+                                "PropertiesChanged", on_properties_changed, this) < 0)
+            return false;
+        slots_.emplace_back(slot);
+        for (const char* member : {"BusLost", "BusRestored"}) {
+            if (sd_bus_match_signal(bus, &slot, caracara::dbus::kBusName, caracara::dbus::kBusPath,
+                                    caracara::dbus::kBusIface, member, on_vehicle_signal, this) < 0)
+                return false;
+            slots_.emplace_back(slot);
+        }
+        // Failsafe(s condition, s action, i thruster) on the vehicle, where the daemon has it.
+        if (sd_bus_match_signal(bus, &slot, caracara::dbus::kBusName, caracara::dbus::kRootPath,
+                                caracara::dbus::kVehicleIface, "Failsafe", on_vehicle_signal, this) < 0)
+            return false;
+        slots_.emplace_back(slot);
+        // A restarted caracarad: its objects are loaded again (the old values are gone).
+        if (sd_bus_match_signal(bus, &slot, "org.freedesktop.DBus", "/org/freedesktop/DBus", "org.freedesktop.DBus",
+                                "NameOwnerChanged", on_owner_changed, this) < 0)
+            return false;
+        slots_.emplace_back(slot);
+        objects_ = client_->get_objects();
+    } catch (const caracaractl::Failure& f) {
+        std::fprintf(stderr, "caracara-bridge: caracarad not reachable (%s); retrying\n", f.message.c_str());
+        slots_.clear();
+        return false;
+    }
+    watch_ = std::make_unique<BusWatch>(io_, client_->bus(), [this] {
+        std::fprintf(stderr, "caracara-bridge: the bus connection closed; reconnecting\n");
+        boost::asio::post(io_, [this, alive = alive_] {
+            if (*alive)
+                retry();
+        });
+    });
+    for (std::size_t i = 0; i < fg::channels().size(); ++i)
+        if (fg::channels()[i].kind != ChannelKind::Events)
+            mark(i);
+    return true;
+}
+
+const Props& Telemetry::props(const std::string& path, const char* iface) const {
+    static const Props none;
+    const auto o = objects_.find(path);
+    if (o == objects_.end())
+        return none;
+    const auto i = o->second.find(iface);
+    return i == o->second.end() ? none : i->second;
+}
+
+int Telemetry::on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto* self = static_cast<Telemetry*>(userdata);
+    try {
+        const char* iface = nullptr;
+        if (sd_bus_message_read(m, "s", &iface) < 0 || !iface)
+            return 0;
+        const Props changed = caracaractl::to_props(caracaractl::read_value(m));
+        self->changed(sd_bus_message_get_path(m) ? sd_bus_message_get_path(m) : "", iface, changed);
+    } catch (const caracaractl::Failure&) {
+        // A malformed signal changes nothing.
+    }
+    return 0;
+}
+
+int Telemetry::on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto* self = static_cast<Telemetry*>(userdata);
+    const std::string member = sd_bus_message_get_member(m) ? sd_bus_message_get_member(m) : "";
+    if (member == "BusLost") {
+        const char* reason = nullptr;
+        if (sd_bus_message_read(m, "s", &reason) >= 0)
+            self->log(4, "bus", std::string("I2C bus lost: ") + (reason ? reason : ""));
+    } else if (member == "BusRestored") {
+        uint32_t pulses = 0;
+        double ms = 0;
+        if (sd_bus_message_read(m, "ud", &pulses, &ms) >= 0) {
+            char text[96];
+            std::snprintf(text, sizeof text, "I2C bus restored after %u SCL pulses in %.1f ms", pulses, ms);
+            self->log(2, "bus", text);
+        }
+    } else if (member == "Failsafe") {
+        const char* condition = nullptr;
+        const char* action = nullptr;
+        int32_t thruster = -1;
+        if (sd_bus_message_read(m, "ssi", &condition, &action, &thruster) >= 0)
+            self->log(3, "failsafe",
+                      std::string("failsafe: ") + (condition ? condition : "") + " -> " + (action ? action : "") +
+                          (thruster >= 0 ? " (thruster " + std::to_string(thruster) + ")" : ""));
+    }
+    return 0;
+}
+
+int Telemetry::on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto* self = static_cast<Telemetry*>(userdata);
+    const char *name = nullptr, *old_owner = nullptr, *new_owner = nullptr;
+    if (sd_bus_message_read(m, "sss", &name, &old_owner, &new_owner) < 0 || !name ||
+        std::string_view(name) != caracara::dbus::kBusName || !new_owner || !*new_owner)
+        return 0;
+    // Not from inside this connection's processing: the call waits for its reply.
+    boost::asio::post(self->io_, [self, alive = self->alive_] {
+        if (*alive)
+            self->reload();
+    });
+    return 0;
+}
+
+void Telemetry::reload() {
+    if (!watch_ || !client_)
+        return; // reconnecting: connect() loads the objects
+    try {
+        objects_ = client_->get_objects();
+    } catch (const caracaractl::Failure& f) {
+        std::fprintf(stderr, "caracara-bridge: reloading caracarad's objects failed (%s)\n", f.message.c_str());
+        return;
+    }
+    for (std::size_t i = 0; i < fg::channels().size(); ++i)
+        if (fg::channels()[i].kind != ChannelKind::Events)
+            mark(i);
+    watch_->kick();
+}
+
+void Telemetry::changed(const std::string& path, const std::string& iface, const Props& changes) {
+    Props& stored = objects_[path][iface];
+    const Props before = stored;
+    for (const auto& [name, value] : changes)
+        stored[name] = value;
+    if (path == kRoot) {
+        bool state = false, motors = false;
+        for (const auto& [name, _] : changes)
+            (name == "MotorValues" || name == "RequestedValues" ? motors : state) = true;
+        if (motors)
+            mark(fg::channel_position(ChannelKind::Motors));
+        if (state)
+            mark(fg::channel_position(ChannelKind::VehicleState));
+        if (changes.contains("State") && text(before, "State") != text(stored, "State")) {
+            const std::string s = text(stored, "State");
+            const std::string source = text(stored, "KillSource");
+            const int level = s == "killed" || s == "powered-off" ? 3 : s == "fault" ? 4 : 2;
+            log(level, s == "killed" ? "kill" : s == "arming" ? "arming" : "state",
+                s + (source.empty() ? "" : " (" + source + ")"));
+        }
+        if (changes.contains("Profile") && text(before, "Profile") != text(stored, "Profile"))
+            log(2, "profile", "profile " + text(stored, "Profile"));
+    } else if (const int t = thruster_of(path); t >= 0) {
+        mark(fg::channel_position(ChannelKind::Thruster, static_cast<unsigned>(t)));
+        if (changes.contains("Faults")) {
+            std::string list;
+            for (const Value& f : get(stored, "Faults").items)
+                list += (list.empty() ? "" : ",") + f.s;
+            std::string old;
+            for (const Value& f : get(before, "Faults").items)
+                old += (old.empty() ? "" : ",") + f.s;
+            if (list != old)
+                log(list.empty() ? 2 : 4, "fault", "thruster " + std::to_string(t) + " faults: " + (list.empty() ? "none" : list));
+        }
+    } else if (path == caracara::dbus::kTeensyPath) {
+        mark(fg::channel_position(ChannelKind::Teensy));
+        if (changes.contains("Orientation"))
+            mark(fg::channel_position(ChannelKind::Attitude));
+    } else if (path == caracara::dbus::kBusPath) {
+        mark(fg::channel_position(ChannelKind::I2cBus));
+        if (changes.contains("Recoveries") && get(before, "Recoveries").unsigned_integer() !=
+                                                   get(stored, "Recoveries").unsigned_integer())
+            log(2, "recovery", "I2C bus recoveries: " + std::to_string(get(stored, "Recoveries").unsigned_integer()));
+    }
+}
+
+void Telemetry::log(int level, const std::string& name, const std::string& message) {
+    const uint64_t now = now_ns();
+    fg::LogEvent e{now, static_cast<fg::LogLevel>(level), name, message};
+    const std::size_t pos = fg::channel_position(ChannelKind::Events);
+    latest_[pos] = std::make_shared<const std::string>(fg::to_json(e));
+    publish_(pos, now, latest_[pos]);
+}
+
+void Telemetry::mark(std::size_t channel) {
+    dirty_.insert(channel);
+    // One message per channel for all the changes one batch of signals brings.
+    if (!flush_posted_) {
+        flush_posted_ = true;
+        boost::asio::post(io_, [this, alive = alive_] {
+            if (*alive)
+                flush();
+        });
+    }
+}
+
+void Telemetry::flush() {
+    flush_posted_ = false;
+    const uint64_t now = now_ns();
+    const std::set<std::size_t> dirty = std::move(dirty_);
+    dirty_.clear();
+    for (const std::size_t c : dirty)
+        build(c, now);
+}
+
+void Telemetry::build(std::size_t channel, uint64_t now) {
+    const fg::ChannelInfo& info = fg::channels()[channel];
+    std::string json;
+    switch (info.kind) {
+    case ChannelKind::VehicleState: {
+        const Props& p = props(kRoot, caracara::dbus::kVehicleIface);
+        fg::VehicleState s{text(p, "State"), text(p, "KillSource"), text(p, "Profile"),
+                           get(p, "ProfileFactor").number(), get(p, "BudgetLimit").integer(),
+                           get(p, "Saturated").boolean(), get(p, "CommandAgeMs").integer(), text(p, "Controller"), {}};
+        const Value& leds = get(p, "Leds");
+        for (std::size_t i = 0; i < 3 && i < leds.items.size(); ++i)
+            s.leds[i] = leds.items[i].integer();
+        json = fg::to_json(s);
+        break;
+    }
+    case ChannelKind::Motors: {
+        const Props& p = props(kRoot, caracara::dbus::kVehicleIface);
+        fg::Motors m;
+        const auto applied = integers(get(p, "MotorValues")), requested = integers(get(p, "RequestedValues"));
+        for (std::size_t i = 0; i < fg::kThrusters; ++i) {
+            m.applied[i] = i < applied.size() ? applied[i] : 0;
+            m.requested[i] = i < requested.size() ? requested[i] : 0;
+        }
+        json = fg::to_json(m);
+        break;
+    }
+    case ChannelKind::Thruster: {
+        const Props& p = props(kThrusterPrefix + std::to_string(info.index), caracara::dbus::kThrusterIface);
+        fg::Thruster t;
+        t.index = info.index;
+        t.reachable = get(p, "Online").boolean();
+        const auto speed = caracara::speed_to_motor(static_cast<uint8_t>(get(p, "ActualSpeed").unsigned_integer()));
+        t.speed = speed ? *speed : 0;
+        t.ordered_value = get(p, "OrderedValue").integer();
+        t.current = get(p, "Current").number();
+        t.temperature = get(p, "Temperature").number();
+        for (const Value& f : get(p, "Faults").items) {
+            t.faults.push_back(f.s);
+            for (const auto fault : caracara::kAllFaults)
+                if (caracara::fault_name(fault) == f.s)
+                    t.fault_bits |= 1u << static_cast<unsigned>(fault);
+        }
+        json = fg::to_json(t);
+        break;
+    }
+    case ChannelKind::Teensy:
+    case ChannelKind::Attitude: {
+        const Props& p = props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface);
+        fg::Teensy t;
+        const Value& o = get(p, "Orientation");
+        if (o.items.size() == 3) {
+            t.yaw = o.items[0].number();
+            t.pitch = o.items[1].number();
+            t.roll = o.items[2].number();
+        }
+        if (info.kind == ChannelKind::Attitude) {
+            json = fg::attitude_json(now, t.yaw, t.pitch, t.roll);
+            break;
+        }
+        t.online = get(p, "Online").boolean();
+        t.distances = integers(get(p, "Distances"));
+        t.servos = integers(get(p, "Servos"));
+        t.task = text(p, "Task");
+        t.frames = get(p, "Frames").unsigned_integer();
+        t.busy_retries = get(p, "BusyRetries").unsigned_integer();
+        t.link_errors = get(p, "LinkErrors").unsigned_integer();
+        json = fg::to_json(t);
+        break;
+    }
+    case ChannelKind::I2cBus: {
+        const Props& p = props(caracara::dbus::kBusPath, caracara::dbus::kBusIface);
+        fg::I2cBus b{text(p, "State"), get(p, "Transactions").unsigned_integer(), get(p, "Errors").unsigned_integer(),
+                     get(p, "Recoveries").unsigned_integer(), get(p, "RecoveryFailures").unsigned_integer(),
+                     text(p, "LastError")};
+        json = fg::to_json(b);
+        break;
+    }
+    case ChannelKind::Events:
+        return;
+    }
+    latest_[channel] = std::make_shared<const std::string>(std::move(json));
+    publish_(channel, now, latest_[channel]);
+}
+
+} // namespace caracara::bridge

@@ -1,0 +1,104 @@
+// The Foxglove channels of the vehicle (docs/foxglove.md): one catalogue of topics, schema
+// names and JSON Schemas, and one function per channel that turns a message into its JSON,
+// shared by the live bridge (tools/bridge) and the MCAP export of a dive (caracaractl export
+// --format mcap), so a recorded dive and a live one look the same in Foxglove.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace caracara::foxglove {
+
+inline constexpr std::size_t kThrusters = 8;
+
+enum class ChannelKind : uint8_t { VehicleState, Motors, Thruster, Teensy, I2cBus, Events, Attitude };
+
+struct ChannelInfo {
+    ChannelKind kind;
+    unsigned index = 0;          // the thruster number for ChannelKind::Thruster
+    std::string topic;           // "/vehicle/state", "/thruster/3", ...
+    std::string schema_name;     // "caracara.VehicleState", "foxglove.Log", ...
+    std::string schema;          // JSON Schema (draft 2020-12) as text
+};
+
+// Every channel, in a fixed order: its position is the channel id the bridge advertises
+// (plus one: ids start at 1) and the MCAP channel id.
+const std::vector<ChannelInfo>& channels();
+// The position in channels() of a channel.
+std::size_t channel_position(ChannelKind kind, unsigned index = 0);
+
+inline constexpr const char* kEncoding = "json";
+inline constexpr const char* kSchemaEncoding = "jsonschema";
+
+// --- messages (what a channel carries) ---------------------------------------------------------
+
+struct VehicleState {
+    std::string state;           // "arming", "ready", "killed", "powered-off", "fault"
+    std::string kill_source;     // "" when not killed
+    std::string profile;
+    double profile_factor = 1.0;
+    int64_t budget_limit = 0;
+    bool saturated = false;
+    int64_t command_age_ms = -1; // -1: no motion command yet, or not recorded
+    std::string controller;      // the commanding client's unique bus name
+    std::array<int64_t, 3> leds{}; // red, green, blue (not recorded in a dive: 0)
+};
+
+struct Motors {
+    std::array<int64_t, kThrusters> applied{};
+    std::array<int64_t, kThrusters> requested{};
+};
+
+struct Thruster {
+    unsigned index = 0;
+    bool reachable = false;
+    int64_t speed = 0;           // the reported SPEED as a motor value (-8850..8850); 0 unknown
+    int64_t ordered_value = 0;
+    double current = 0;          // A
+    double temperature = 0;      // degrees C
+    unsigned fault_bits = 0;     // the SeaBotix FAULT bits
+    std::vector<std::string> faults;
+};
+
+struct Teensy {
+    bool online = false;
+    double yaw = 0, pitch = 0, roll = 0;   // radians
+    std::vector<int64_t> distances;        // mm
+    std::vector<int64_t> servos;           // degrees
+    std::string task;                      // "idle", "turning"
+    uint64_t frames = 0, busy_retries = 0, link_errors = 0;
+};
+
+struct I2cBus {
+    std::string state;           // "ok", "recovering", "lost"
+    uint64_t transactions = 0, errors = 0, recoveries = 0, recovery_failures = 0;
+    std::string last_error;
+};
+
+// foxglove.Log levels.
+enum class LogLevel : uint8_t { Unknown = 0, Debug = 1, Info = 2, Warning = 3, Error = 4, Fatal = 5 };
+
+struct LogEvent {
+    uint64_t time_ns = 0;
+    LogLevel level = LogLevel::Info;
+    std::string name;            // "kill", "fault", "bus", "arming", "failsafe", "profile"
+    std::string message;
+};
+
+// --- JSON ------------------------------------------------------------------------------------
+
+std::string to_json(const VehicleState& m);
+std::string to_json(const Motors& m);
+std::string to_json(const Thruster& m);
+std::string to_json(const Teensy& m);
+std::string to_json(const I2cBus& m);
+std::string to_json(const LogEvent& m);
+// foxglove.FrameTransform of the vehicle ("caracara") in "world" from yaw, pitch, roll.
+std::string attitude_json(uint64_t time_ns, double yaw, double pitch, double roll);
+
+// The SeaBotix fault names of a FAULT byte ("overtemp", "stall", ...).
+std::vector<std::string> fault_names(unsigned bits);
+
+} // namespace caracara::foxglove
