@@ -8,6 +8,7 @@
 #include "drivers/platform/event_loop.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace caracara {
@@ -18,6 +19,8 @@ public:
         : event_(event), vehicle_(vehicle), bus_(bus), loop_(loop) {}
 
     void publish() const;
+    // The active failsafes for the STATUS= line ("" when none).
+    void set_failsafe_summary(std::function<std::string()> summary) { failsafes_ = std::move(summary); }
     // Starts feeding the watchdog if systemd asked for one (WatchdogSec=).
     void start_watchdog();
     void ready(const char* bus_name) const;
@@ -32,6 +35,7 @@ private:
     const ControlLoop& loop_;
     uint64_t interval_us_ = 0;
     SourcePtr watchdog_;
+    std::function<std::string()> failsafes_;
 };
 
 } // namespace caracara

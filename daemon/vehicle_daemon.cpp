@@ -14,10 +14,23 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, Gp
       vehicle_(config_, bus_, lines_, teensy_, events_),
       loop_(event, config_.control, vehicle_, bus_, teensy_, lines_, events_),
       recovery_(event, config_, io, gpio, bus_, vehicle_, events_),
-      status_(event, vehicle_, bus_, loop_) {
+      status_(event, vehicle_, bus_, loop_),
+      failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); }, vehicle_,
+                 events_) {
     vehicle_.set_loop(&loop_);
     bus_.set_listener(&recovery_);
     events_.attach(&status_);
+    status_.set_failsafe_summary([this] { return failsafes_.summary(); });
+}
+
+std::optional<FailsafeReading> VehicleDaemon::reading(std::size_t i) const {
+    const auto& st = bus_.thruster(i).last_status();
+    if (!st || !bus_.thruster(i).online())
+        return std::nullopt;
+    FailsafeReading r{st->faults.bits, std::nullopt};
+    if (st->variant == Variant::SeaBotix)
+        r.temperature_c = st->seabotix.temperature_c;
+    return r;
 }
 
 std::string VehicleDaemon::start() {
@@ -47,6 +60,8 @@ std::string VehicleDaemon::start() {
     }
     if (std::string e = loop_.start(); !e.empty())
         return e;
+    if (std::string e = failsafes_.start(); !e.empty())
+        return e;
     started_ = true;
     return {};
 }
@@ -57,6 +72,7 @@ void VehicleDaemon::shutdown() {
     started_ = false;
     bus_.set_gate(nullptr);
     loop_.stop();
+    failsafes_.stop();
     if (recorder_) {
         recorder_->stop(); // the dive ends here, before the zeros of the way out
         events_.attach_recorder(nullptr);

@@ -8,6 +8,7 @@
 #include "daemon/control_loop.hpp"
 #include "daemon/dive_recorder.hpp"
 #include "daemon/dive_writer.hpp"
+#include "daemon/failsafe_monitor.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/service_status.hpp"
 #include "daemon/teensy_port.hpp"
@@ -49,10 +50,15 @@ public:
     ServiceStatus& status() { return status_; }
     BusRecovery& recovery() { return recovery_; }
     SafetyLines& lines() { return lines_; }
+    FailsafeMonitor& failsafes() { return failsafes_; }
+    const FailsafeMonitor& failsafes() const { return failsafes_; }
     // The dive recorder, or nullptr when recorder.enabled is false.
     const DiveRecorder* recorder() const { return recorder_.get(); }
 
 private:
+    // Thruster i's last good status reply, for the failsafes; nullopt while it does not answer.
+    std::optional<FailsafeReading> reading(std::size_t i) const;
+
     sd_event* event_;
     DaemonConfig config_;
     VehicleEvents events_;
@@ -63,6 +69,7 @@ private:
     ControlLoop loop_;
     BusRecovery recovery_;
     ServiceStatus status_;
+    FailsafeMonitor failsafes_;
     std::unique_ptr<DiveWriter> dive_writer_;
     std::unique_ptr<DiveRecorder> recorder_;
     bool started_ = false;

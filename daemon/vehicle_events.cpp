@@ -5,7 +5,7 @@
 namespace caracara {
 
 void VehicleEvents::changed(uint32_t changes) {
-    if ((changes & (kChangeState | kChangeBus | kChangeProfile | kChangeFaults)) && status_)
+    if ((changes & (kChangeState | kChangeBus | kChangeProfile | kChangeFaults | kChangeFailsafes)) && status_)
         status_->publish();
     if (changes && recorder_)
         recorder_->vehicle_changed(changes);

@@ -13,6 +13,8 @@ public:
     // Every property of the changes, changed or not: a command that sets the same values again
     // is still announced.
     void announce(uint32_t changes) { object_.announce(changes, AnnouncedObject::When::Always); }
+    // The Failsafe signal: one raised.
+    void emit_failsafe(const ActiveFailsafe& f);
 
 private:
     AnnouncedObject object_;
