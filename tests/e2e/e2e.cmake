@@ -3,7 +3,7 @@
 # Included from tests/CMakeLists.txt. Needs Debian's /usr/bin/python3 with python3-dbus and
 # python3-gi, busctl and dbus-daemon; run with `ctest -L e2e`.
 set(CARACARA_E2E_DIR ${CMAKE_CURRENT_LIST_DIR})
-foreach(name vehicle introspection caracaractl mission paths_out faults)
+foreach(name vehicle introspection caracaractl mission paths_out faults failsafes)
   add_test(NAME e2e_${name}
            COMMAND /usr/bin/python3 -m unittest -v test_${name}
            WORKING_DIRECTORY ${CARACARA_E2E_DIR})
