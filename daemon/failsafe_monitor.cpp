@@ -16,9 +16,9 @@ std::string describe(const ActiveFailsafe& f) {
 } // namespace
 
 FailsafeMonitor::FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters,
-                                 Readings readings, Vehicle& vehicle, VehicleEvents& events)
-    : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)), vehicle_(vehicle),
-      events_(events), policy_(settings, thrusters) {}
+                                 Readings readings, Conditions conditions, Vehicle& vehicle, VehicleEvents& events)
+    : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)),
+      conditions_(std::move(conditions)), vehicle_(vehicle), events_(events), policy_(settings, thrusters) {}
 
 std::string FailsafeMonitor::start() {
     sd_event_source* s = nullptr;
@@ -42,6 +42,12 @@ void FailsafeMonitor::poll(uint64_t now) {
     for (std::size_t i = 0; i < thrusters_; ++i)
         if (const auto r = readings_(i)) {
             FailsafeTransitions t = policy_.observe(i, r->fault_bits, r->temperature_c, now);
+            ts.insert(ts.end(), t.begin(), t.end());
+        }
+    const auto holding = conditions_();
+    for (std::size_t c = 0; c < kFailsafeConditionCount; ++c)
+        if (condition_is_fixed(static_cast<FailsafeCondition>(c))) {
+            FailsafeTransitions t = policy_.set_condition(static_cast<FailsafeCondition>(c), holding[c], now);
             ts.insert(ts.end(), t.begin(), t.end());
         }
     FailsafeTransitions due = policy_.tick(now);
@@ -116,7 +122,10 @@ void FailsafeMonitor::keep_surfacing(uint64_t now) {
 }
 
 Result FailsafeMonitor::clear_kill_refusal() const {
-    const std::vector<ActiveFailsafe> b = policy_.blocking();
+    // The fixed ones are refused where they arise, by name (BusLost, ThrusterUnreachable), and
+    // at once when they end, not at this object's next reading.
+    std::vector<ActiveFailsafe> b = policy_.blocking();
+    std::erase_if(b, [](const ActiveFailsafe& f) { return condition_is_fixed(f.condition); });
     if (b.empty())
         return {};
     std::string m = "a failsafe holds: ";
@@ -131,6 +140,8 @@ Result FailsafeMonitor::clear_kill_override(std::string_view condition, std::str
     const auto c = condition_from_name(condition);
     if (!c)
         return {Status::InvalidValue, "no failsafe condition \"" + std::string(condition) + "\""};
+    if (condition_is_fixed(*c))
+        return {Status::FailsafeActive, std::string(condition) + " is fixed at kill: it cannot be overridden"};
     // Only the named condition: another that holds still refuses.
     for (const ActiveFailsafe& f : policy_.blocking())
         if (f.condition != *c)

@@ -27,12 +27,15 @@ struct FailsafeReading {
 class FailsafeMonitor final : public FailsafeGate {
 public:
     using Readings = std::function<std::optional<FailsafeReading>(std::size_t thruster)>;
+    // Which of the vehicle's own (fixed) conditions hold now. The daemon already kills for them
+    // where they arise; here they are told as failsafes, and hold a ClearKill like the others.
+    using Conditions = std::function<std::array<bool, kFailsafeConditionCount>()>;
     // Readings at 20 Hz: a status reply comes every (thrusters / status reads per tick) cycles,
     // 160 ms for eight at 50 Hz, so a persistence time is kept to within one period.
     static constexpr uint64_t kPeriodNs = 50'000'000;
 
     FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters, Readings readings,
-                    Vehicle& vehicle, VehicleEvents& events);
+                    Conditions conditions, Vehicle& vehicle, VehicleEvents& events);
     std::string start(); // "" or why the timer could not be made
     void stop() { timer_.reset(); }
 
@@ -57,6 +60,7 @@ private:
     const FailsafeSettings& settings_;
     std::size_t thrusters_;
     Readings readings_;
+    Conditions conditions_;
     Vehicle& vehicle_;
     VehicleEvents& events_;
     FailsafePolicy policy_;

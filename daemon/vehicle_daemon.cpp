@@ -15,12 +15,19 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, Gp
       loop_(event, config_.control, vehicle_, bus_, teensy_, lines_, events_),
       recovery_(event, config_, io, gpio, bus_, vehicle_, events_),
       status_(event, vehicle_, bus_, loop_),
-      failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); }, vehicle_,
-                 events_) {
+      failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); },
+                 [this] { return fixed_conditions(); }, vehicle_, events_) {
     vehicle_.set_loop(&loop_);
     bus_.set_listener(&recovery_);
     events_.attach(&status_);
     status_.set_failsafe_summary([this] { return failsafes_.summary(); });
+}
+
+std::array<bool, kFailsafeConditionCount> VehicleDaemon::fixed_conditions() const {
+    std::array<bool, kFailsafeConditionCount> c{};
+    c[static_cast<std::size_t>(FailsafeCondition::BusLost)] = bus_.telemetry().state == BusState::Lost;
+    c[static_cast<std::size_t>(FailsafeCondition::ThrusterUnreachable)] = bus_.first_unreachable().has_value();
+    return c;
 }
 
 std::optional<FailsafeReading> VehicleDaemon::reading(std::size_t i) const {

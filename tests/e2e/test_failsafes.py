@@ -357,6 +357,28 @@ class SurfaceTest(FailsafeCase):
         poll(lambda: self.failsafes() == [], 10)
 
 
+class FixedConditionTest(FailsafeCase):
+    def test_an_unreachable_thruster_is_told_as_a_failsafe_and_cannot_be_overridden(self):
+        rig = self.rig
+        rig.reset()
+        self.drive([1500] * MOTORS)
+        rig.sim_thruster_call(4, "SetNack", True, signature="b")
+        try:
+            self.signals.wait(("thruster-unreachable", "kill", -1))
+            self.assertEqual(rig.state(), "killed")
+            self.assertEqual(rig.vget("KillSource"), "device")  # the kill where it arose, first
+            self.assertIn(("thruster-unreachable", "kill", -1), self.failsafes())
+            self.assertEqual(error_name(rig.vcall, "ClearKill"), ERR + "ThrusterUnreachable")
+            self.assertEqual(error_name(rig.vcall, "ClearKillOverride", "thruster-unreachable", signature="s"),
+                             ERR + "FailsafeActive")
+            self.assertEqual(rig.state(), "killed")
+        finally:
+            rig.sim_thruster_call(4, "SetNack", False, signature="b")
+        poll(lambda: self.failsafes() == [], 10, message="thruster-unreachable did not clear")
+        poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10)
+        rig.wait_state("ready")
+
+
 class ConfigCheckTest(unittest.TestCase):
     def test_weakening_a_fixed_failsafe_is_refused_by_name(self):
         rig = Rig(control=CONTROL, extra_config={"failsafe": {"bus-lost": {"action": "warn"}}})
