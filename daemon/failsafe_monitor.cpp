@@ -4,6 +4,8 @@
 #include "daemon/log.hpp"
 #include "drivers/platform/io_error.hpp"
 
+#include <algorithm>
+
 namespace caracara {
 
 namespace {
@@ -18,11 +20,13 @@ std::string describe(const ActiveFailsafe& f) {
 FailsafeMonitor::FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters,
                                  Readings readings, Conditions conditions, Vehicle& vehicle, VehicleEvents& events)
     : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)),
-      conditions_(std::move(conditions)), vehicle_(vehicle), events_(events), policy_(settings, thrusters) {}
+      conditions_(std::move(conditions)), vehicle_(vehicle), events_(events), policy_(settings, thrusters),
+      period_us_(std::max<uint64_t>(1000, std::min(kPeriodNs, vehicle.safety().config().command_timeout_ns / 2)) /
+                 1000) {}
 
 std::string FailsafeMonitor::start() {
     sd_event_source* s = nullptr;
-    if (int r = sd_event_add_time_relative(event_, &s, CLOCK_MONOTONIC, kPeriodNs / 1000, 1000, on_timer, this); r < 0)
+    if (int r = sd_event_add_time_relative(event_, &s, CLOCK_MONOTONIC, period_us_, 1000, on_timer, this); r < 0)
         return "sd_event_add_time_relative: " + errno_name(-r);
     timer_.reset(s);
     sd_event_source_set_enabled(s, SD_EVENT_ON);
@@ -32,7 +36,7 @@ std::string FailsafeMonitor::start() {
 
 int FailsafeMonitor::on_timer(sd_event_source* s, uint64_t usec, void* userdata) {
     auto* self = static_cast<FailsafeMonitor*>(userdata);
-    sd_event_source_set_time(s, usec + kPeriodNs / 1000);
+    sd_event_source_set_time(s, usec + self->period_us_);
     self->poll(monotonic_ns());
     return 0;
 }

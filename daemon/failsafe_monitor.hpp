@@ -31,7 +31,8 @@ public:
     // where they arise; here they are told as failsafes, and hold a ClearKill like the others.
     using Conditions = std::function<std::array<bool, kFailsafeConditionCount>()>;
     // Readings at 20 Hz: a status reply comes every (thrusters / status reads per tick) cycles,
-    // 160 ms for eight at 50 Hz, so a persistence time is kept to within one period.
+    // 160 ms for eight at 50 Hz, so a persistence time is kept to within one period. Faster
+    // when the command timeout is shorter than two periods: the ascent is re-sent at each one.
     static constexpr uint64_t kPeriodNs = 50'000'000;
 
     FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters, Readings readings,
@@ -65,6 +66,7 @@ private:
     VehicleEvents& events_;
     FailsafePolicy policy_;
     SourcePtr timer_;
+    uint64_t period_us_;
     std::array<bool, kMotorCount> excluded_{};
     uint64_t surface_until_ = 0; // 0: not surfacing
     std::string surface_reason_;

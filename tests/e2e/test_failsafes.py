@@ -71,10 +71,11 @@ class FailsafeSignals:
 class FailsafeCase(unittest.TestCase):
     RULES = {}
     SURFACE = None
+    CONTROL = CONTROL
 
     @classmethod
     def setUpClass(cls):
-        cls.rig = Rig(control=CONTROL, extra_config=failsafe_config(cls.RULES, cls.SURFACE))
+        cls.rig = Rig(control=cls.CONTROL, extra_config=failsafe_config(cls.RULES, cls.SURFACE))
         cls.addClassCleanup(cls.rig.stop_checked)
         cls.rig.start()
         cls.rig.arm()
@@ -289,6 +290,8 @@ class KillAndOverrideTest(FailsafeCase):
 class SurfaceTest(FailsafeCase):
     RULES = {"water-detect": ("surface", 300)}
     SURFACE = {"heave": -0.5, "duration_ms": 1500}
+    # Shorter than the ascent, many times over: the ascent must be re-sent, without a gap.
+    CONTROL = dict(CONTROL, command_timeout_ms=60)
 
     def ascent(self):
         """The mixing of the heave axis alone (z = -0.5), from the seed's table."""
@@ -352,6 +355,30 @@ class SurfaceTest(FailsafeCase):
             time.sleep(2.0)  # past the ascent's end: nothing more happens
             self.assertEqual(rig.vget("KillSource"), "dbus")
             self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
+        finally:
+            self.fault(3, "water-detect", False)
+        poll(lambda: self.failsafes() == [], 10)
+
+    def test_the_kill_switch_during_the_ascent_kills_at_once(self):
+        rig = self.rig
+        rig.reset()
+        self.fault(3, "water-detect", True)
+        try:
+            self.signals.wait(("water-detect", "surface", 3))
+            rig.wait_sim_speeds([speed_byte(v) for v in self.ascent()])
+            since = rig.wire_next()
+            rig.sim_call("SetKillSwitch", True, signature="b")
+            try:
+                rig.wait_state("killed", timeout=5)
+                self.assertEqual(rig.vget("KillSource"), "switch")
+                rig.wait_sim_zero()
+                log = rig.wire_log(since)[1]
+                edge = kill_edges(log)[0]
+                self.assertFalse([e for e, i, s in orders(log) if e.index > edge.index and s != ZERO])
+                time.sleep(2.0)  # past the ascent's end
+                self.assertEqual(rig.vget("KillSource"), "switch")
+            finally:
+                rig.sim_call("SetKillSwitch", False, signature="b")
         finally:
             self.fault(3, "water-detect", False)
         poll(lambda: self.failsafes() == [], 10)
