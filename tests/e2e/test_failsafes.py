@@ -7,7 +7,9 @@ kills, kill asserts the kill output and zeroes. A condition shorter than its per
 does nothing. After a failsafe kill ClearKill is refused while the condition holds, and
 ClearKillOverride names it, in the journal with the caller."""
 import os
+import socket
 import subprocess
+import tempfile
 import time
 import unittest
 
@@ -382,6 +384,56 @@ class SurfaceTest(FailsafeCase):
         finally:
             self.fault(3, "water-detect", False)
         poll(lambda: self.failsafes() == [], 10)
+
+
+class StatusLineTest(FailsafeCase):
+    """systemd's STATUS= line, read from a notify socket of the test's own, as systemd would."""
+    RULES = {"water-detect": ("warn", 0)}
+
+    @classmethod
+    def setUpClass(cls):
+        cls.notify_dir = tempfile.mkdtemp(prefix="caracara-notify-")
+        cls.notify = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        cls.notify.bind(os.path.join(cls.notify_dir, "notify"))
+        cls.notify.settimeout(0.05)
+        os.environ["NOTIFY_SOCKET"] = os.path.join(cls.notify_dir, "notify")
+        try:
+            super().setUpClass()
+        finally:
+            del os.environ["NOTIFY_SOCKET"]
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.notify.close()
+        os.unlink(os.path.join(cls.notify_dir, "notify"))
+        os.rmdir(cls.notify_dir)
+
+    def status_lines(self):
+        out = []
+        while True:
+            try:
+                msg = self.notify.recv(4096).decode()
+            except socket.timeout:
+                return out
+            out += [line[len("STATUS="):] for line in msg.splitlines() if line.startswith("STATUS=")]
+
+    def test_the_status_line_names_the_failsafe(self):
+        rig = self.rig
+        rig.reset()
+        self.status_lines()
+        self.fault(3, "water-detect", True)
+        try:
+            self.signals.wait(("water-detect", "warn", 3))
+            seen = []
+            poll(lambda: seen.extend(self.status_lines()) or
+                 any("FAILSAFE water-detect warn thruster 3" in s for s in seen), 5,
+                 message="STATUS= never named the failsafe")
+        finally:
+            self.fault(3, "water-detect", False)
+        poll(lambda: self.failsafes() == [], 10)
+        seen = []
+        poll(lambda: seen.extend(self.status_lines()) or (seen and "FAILSAFE" not in seen[-1]), 5,
+             message="STATUS= kept the failsafe")
 
 
 class FixedConditionTest(FailsafeCase):
