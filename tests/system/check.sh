@@ -371,7 +371,7 @@ check "tester: caracaractl status exits 0" as tester caracaractl status
 check "tester: reads the simulator's wire log" allowed tester $S $SP $S GetWireLog t 0
 for call in "SetThrust ai 8 1000 0 0 0 0 0 0 0" "SetMotion dddddd 0.1 0 0 0 0 0" \
             "ApplyPacket ai 13 0 0 0 0 0 0 0 0 0 0 0 0 0" "Kill" "ClearKill" "PowerOff s power-off" \
-            "SetLeds yyy 1 2 3"; do
+            "SetLeds yyy 1 2 3" "ClearKillOverride s water-detect"; do
   # shellcheck disable=SC2086
   check "tester: $V.${call%% *} refused by the policy" denied tester $V $VP $V $call
 done
