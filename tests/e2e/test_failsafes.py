@@ -263,6 +263,13 @@ class KillAndOverrideTest(FailsafeCase):
             self.assertEqual(error_name(rig.vcall, "ClearKillOverride", "stall", signature="s"),
                              ERR + "FailsafeActive")
             self.assertEqual(error_name(rig.vcall, "ClearKillOverride", "leak", signature="s"), ERR + "InvalidValue")
+            r = rig.ctl("clear-kill")
+            self.assertEqual(r.returncode, 1)
+            self.assertIn(ERR + "FailsafeActive", r.stderr)
+            self.assertIn('ClearKillOverride("hall")', r.stderr)  # the way out, named
+            r = rig.ctl("clear-kill-override", "stall")
+            self.assertEqual(r.returncode, 1)
+            self.assertIn(ERR + "FailsafeActive", r.stderr)
             self.assertEqual(rig.state(), "killed")
             me = rig.conn.get_unique_name()
             rig.vcall("ClearKillOverride", "hall", signature="s")
