@@ -64,8 +64,7 @@ void FailsafeMonitor::poll(uint64_t now) {
 void FailsafeMonitor::tell(const FailsafeTransitions& ts) {
     for (const FailsafeTransition& t : ts) {
         if (t.raised)
-            log_warning("FAILSAFE %s: %s held for %u ms", describe(t.failsafe).c_str(),
-                        std::string(condition_name(t.failsafe.condition)).c_str(),
+            log_warning("FAILSAFE %s: the condition held for %u ms", describe(t.failsafe).c_str(),
                         settings_.rule(t.failsafe.condition).persistence_ms);
         else
             log_notice("failsafe %s cleared: the condition is gone%s", describe(t.failsafe).c_str(),
