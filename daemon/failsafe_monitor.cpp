@@ -128,7 +128,9 @@ Result FailsafeMonitor::clear_kill_refusal() const {
     // The fixed ones are refused where they arise, by name (BusLost, ThrusterUnreachable), and
     // at once when they end, not at this object's next reading.
     std::vector<ActiveFailsafe> b = policy_.blocking();
-    std::erase_if(b, [](const ActiveFailsafe& f) { return condition_is_fixed(f.condition); });
+    std::erase_if(b, [this](const ActiveFailsafe& f) {
+        return condition_is_fixed(f.condition) || (overriding_ && f.condition == *overriding_);
+    });
     if (b.empty())
         return {};
     std::string m = "a failsafe holds: ";
@@ -145,17 +147,18 @@ Result FailsafeMonitor::clear_kill_override(std::string_view condition, std::str
         return {Status::InvalidValue, "no failsafe condition \"" + std::string(condition) + "\""};
     if (condition_is_fixed(*c))
         return {Status::FailsafeActive, std::string(condition) + " is fixed at kill: it cannot be overridden"};
-    // Only the named condition: another that holds still refuses.
-    for (const ActiveFailsafe& f : policy_.blocking())
-        if (f.condition != *c)
-            return {Status::FailsafeActive, "a failsafe of another condition holds: " + describe(f)};
-    const std::size_t n = policy_.override_condition(*c);
-    if (n)
+    // ClearKill with the named condition's failsafes set aside (another that holds still
+    // refuses); they are overridden only when it clears the kill: a refused call changes nothing.
+    overriding_ = *c;
+    Result r = vehicle_.clear_kill();
+    overriding_.reset();
+    if (!r.ok())
+        return r;
+    if (policy_.override_condition(*c)) {
         log_warning("FAILSAFE OVERRIDE: %s named %s in ClearKillOverride; it only warns until it clears",
                     std::string(caller).c_str(), std::string(condition).c_str());
-    Result r = vehicle_.clear_kill();
-    if (n)
         events_.changed(kChangeFailsafes);
+    }
     return r;
 }
 

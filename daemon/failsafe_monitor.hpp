@@ -68,7 +68,8 @@ private:
     SourcePtr timer_;
     uint64_t period_us_;
     std::array<bool, kMotorCount> excluded_{};
-    uint64_t surface_until_ = 0; // 0: not surfacing
+    std::optional<FailsafeCondition> overriding_; // set aside during ClearKillOverride's ClearKill
+    uint64_t surface_until_ = 0;                  // 0: not surfacing
     std::string surface_reason_;
 };
 

@@ -321,6 +321,10 @@ class SurfaceTest(FailsafeCase):
             rig.wait_sim_speeds(ascent)
             self.assertEqual(error_name(rig.thrust, [1000] * MOTORS), ERR + "Surfacing")
             self.assertEqual(error_name(rig.motion, y=0.5), ERR + "Surfacing")
+            # Nothing to clear yet: refused, and the failsafe is not overridden by the attempt.
+            self.assertEqual(error_name(rig.vcall, "ClearKillOverride", "water-detect", signature="s"),
+                             ERR + "NotKilled")
+            self.assertEqual(self.failsafes(), [("water-detect", "surface", 3)])
             self.assertIn("SURFACING (water-detect surface thruster 3)", rig.log())
             rig.wait_state("killed", timeout=10)
             self.assertEqual(rig.vget("KillSource"), "failsafe")
