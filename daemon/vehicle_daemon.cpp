@@ -27,6 +27,7 @@ std::array<bool, kFailsafeConditionCount> VehicleDaemon::fixed_conditions() cons
     std::array<bool, kFailsafeConditionCount> c{};
     c[static_cast<std::size_t>(FailsafeCondition::BusLost)] = bus_.telemetry().state == BusState::Lost;
     c[static_cast<std::size_t>(FailsafeCondition::ThrusterUnreachable)] = bus_.first_unreachable().has_value();
+    c[static_cast<std::size_t>(FailsafeCondition::KillSwitchUnreadable)] = lines_.kill_switch_unreadable();
     return c;
 }
 

@@ -58,8 +58,9 @@ public:
 private:
     // Thruster i's last good status reply, for the failsafes; nullopt while it does not answer.
     std::optional<FailsafeReading> reading(std::size_t i) const;
-    // The fixed conditions the daemon can tell today: bus lost, a thruster unreachable. (Pilot
-    // lost zeroes without a kill; the Teensy link and kill switch lines kill as "device".)
+    // The fixed conditions the daemon can tell today: bus lost, a thruster unreachable, the kill
+    // switch unreadable. (Pilot lost zeroes without a kill; a Teensy link that goes away kills
+    // as "device" but is not told as a failsafe yet.)
     std::array<bool, kFailsafeConditionCount> fixed_conditions() const;
 
     sd_event* event_;

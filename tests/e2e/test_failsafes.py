@@ -469,6 +469,22 @@ class FixedConditionTest(FailsafeCase):
         rig.wait_state("ready")
 
 
+    def test_an_unreadable_kill_switch_is_told_as_a_failsafe(self):
+        rig = self.rig
+        rig.reset()
+        sim = rig.procs.pop("caracara-sim")  # the lines and the bus go with it
+        sim.kill()
+        sim.wait(10)
+        self.signals.wait(("kill-switch-unreadable", "kill", -1))
+        self.assertEqual(rig.state(), "killed")
+        self.assertIn(("kill-switch-unreadable", "kill", -1), self.failsafes())
+        rig.start_sim()
+        poll(lambda: ("kill-switch-unreadable", "kill", -1) not in self.failsafes(), 15,
+             message="the switch read again did not clear the failsafe")
+        poll(lambda: error_name(rig.vcall, "ClearKill") is None, 15)
+        rig.wait_state("ready")
+
+
 class ConfigCheckTest(unittest.TestCase):
     def test_weakening_a_fixed_failsafe_is_refused_by_name(self):
         rig = Rig(control=CONTROL, extra_config={"failsafe": {"bus-lost": {"action": "warn"}}})
