@@ -1,5 +1,6 @@
 #include "core/config.hpp"
 
+#include "core/failsafe_config.hpp"
 #include "core/hex.hpp"
 #include "core/toml_checker.hpp"
 
@@ -403,7 +404,8 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     Checker c;
     DaemonConfig cfg;
     // [sim] belongs to caracara-sim, which reads the same file; it is not checked here.
-    c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "recorder", "sim"});
+    c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "recorder", "failsafe",
+                       "sim"});
     if (const toml::table* t = c.table(root, "", "i2c"))
         parse_i2c(c, *t, cfg.i2c);
     if (const toml::table* t = c.table(root, "", "spi"))
@@ -421,6 +423,8 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
         parse_profiles(c, *t, cfg.profiles);
     if (const toml::table* t = c.table(root, "", "recorder"))
         parse_recorder(c, *t, cfg.recorder);
+    if (const toml::table* t = c.table(root, "", "failsafe"))
+        parse_failsafe(c, *t, cfg.failsafe);
     c.table(root, "", "sim");
     if (!cfg.profiles.empty() && !find_profile(cfg, cfg.control.profile)) {
         c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + profile_names(cfg),

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "core/budget.hpp"
+#include "core/failsafe.hpp"
 #include "core/mixing.hpp"
 #include "core/safety.hpp"
 #include "core/link_config.hpp"
@@ -108,6 +109,7 @@ struct DaemonConfig {
     GpioSettings gpio;
     RecoverySettings recovery;
     RecorderSettings recorder;
+    FailsafeSettings failsafe;
     std::vector<ThrustProfile> profiles{{"water", 1.0}};
 };
 

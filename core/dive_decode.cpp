@@ -13,7 +13,7 @@ namespace caracara::dive {
 namespace {
 
 constexpr uint8_t kMaxSafetyState = 3;  // SafetyState::PoweredOff
-constexpr uint8_t kMaxKillSource = 6;   // KillSource::Device
+constexpr uint8_t kMaxKillSource = 7;   // KillSource::Failsafe
 constexpr unsigned kMaxBusState = 2;    // BusState::Lost
 constexpr uint8_t kFaultBits = 0x1F;
 constexpr std::size_t kBlockHeader = 12;
@@ -61,7 +61,7 @@ bool read_event(ByteReader& r, Event& e) {
     e.number = r.f32();
     e.text = r.str(kMaxText);
     e.client = r.str(kMaxText);
-    if (r.failed() || kind < 1 || kind > static_cast<uint8_t>(EventKind::Profile))
+    if (r.failed() || kind < 1 || kind > static_cast<uint8_t>(EventKind::Failsafe))
         return false;
     e.kind = static_cast<EventKind>(kind);
     return e.state <= kMaxSafetyState && e.kill_source <= kMaxKillSource && e.thruster < kThrusters &&

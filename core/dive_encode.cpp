@@ -30,6 +30,7 @@ std::string_view event_kind_name(EventKind k) {
     case EventKind::BusLost: return "bus-lost";
     case EventKind::BusRestored: return "bus-restored";
     case EventKind::Profile: return "profile";
+    case EventKind::Failsafe: return "failsafe";
     }
     return "unknown";
 }

@@ -91,8 +91,12 @@ enum class EventKind : uint8_t {
     BusLost = 3,      // text = reason
     BusRestored = 4,  // value = SCL pulses, number = milliseconds
     Profile = 5,      // text = name, number = factor
+    Failsafe = 6,     // text = "<condition> <action>", thruster, value = kFailsafe* bits
 };
-std::string_view event_kind_name(EventKind k); // "state", "fault", "bus-lost", "bus-restored", "profile"
+// A failsafe event's value bits.
+inline constexpr uint32_t kFailsafeRaised = 1u << 0;  // raised (else cleared)
+inline constexpr uint32_t kFailsafeVehicle = 1u << 1; // the vehicle's own, not `thruster`'s
+std::string_view event_kind_name(EventKind k); // "state", "fault", "bus-lost", "bus-restored", "profile", "failsafe"
 
 struct Event {
     uint32_t t_100us = 0;

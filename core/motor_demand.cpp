@@ -8,7 +8,7 @@ MotorValues MotorDemand::scaled(const MotorValues& wanted) const {
     // The profile scales before the budget, so the budget holds whatever the profile.
     MotorValues m{};
     for (size_t i = 0; i < kMotorCount; ++i)
-        m[i] = static_cast<int32_t>(std::lround(wanted[i] * profile_->factor));
+        m[i] = excluded_[i] ? 0 : static_cast<int32_t>(std::lround(wanted[i] * profile_->factor));
     return m;
 }
 
@@ -26,6 +26,15 @@ bool MotorDemand::take(const MotorValues& wanted, const BudgetResult& b, bool mi
 
 bool MotorDemand::set_profile(const ThrustProfile& profile) {
     profile_ = &profile;
+    return reapply();
+}
+
+bool MotorDemand::set_excluded(const std::array<bool, kMotorCount>& excluded) {
+    excluded_ = excluded;
+    return reapply();
+}
+
+bool MotorDemand::reapply() {
     BudgetResult b = evaluate(requested_);
     if (!b.ok()) // under policy "reject" a command that no longer fits goes to zero, not the old factor
         b = apply_budget(MotorValues{}, policy_);

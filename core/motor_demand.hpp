@@ -8,6 +8,7 @@
 #include "core/config.hpp"
 #include "core/motor.hpp"
 
+#include <array>
 #include <cstdint>
 
 namespace caracara {
@@ -24,6 +25,9 @@ public:
     bool take(const MotorValues& wanted, const BudgetResult& b, bool mix_saturated);
     // A new profile: the standing command under it (zero if it no longer fits a "reject" budget).
     bool set_profile(const ThrustProfile& profile);
+    // Thrusters a failsafe excluded: ordered zero and so left out of the budget's count; the
+    // standing command goes out again without them (and with them once they are back).
+    bool set_excluded(const std::array<bool, kMotorCount>& excluded);
     // Kill, timeout, client gone: nothing stored resumes by itself.
     void clear();
 
@@ -32,8 +36,10 @@ public:
     int32_t limit() const { return limit_; }
     bool saturated() const { return saturated_; }
     const ThrustProfile& profile() const { return *profile_; }
+    const std::array<bool, kMotorCount>& excluded() const { return excluded_; }
 
 private:
+    bool reapply(); // the standing command again under the current profile and exclusions
     MotorValues scaled(const MotorValues& wanted) const;
 
     BudgetPolicy policy_;
@@ -43,6 +49,7 @@ private:
     int32_t limit_ = 0;
     bool saturated_ = false;
     bool mix_saturated_ = false;
+    std::array<bool, kMotorCount> excluded_{};
 };
 
 } // namespace caracara

@@ -21,6 +21,7 @@ std::string_view kill_source_name(KillSource s) {
     case KillSource::Fault: return "bus"; // the escalated fault is the I2C bus that could not be recovered
     case KillSource::Start: return "start";
     case KillSource::Device: return "device";
+    case KillSource::Failsafe: return "failsafe";
     }
     return "?";
 }

@@ -34,8 +34,9 @@ enum class KillSource {
     Fault,   // an escalated fault, e.g. the I2C bus could not be recovered
     Start,   // every start of the daemon, until someone decides to arm it (ClearKill)
     Device,  // a line or device the daemon drives went away (kill/power-off output, the Teensy's SPI)
+    Failsafe, // a failsafe's kill, or the end of its ascent (core/failsafe_policy)
 };
-// "none", "dbus", "switch", "packet", "bus", "start", "device"
+// "none", "dbus", "switch", "packet", "bus", "start", "device", "failsafe"
 std::string_view kill_source_name(KillSource s);
 
 enum class SafetyError {

@@ -22,6 +22,8 @@ std::string_view status_name(Status s) {
     case Status::UnknownProfile: return "UnknownProfile";
     case Status::BusLost: return "BusLost";
     case Status::ThrusterUnreachable: return "ThrusterUnreachable";
+    case Status::Surfacing: return "Surfacing";
+    case Status::FailsafeActive: return "FailsafeActive";
     }
     return "Hardware";
 }

@@ -27,6 +27,8 @@ enum class Status {
     UnknownProfile,
     BusLost,
     ThrusterUnreachable,
+    Surfacing,       // a failsafe's ascent is running: other motion waits for it (Kill does not)
+    FailsafeActive,  // ClearKill while the failsafe that killed still holds
 };
 std::string_view status_name(Status s); // "OutOfRange", ...
 

@@ -133,6 +133,17 @@ void DiveRecorder::vehicle_changed(uint32_t changes) {
                                                  : "killed (" + std::string(vehicle_.kill_source_name()) + ")");
 }
 
+void DiveRecorder::failsafe(const ActiveFailsafe& f, bool raised) {
+    if (!recording_)
+        return;
+    dive::Event e;
+    e.kind = dive::EventKind::Failsafe;
+    e.thruster = static_cast<uint8_t>(f.thruster < 0 ? 0 : f.thruster);
+    e.value = (raised ? dive::kFailsafeRaised : 0u) | (f.thruster < 0 ? dive::kFailsafeVehicle : 0u);
+    e.text = std::string(condition_name(f.condition)) + " " + std::string(action_name(f.effective()));
+    add_event(std::move(e), monotonic_ns());
+}
+
 void DiveRecorder::bus_lost(const std::string& reason) {
     if (!recording_)
         return;

@@ -38,6 +38,7 @@ public:
     void bus_lost(const std::string& reason) override;
     void bus_restored(uint32_t pulses, double milliseconds) override;
     void cycle(uint64_t now_ns) override;
+    void failsafe(const ActiveFailsafe& f, bool raised) override;
 
 private:
     void begin(uint64_t now_ns, const char* reason);

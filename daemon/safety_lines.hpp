@@ -48,6 +48,8 @@ public:
         kill_output_watcher_ = watcher;
         kill_output_changed();
     }
+    // A configured switch that cannot be read now (it counts as set meanwhile).
+    bool kill_switch_unreadable() const { return settings_.kill_switch && !kill_switch_; }
     // The switch's event fd (for the loop's "is anything waiting" check), or -1.
     int kill_switch_fd() const { return kill_switch_ ? kill_switch_->event_fd() : -1; }
 

@@ -13,6 +13,10 @@ void ServiceStatus::publish() const {
         for (Fault f : {Fault::WaterDetect, Fault::Overtemp})
             if (bus_.health().faults(i).has(f))
                 faults += "; thruster " + std::to_string(i) + " " + std::string(fault_name(f));
+    if (const std::string fs = failsafes_ ? failsafes_() : std::string(); !fs.empty())
+        faults += "; FAILSAFE " + fs;
+    if (vehicle_.surfacing())
+        faults += "; SURFACING";
     sd_notifyf(0, "STATUS=%s%s%s; profile %s; I2C bus %s; %zu thrusters%s", state.c_str(), ks.empty() ? "" : " by ",
                ks.c_str(), vehicle_.profile().name.c_str(), std::string(bus_state_name(bus_.monitor().telemetry().state)).c_str(),
                bus_.size(), faults.c_str());

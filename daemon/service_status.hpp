@@ -9,6 +9,7 @@
 #include "drivers/platform/event_loop.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace caracara {
@@ -19,11 +20,13 @@ public:
         : event_(event), vehicle_(vehicle), bus_(bus), loop_(loop) {}
 
     void publish() const;
-    // A change of state, bus, profile or faults shows on the STATUS= line.
+    // A change of state, bus, profile, faults or failsafes shows on the STATUS= line.
     void vehicle_changed(uint32_t changes) override {
-        if (changes & (kChangeState | kChangeBus | kChangeProfile | kChangeFaults))
+        if (changes & (kChangeState | kChangeBus | kChangeProfile | kChangeFaults | kChangeFailsafes))
             publish();
     }
+    // The active failsafes for the STATUS= line ("" when none).
+    void set_failsafe_summary(std::function<std::string()> summary) { failsafes_ = std::move(summary); }
     // Starts feeding the watchdog if systemd asked for one (WatchdogSec=).
     void start_watchdog();
     void ready(const char* bus_name) const;
@@ -38,6 +41,7 @@ private:
     const ControlLoop& loop_;
     uint64_t interval_us_ = 0;
     SourcePtr watchdog_;
+    std::function<std::string()> failsafes_;
 };
 
 } // namespace caracara

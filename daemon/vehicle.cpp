@@ -48,6 +48,8 @@ void Vehicle::handle(const SafetyAction& a) {
     // A kill reaches the kill output first: it is one GPIO write, and the zero orders behind it
     // are bus transfers that a hung device can delay. Releasing it (arming) waits for the zeros.
     const bool assert_first = a.state_changed && safety_.kill_output_asserted();
+    if (safety_.kill_output_asserted())
+        surfacing_ = false; // a kill ends an ascent at once
     if (assert_first) {
         bus_.hold_orders();
         lines_.set_kill_output(true);
@@ -115,6 +117,8 @@ void Vehicle::demand_changed() {
 }
 
 Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
+    if (surfacing_ && client != kFailsafeClient)
+        return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
     const BudgetResult b = demand_.evaluate(wanted);
     if (!b.ok())
         return {status_of(b.error), b.message};
@@ -133,6 +137,8 @@ Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std
 }
 
 Result Vehicle::accept_command(std::string_view client) {
+    if (surfacing_)
+        return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
     if (Result r = state_error(); !r.ok())
         return r;
     const std::string previous = safety_.commanding_client();
@@ -262,6 +268,9 @@ Result Vehicle::clear_kill() {
                     std::string(io_error_name(bus_.thruster(*i).last_error())) + "); the kill stays"};
     if (lines_.kill_output_missing() && safety_.state() == SafetyState::Killed)
         return {Status::Hardware, "the kill output line is gone (asked for again once a second); the kill stays"};
+    if (failsafe_gate_ && safety_.state() == SafetyState::Killed)
+        if (Result r = failsafe_gate_->clear_kill_refusal(); !r.ok())
+            return r;
     SafetyAction a = safety_.clear_kill(monotonic_ns());
     if (!a.ok())
         return {status_of(a.error), a.message};
@@ -285,6 +294,21 @@ Result Vehicle::power_off(std::string_view confirmation) {
     teensy_.stop_motion();
     teensy_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
+}
+
+void Vehicle::exclude(const std::array<bool, kMotorCount>& excluded) {
+    const bool changed = demand_.set_excluded(excluded);
+    demand_changed();
+    events_.changed(changed ? kChangeMotors : 0u);
+}
+
+Result Vehicle::surface(const AxisDemand& ascent) {
+    MixResult mr = mix(ascent, config_.mixing);
+    if (mr.error != MixError::None)
+        return {status_of(mr.error), mr.message};
+    Result r = accept_motors(mr.motors, mr.saturated, kFailsafeClient);
+    surfacing_ = r.ok();
+    return r;
 }
 
 Result Vehicle::set_leds(int red, int green, int blue) {

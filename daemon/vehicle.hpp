@@ -13,6 +13,7 @@
 #include "daemon/command_gate.hpp"
 #include "daemon/completion.hpp"
 #include "daemon/demand_listener.hpp"
+#include "daemon/failsafe_gate.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/teensy_port.hpp"
 #include "daemon/thruster_bus.hpp"
@@ -79,6 +80,17 @@ public:
     const std::string& controller_client() const { return safety_.commanding_client(); }
     const ThrustProfile& profile() const { return demand_.profile(); }
 
+    // Failsafes (daemon/failsafe_monitor decides, the Vehicle carries out).
+    static constexpr std::string_view kFailsafeClient = "failsafe"; // who drives an ascent
+    void set_failsafe_gate(const FailsafeGate* gate) { failsafe_gate_ = gate; }
+    // These thrusters to zero and out of the budget's count; the standing command goes on.
+    void exclude(const std::array<bool, kMotorCount>& excluded);
+    // The ascent, through the mixing and the budget, as client kFailsafeClient (called again
+    // to keep it past the command timeout); every other motion command gets Surfacing until
+    // a kill ends it.
+    Result surface(const AxisDemand& ascent);
+    bool surfacing() const { return surfacing_; }
+
 private:
     static int on_deadline(sd_event_source*, uint64_t usec, void* userdata);
     Result apply_packet(std::span<const int32_t> words, std::string_view client);
@@ -101,6 +113,8 @@ private:
     uint64_t deadline_at_ = SafetyMachine::kNoDeadline; // what deadline_ is armed for
 
     MotorDemand demand_;
+    const FailsafeGate* failsafe_gate_ = nullptr;
+    bool surfacing_ = false;
 };
 
 } // namespace caracara

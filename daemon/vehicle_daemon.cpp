@@ -14,10 +14,31 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, Gp
       vehicle_(config_, bus_, lines_, teensy_, events_),
       loop_(event, config_.control, vehicle_, bus_, teensy_, lines_, events_),
       recovery_(event, config_, io, gpio, bus_, loop_, vehicle_, events_),
-      status_(event, vehicle_, bus_, loop_) {
+      status_(event, vehicle_, bus_, loop_),
+      failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); },
+                 [this] { return fixed_conditions(); }, vehicle_, events_) {
     vehicle_.set_demand_listener(&loop_);
     bus_.monitor().set_listener(&recovery_);
     events_.attach_status(&status_);
+    status_.set_failsafe_summary([this] { return failsafes_.summary(); });
+}
+
+std::array<bool, kFailsafeConditionCount> VehicleDaemon::fixed_conditions() const {
+    std::array<bool, kFailsafeConditionCount> c{};
+    c[static_cast<std::size_t>(FailsafeCondition::BusLost)] = bus_.monitor().telemetry().state == BusState::Lost;
+    c[static_cast<std::size_t>(FailsafeCondition::ThrusterUnreachable)] = bus_.health().first_unreachable().has_value();
+    c[static_cast<std::size_t>(FailsafeCondition::KillSwitchUnreadable)] = lines_.kill_switch_unreadable();
+    return c;
+}
+
+std::optional<FailsafeReading> VehicleDaemon::reading(std::size_t i) const {
+    const auto& st = bus_.thruster(i).last_status();
+    if (!st || !bus_.thruster(i).online())
+        return std::nullopt;
+    FailsafeReading r{st->faults.bits, std::nullopt};
+    if (st->variant == Variant::SeaBotix)
+        r.temperature_c = st->seabotix.temperature_c;
+    return r;
 }
 
 std::string VehicleDaemon::start() {
@@ -47,6 +68,8 @@ std::string VehicleDaemon::start() {
     }
     if (std::string e = loop_.start(); !e.empty())
         return e;
+    if (std::string e = failsafes_.start(); !e.empty())
+        return e;
     started_ = true;
     return {};
 }
@@ -63,6 +86,7 @@ void VehicleDaemon::shutdown() {
     started_ = false;
     bus_.health().set_gate(nullptr);
     loop_.stop();
+    failsafes_.stop();
     if (recorder_) {
         recorder_->stop(); // the dive ends here, before the zeros of the way out
         events_.attach_recorder(nullptr);

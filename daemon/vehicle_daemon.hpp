@@ -8,6 +8,7 @@
 #include "daemon/control_loop.hpp"
 #include "daemon/dive_recorder.hpp"
 #include "daemon/dive_writer.hpp"
+#include "daemon/failsafe_monitor.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/service_status.hpp"
 #include "daemon/teensy_port.hpp"
@@ -52,10 +53,19 @@ public:
     ControlLoop& loop() { return loop_; }
     const ControlLoop& loop() const { return loop_; }
     ServiceStatus& status() { return status_; }
+    FailsafeMonitor& failsafes() { return failsafes_; }
+    const FailsafeMonitor& failsafes() const { return failsafes_; }
     // The dive recorder, or nullptr when recorder.enabled is false.
     const DiveRecorder* recorder() const { return recorder_.get(); }
 
 private:
+    // Thruster i's last good status reply, for the failsafes; nullopt while it does not answer.
+    std::optional<FailsafeReading> reading(std::size_t i) const;
+    // The fixed conditions the daemon can tell today: bus lost, a thruster unreachable, the kill
+    // switch unreadable. (Pilot lost zeroes without a kill; a Teensy link that goes away kills
+    // as "device" but is not told as a failsafe yet.)
+    std::array<bool, kFailsafeConditionCount> fixed_conditions() const;
+
     sd_event* event_;
     DaemonConfig config_;
     VehicleEvents events_;
@@ -66,6 +76,7 @@ private:
     ControlLoop loop_;
     BusRecovery recovery_;
     ServiceStatus status_;
+    FailsafeMonitor failsafes_;
     std::unique_ptr<DiveWriter> dive_writer_;
     std::unique_ptr<DiveRecorder> recorder_;
     bool started_ = false;

@@ -41,6 +41,12 @@ public:
                 o->bus_restored(pulses, milliseconds);
     }
 
+    void failsafe(const ActiveFailsafe& f, bool raised) {
+        for (VehicleObserver* o : {recorder_, observer_})
+            if (o)
+                o->failsafe(f, raised);
+    }
+
 private:
     VehicleObserver* observer_ = nullptr;
     VehicleObserver* recorder_ = nullptr;

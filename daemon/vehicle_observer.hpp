@@ -3,6 +3,8 @@
 // the I2C bus going and coming back.
 #pragma once
 
+#include "core/failsafe_policy.hpp"
+
 #include <cstdint>
 #include <string>
 
@@ -17,6 +19,7 @@ enum VehicleChange : uint32_t {
     kChangeBus = 1u << 4,        // the Bus object's State and recovery figures
     kChangeProfile = 1u << 5,    // Profile, ProfileFactor
     kChangeFaults = 1u << 6,     // a thruster's fault bits (its Faults property goes with telemetry)
+    kChangeFailsafes = 1u << 7,  // Failsafes (the active ones)
 };
 
 class VehicleObserver {
@@ -31,6 +34,8 @@ public:
     virtual void bus_restored(uint32_t /*pulses*/, double /*milliseconds*/) {}
     // Every control-loop cycle (the dive recorder's samples).
     virtual void cycle(uint64_t /*now_ns*/) {}
+    // A failsafe was raised or its condition cleared (daemon/failsafe_monitor).
+    virtual void failsafe(const ActiveFailsafe& /*f*/, bool /*raised*/) {}
 };
 
 } // namespace caracara

@@ -57,6 +57,20 @@ int m_kill(sd_bus_message* m, void* userdata, sd_bus_error*) {
 
 int m_clear_kill(sd_bus_message* m, void* userdata, sd_bus_error*) { return reply(m, ctl(userdata).clear_kill()); }
 
+int m_clear_kill_override(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    const char* condition = nullptr;
+    if (int r = sd_bus_message_read(m, "s", &condition); r < 0)
+        return r;
+    return reply(m, static_cast<Parts*>(userdata)->failsafes.clear_kill_override(condition, sender(m)));
+}
+
+std::vector<std::tuple<std::string, std::string, int32_t>> failsafes(const Parts& d) {
+    std::vector<std::tuple<std::string, std::string, int32_t>> out;
+    for (const ActiveFailsafe& f : d.failsafes.active())
+        out.emplace_back(condition_name(f.condition), action_name(f.effective()), f.thruster);
+    return out;
+}
+
 int m_power_off(sd_bus_message* m, void* userdata, sd_bus_error*) {
     const char* confirmation = nullptr;
     if (int r = sd_bus_message_read(m, "s", &confirmation); r < 0)
@@ -89,6 +103,10 @@ constexpr Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("ApplyPacket", SD_BUS_ARGS("ai", packet), SD_BUS_NO_RESULT, m_apply_packet, kUnpriv)),
     member(SD_BUS_METHOD("Kill", "", "", m_kill, kUnpriv)),
     member(SD_BUS_METHOD("ClearKill", "", "", m_clear_kill, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("ClearKillOverride", SD_BUS_ARGS("s", condition), SD_BUS_NO_RESULT,
+                                   m_clear_kill_override, kUnpriv)),
+    member(SD_BUS_SIGNAL_WITH_ARGS("Failsafe", SD_BUS_ARGS("s", condition, "s", action, "i", thruster), 0)),
+    property<[](D d) { return failsafes(d); }>("Failsafes", kChange, kChangeFailsafes),
     member(SD_BUS_METHOD_WITH_ARGS("PowerOff", SD_BUS_ARGS("s", confirmation), SD_BUS_NO_RESULT, m_power_off, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
                                    kUnpriv)),
@@ -116,5 +134,11 @@ constexpr auto kVtable = vtable(kMembers);
 
 VehicleObject::VehicleObject(sd_bus* bus, const Parts& parts)
     : parts_(parts), object_(bus, kRootPath, kVehicleIface, kMembers, kVtable, &parts_) {}
+
+void VehicleObject::emit_failsafe(const ActiveFailsafe& f) {
+    sd_bus_emit_signal(object_.bus(), object_.path().c_str(), object_.iface(), "Failsafe", "ssi",
+                       std::string(condition_name(f.condition)).c_str(), std::string(action_name(f.effective())).c_str(),
+                       int32_t(f.thruster));
+}
 
 } // namespace caracara::dbus

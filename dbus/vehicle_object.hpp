@@ -3,6 +3,7 @@
 
 #include "core/config.hpp"
 #include "daemon/control_loop.hpp"
+#include "daemon/failsafe_monitor.hpp"
 #include "daemon/teensy_port.hpp"
 #include "daemon/vehicle.hpp"
 #include "dbus/announced_object.hpp"
@@ -12,12 +13,13 @@ namespace caracara::dbus {
 class VehicleObject {
 public:
     // What the object drives and shows: the vehicle, the Teensy's LEDs, the loop's cycle
-    // count and the control settings.
+    // count, the control settings and the failsafes (active ones, ClearKillOverride).
     struct Parts {
         Vehicle& vehicle;
         const TeensyPort& teensy;
         const ControlLoop& loop;
         const ControlSettings& control;
+        FailsafeMonitor& failsafes;
     };
     VehicleObject(sd_bus* bus, const Parts& parts);
     VehicleObject(const VehicleObject&) = delete;
@@ -26,6 +28,8 @@ public:
     // Every property of the changes, changed or not: a command that sets the same values again
     // is still announced.
     void announce(uint32_t changes) { object_.announce(changes, AnnouncedObject::When::Always); }
+    // The Failsafe signal: one raised.
+    void emit_failsafe(const ActiveFailsafe& f);
 
 private:
     Parts parts_; // the methods' and properties' userdata

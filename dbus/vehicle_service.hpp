@@ -29,6 +29,10 @@ public:
     void telemetry() override { announcer_.request(kTelemetryTick); }
     void bus_lost(const std::string& reason) override { bus_object_.emit_lost(reason); }
     void bus_restored(uint32_t pulses, double milliseconds) override { bus_object_.emit_restored(pulses, milliseconds); }
+    void failsafe(const ActiveFailsafe& f, bool raised) override {
+        if (raised)
+            vehicle_.emit_failsafe(f);
+    }
 
 private:
     void announce(uint32_t changes);

@@ -59,6 +59,20 @@ int m_set_hang(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return sd_bus_reply_method_return(m, "");
 }
 
+// The motor's temperature and the water's it tends to: water at the motor's temperature holds it
+// there (a stopped motor does not heat), for overtemp's 110/100 C hysteresis (SeaBotix IDS
+// 8.4.2 remark 6).
+int m_set_temperature(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    double motor = 0, water = 0;
+    if (int r = sd_bus_message_read(m, "dd", &motor, &water); r < 0)
+        return r;
+    if (!(motor >= -5 && motor <= 255 && water >= -5 && water <= 255))
+        return sd_bus_error_setf(err, kInspectInvalid, "temperatures must be -5..255 C");
+    thruster(userdata).set_temperature(motor);
+    thruster(userdata).set_water_temperature(water);
+    return sd_bus_reply_method_return(m, "");
+}
+
 int m_power_cycle(sd_bus_message* m, void* userdata, sd_bus_error*) {
     thruster(userdata).power_cycle();
     return sd_bus_reply_method_return(m, "");
@@ -90,6 +104,8 @@ constexpr dbus::Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("CorruptReplies", SD_BUS_ARGS("u", count, "s", how), SD_BUS_NO_RESULT, m_corrupt, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetHang", SD_BUS_ARGS("u", ms), SD_BUS_NO_RESULT, m_set_hang, kUnpriv)),
     member(SD_BUS_METHOD("PowerCycle", "", "", m_power_cycle, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetTemperature", SD_BUS_ARGS("d", motor, "d", water), SD_BUS_NO_RESULT,
+                                   m_set_temperature, kUnpriv)),
 };
 constexpr auto kVtable = dbus::vtable(kMembers);
 

@@ -64,6 +64,8 @@ public:
     };
     void replay(const std::optional<Replayed>& r) { replayed_ = r; }
     void set_water_temperature(double c) { water_temp_c_ = c; }
+    // The motor's temperature now (it heats and cools from there); overtemp follows at the next step.
+    void set_temperature(double c) { temperature_c_ = c; }
 
     // Inspection.
     const ThrusterSpec& spec() const { return spec_; }

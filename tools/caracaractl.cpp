@@ -143,6 +143,11 @@ int cmd_clear_kill(Client& c, const Args&, const Options&) {
     return kExitOk;
 }
 
+int cmd_clear_kill_override(Client& c, const Args& a, const Options&) {
+    c.call(kRootPath, kVehicleIface, "ClearKillOverride", append_args("s", a[0].c_str()));
+    return kExitOk;
+}
+
 int cmd_profile(Client& c, const Args& a, const Options&) {
     c.call(kRootPath, kVehicleIface, "SetProfile", append_args("s", a[0].c_str()));
     return kExitOk;
@@ -235,6 +240,9 @@ constexpr Command kCommands[] = {
     {"kill", "", "Zero every thruster at once and latch the kill", 0, cmd_kill},
     {"clear-kill", "", "Clear the kill, e.g. the one every start comes up with (arming, then ready)", 0,
      cmd_clear_kill},
+    {"clear-kill-override", "CONDITION",
+     "Clear a failsafe's kill while its condition (e.g. water-detect) still holds, deliberately", 1,
+     cmd_clear_kill_override},
     {"profile", "NAME", "Select a thrust profile (a scale factor, e.g. water, air)", 1, cmd_profile},
     {"leds", "R G B", "Set the LED colour (0..255 each)", 3, cmd_leds},
     {"power-off", "[--yes-power-off]", "Power the vehicle off, irreversibly (asks to confirm)", 0, cmd_power_off,

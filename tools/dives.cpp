@@ -143,6 +143,9 @@ std::string describe(const dive::Event& e) {
     case dive::EventKind::BusLost: return "reason=" + e.text;
     case dive::EventKind::BusRestored: return strf("pulses=%u ms=%.1f", e.value, e.number);
     case dive::EventKind::Profile: return strf("%s factor=%g", e.text.c_str(), e.number);
+    case dive::EventKind::Failsafe:
+        return strf("%s %s%s", e.text.c_str(), (e.value & dive::kFailsafeRaised) ? "raised" : "cleared",
+                    (e.value & dive::kFailsafeVehicle) ? "" : strf(" thruster=%u", e.thruster).c_str());
     }
     return "";
 }

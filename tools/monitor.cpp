@@ -82,6 +82,19 @@ int on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
     });
 }
 
+// The daemon's Failsafe signal: a failsafe raised, said in words.
+int on_failsafe(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto& mon = *static_cast<Monitor*>(userdata);
+    return guarded(mon, [&] {
+        const char *condition = nullptr, *action = nullptr;
+        int32_t thruster = -1;
+        if (sd_bus_message_read(m, "ssi", &condition, &action, &thruster) < 0)
+            return;
+        print_line(std::string("FAILSAFE ") + condition + " -> " + action +
+                   (thruster >= 0 ? " (thruster " + std::to_string(thruster) + ")" : std::string()));
+    });
+}
+
 int on_name_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
     auto& mon = *static_cast<Monitor*>(userdata);
     const char *name = nullptr, *old_owner = nullptr, *new_owner = nullptr;
@@ -158,6 +171,10 @@ int run_monitor(Client& client, bool all) {
     caracara::dbus::SlotPtr changes_slot(raw_slot);
     check(sd_bus_add_match(bus, &raw_slot, owner.c_str(), on_name_owner_changed, &mon), "cannot subscribe");
     caracara::dbus::SlotPtr owner_slot(raw_slot);
+    const std::string failsafe = std::string("type='signal',sender='") + kService + "',path='" + kRootPath +
+                                 "',interface='" + kVehicleIface + "',member='Failsafe'";
+    check(sd_bus_add_match(bus, &raw_slot, failsafe.c_str(), on_failsafe, &mon), "cannot subscribe");
+    caracara::dbus::SlotPtr failsafe_slot(raw_slot);
     check(sd_bus_add_filter(bus, &raw_slot, on_message, &mon), "cannot watch the connection");
     caracara::dbus::SlotPtr filter_slot(raw_slot);
 

@@ -78,6 +78,13 @@ void print_vehicle(std::ostream& out, const Props& v) {
     if (source == "start")
         shown += "; every start comes up killed: `caracaractl clear-kill` arms it";
     key_line(out, "State", shown);
+    // (condition, action, thruster) of each active failsafe.
+    key_line(out, "Failsafes", join(prop(v, "Failsafes"), ", ", [](const Value& f) {
+        if (f.items.size() != 3)
+            return render(f);
+        const int64_t t = f.items[2].integer();
+        return f.items[0].s + " " + f.items[1].s + (t >= 0 ? strf(" (thruster %lld)", static_cast<long long>(t)) : "");
+    }, "none"));
     const std::string controller = prop(v, "Controller").s;
     key_line(out, "Controller", controller.empty() ? "none" : controller);
     auto values = [](const Value& list) { return join(list, " ", [](const Value& x) { return render(x); }); };

@@ -79,6 +79,8 @@ class FaultsToldTest(VehicleTestCase):
     """A thruster fault that appears or clears is logged once, not once per status read, and
     water detect and over-temperature are spelt out by caracaractl status."""
     CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 60000, "status_reads_per_tick": 8}
+    # Told, not acted on: the default failsafe (surface after 2 s) is e2e_failsafes' to judge.
+    EXTRA_CONFIG = {"failsafe": {"water-detect": {"action": "warn"}}}
 
     def test_water_detect_logged_once_and_shown(self):
         rig = self.rig

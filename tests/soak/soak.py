@@ -48,6 +48,12 @@ VEHICLE = "org.caracara.Vehicle1"
 PATH = "/org/caracara/Vehicle1"
 
 
+# The soak's books are the bus's: every accepted command on the wire. Its fault bits are noise
+# for the bus to carry (a latched ground fault would otherwise exclude its thruster for good);
+# the failsafes' own actions are e2e_failsafes' to judge.
+FAILSAFE_WARN = {c: {"action": "warn"} for c in ("water-detect", "ground-fault", "overtemp", "stall", "hall")}
+
+
 class SoakRig(Rig):
     """The simulator with a wire log large enough for the soak's drains to keep up."""
 
@@ -79,7 +85,7 @@ class Soak:
         self.args = args
         self.rng = random.Random(args.seed)
         self.rig = SoakRig(control={"arming_delay_ms": 100, "command_timeout_ms": TIMEOUT_MS, "loop_rate_hz": args.loop_rate},
-                       gpio=False, extra_config={"gpio": GPIO, "recovery": RECOVERY})
+                       gpio=False, extra_config={"gpio": GPIO, "recovery": RECOVERY, "failsafe": FAILSAFE_WARN})
         self.commands = []   # (t_sent, speeds) of accepted SetThrust calls
         self.excused = []    # (t0, t1, thruster or None): faults during which orders may not arrive
         self.pauses = []     # (t_pause, t_resume)

@@ -345,7 +345,7 @@ check "tester: caracaractl status exits 0" as tester caracaractl status
 check "tester: reads the simulator's wire log" allowed tester $S $SP $S GetWireLog t 0
 for call in "SetThrust ai 8 1000 0 0 0 0 0 0 0" "SetMotion dddddd 0.1 0 0 0 0 0" \
             "ApplyPacket ai 13 0 0 0 0 0 0 0 0 0 0 0 0 0" "Kill" "ClearKill" "PowerOff s power-off" \
-            "SetLeds yyy 1 2 3"; do
+            "SetLeds yyy 1 2 3" "ClearKillOverride s water-detect"; do
   # shellcheck disable=SC2086
   check "tester: $V.${call%% *} refused by the policy" denied tester $V $VP $V $call
 done
@@ -417,6 +417,9 @@ check "root: ClearKill" busctl call $V $VP $V ClearKill
 check "ready again after the arming delay" wait_until 10 state_is ready
 
 # --- 9b. a thruster fault is told: STATUS= and the journal's THRUSTER=/FAULT= fields, once ---------
+# Killed first: held past its persistence time, water detect's default failsafe (surface) would
+# start an ascent here whatever this section takes; killed, it has nothing to drive.
+busctl call $V $VP $V Kill
 busctl call $S "$SP/thruster/2" $ST SetFault sb water-detect true
 status_has_water() { unit caracarad StatusText | grep -q "thruster 2 water-detect"; }
 check "water detect on thruster 2 shows on the Status: line ($(unit caracarad StatusText))" wait_until 10 status_has_water
@@ -429,6 +432,9 @@ ncleared=$(journalctl --no-pager -o cat THRUSTER=2 FAULT=water-detect FAULT_STAT
 once_each_way() { [ "$nraised" = 1 ] && [ "$ncleared" = 1 ]; }
 check "the journal has it once each way with THRUSTER=2 FAULT=water-detect (raised $nraised, cleared $ncleared)" \
   once_each_way
+clear_kill_ok() { busctl call $V $VP $V ClearKill >/dev/null 2>&1; }
+check "ClearKill once the water is gone" wait_until 10 clear_kill_ok
+check "ready again after the arming delay" wait_until 10 state_is ready
 
 # --- 10. systemctl stop leaves the thrusters at zero ----------------------------------------------------
 hold 1000

@@ -162,3 +162,27 @@ TEST_CASE("[recorder] configuration") {
     CHECK(bad.error().find("recorder.max_total_mb") != std::string::npos);
     CHECK(bad.error().find("unknown key 'recorder.size'") != std::string::npos);
 }
+
+TEST_CASE("a failsafe event and the failsafe kill source read back; a kind beyond them is refused") {
+    dive::Dive d = sample_dive();
+    d.events.insert(d.events.end() - 1,
+                    {23700, dive::EventKind::Failsafe, 0, 0, 3, dive::kFailsafeRaised, 0, "water-detect surface", ""});
+    d.events.insert(d.events.end() - 1,
+                    {23750, dive::EventKind::Failsafe, 0, 0, 0, dive::kFailsafeRaised | dive::kFailsafeVehicle, 0,
+                     "bus-lost kill", ""});
+    d.events.back().kill_source = static_cast<uint8_t>(KillSource::Failsafe);
+    const dive::Dive r = dive::decode(encode(d));
+    REQUIRE(r.ok());
+    CHECK(r.events == d.events);
+    CHECK(dive::event_kind_name(r.events[4].kind) == "failsafe");
+
+    // One past the last kind: refused by name, what came before kept.
+    std::vector<uint8_t> records;
+    dive::Event bad = d.events[4];
+    dive::encode_event(records, bad);
+    records[1 + 2 + 4] = static_cast<uint8_t>(dive::EventKind::Failsafe) + 1; // kind, after the record header and t
+    std::vector<uint8_t> file = dive::encode_header(d.header);
+    const auto blk = dive::seal_block(records);
+    file.insert(file.end(), blk.begin(), blk.end());
+    CHECK_FALSE(dive::decode(file).ok());
+}

@@ -47,3 +47,28 @@ TEST_CASE("under policy reject a command that no longer fits a new profile goes 
     CHECK(d.set_profile(water)); // 8850 x5 is over budget: refused, so zero rather than 0.4
     CHECK(d.applied() == MotorValues{});
 }
+
+TEST_CASE("an excluded thruster is ordered zero and left out of the budget's count") {
+    const ThrustProfile water{"water", 1.0};
+    MotorDemand d(BudgetPolicy::Scale, water);
+    const MotorValues m{7000, 7000, 7000, 0, 0, 0, 0, 0};
+    CHECK(d.take(m, d.evaluate(m), false));
+    CHECK(d.applied() == MotorValues{5750, 5750, 5750, 0, 0, 0, 0, 0}); // three running
+    std::array<bool, kMotorCount> out{};
+    out[2] = true;
+    CHECK(d.set_excluded(out));
+    CHECK(d.applied() == MotorValues{7000, 7000, 0, 0, 0, 0, 0, 0}); // two running: 7850 allows 7000
+    CHECK(d.limit() == 7850);
+    CHECK(d.requested() == m);
+    // A new command while excluded stays without it; lifting the exclusion brings it back.
+    const MotorValues n{0, 0, 3000, 3000, 0, 0, 0, 0};
+    CHECK(d.take(n, d.evaluate(n), false));
+    CHECK(d.applied() == MotorValues{0, 0, 0, 3000, 0, 0, 0, 0});
+    CHECK(d.set_excluded({}));
+    CHECK(d.applied() == n);
+    // Cleared (a kill) keeps nothing, but the exclusion stays for the next command.
+    CHECK(d.set_excluded(out));
+    d.clear();
+    CHECK(d.take(m, d.evaluate(m), false));
+    CHECK(d.applied()[2] == 0);
+}

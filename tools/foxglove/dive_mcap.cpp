@@ -44,6 +44,19 @@ LogEvent log_of(const dive::Event& e, uint64_t time_ns, VehicleState& state) {
         log.message = text;
         break;
     }
+    case dive::EventKind::Failsafe: {
+        // The same words as the live bridge's log of the Failsafe signal (tools/bridge/telemetry.cpp).
+        const auto space = e.text.find(' ');
+        const std::string condition = e.text.substr(0, space);
+        const std::string action = space == std::string::npos ? "" : e.text.substr(space + 1);
+        const bool raised = e.value & dive::kFailsafeRaised;
+        log.name = "failsafe";
+        log.level = raised ? LogLevel::Warning : LogLevel::Info;
+        log.message = "failsafe: " + condition + " -> " + action +
+                      (e.value & dive::kFailsafeVehicle ? "" : " (thruster " + std::to_string(e.thruster) + ")") +
+                      (raised ? "" : " cleared");
+        break;
+    }
     case dive::EventKind::Profile:
         state.profile = e.text;
         state.profile_factor = e.number;

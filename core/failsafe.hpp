@@ -1,0 +1,80 @@
+// Failsafes: a condition, the action it takes and how long it must hold first (the
+// [failsafe] table; daemon/caracarad.toml.example gives the defaults and why). The five
+// thruster conditions are the SeaBotix FAULT bits (SeaBotix IDS 8.4.2); the other five are
+// the daemon's own safety conditions, fixed at kill.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace caracara {
+
+enum class FailsafeCondition : uint8_t {
+    // A thruster's FAULT bits (SeaBotix IDS 8.4.2).
+    WaterDetect,
+    GroundFault,
+    Overtemp,
+    Stall,
+    Hall,
+    // Fixed at kill: they protect people.
+    PilotLost,
+    ThrusterUnreachable,
+    BusLost,
+    TeensyLinkLost,
+    KillSwitchUnreadable,
+};
+inline constexpr std::size_t kFailsafeConditionCount = 10;
+inline constexpr std::size_t kThrusterConditionCount = 5; // WaterDetect..Hall
+inline constexpr std::array<FailsafeCondition, kThrusterConditionCount> kThrusterConditions{
+    FailsafeCondition::WaterDetect, FailsafeCondition::GroundFault, FailsafeCondition::Overtemp,
+    FailsafeCondition::Stall, FailsafeCondition::Hall};
+
+// In order of severity: when two conditions hold, the later action wins.
+enum class FailsafeAction : uint8_t { Warn, Exclude, Surface, Kill };
+
+// "water-detect", "ground-fault", "overtemp", "stall", "hall", "pilot-lost",
+// "thruster-unreachable", "bus-lost", "teensy-link-lost", "kill-switch-unreadable"
+std::string_view condition_name(FailsafeCondition c);
+std::optional<FailsafeCondition> condition_from_name(std::string_view name);
+std::string_view action_name(FailsafeAction a); // "warn", "exclude", "surface", "kill"
+std::optional<FailsafeAction> action_from_name(std::string_view name);
+
+// Fixed at kill; the config checker refuses a weaker action.
+constexpr bool condition_is_fixed(FailsafeCondition c) { return c >= FailsafeCondition::PilotLost; }
+// The FAULT bit of a thruster condition (SeaBotix IDS 8.4.2, word 2).
+uint8_t condition_fault_bit(FailsafeCondition c);
+
+// How a thruster condition ends, as the controller reports it (SeaBotix IDS 8.4.2 remarks):
+// water detect, stall and hall when the bit reads clear; ground fault only when power is cycled
+// (the controller keeps the bit until then, remark 3); overtemp sets at 110 C and clears at
+// 100 C (remark 6), which the policy applies to the TEMPERATURE byte as well as the bit.
+enum class FailsafeClearing { BitClear, PowerCycle, Hysteresis };
+FailsafeClearing condition_clearing(FailsafeCondition c);
+
+struct FailsafeRule {
+    FailsafeAction action = FailsafeAction::Warn;
+    uint32_t persistence_ms = 0; // the condition must hold this long before the action
+};
+
+// [failsafe.surface]: the ascent (a heave demand on the mixing's z axis, +deeper, so
+// negative is up) for a time, then a kill.
+struct SurfaceSettings {
+    double heave = -0.5;
+    uint32_t duration_ms = 15000;
+};
+
+struct FailsafeSettings {
+    std::array<FailsafeRule, kFailsafeConditionCount> rules = default_rules();
+    SurfaceSettings surface;
+    uint8_t overtemp_set_c = 110;   // SeaBotix IDS 8.4.2 remark 6
+    uint8_t overtemp_clear_c = 100;
+
+    const FailsafeRule& rule(FailsafeCondition c) const { return rules[static_cast<std::size_t>(c)]; }
+    FailsafeRule& rule(FailsafeCondition c) { return rules[static_cast<std::size_t>(c)]; }
+    static std::array<FailsafeRule, kFailsafeConditionCount> default_rules();
+};
+
+} // namespace caracara

@@ -1,0 +1,172 @@
+#include "daemon/failsafe_monitor.hpp"
+
+#include "core/clock.hpp"
+#include "daemon/log.hpp"
+#include "drivers/platform/io_error.hpp"
+
+#include <algorithm>
+
+namespace caracara {
+
+namespace {
+std::string describe(const ActiveFailsafe& f) {
+    std::string s = std::string(condition_name(f.condition)) + " " + std::string(action_name(f.effective()));
+    if (f.thruster >= 0)
+        s += " thruster " + std::to_string(f.thruster);
+    return s;
+}
+} // namespace
+
+FailsafeMonitor::FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters,
+                                 Readings readings, Conditions conditions, Vehicle& vehicle, VehicleEvents& events)
+    : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)),
+      conditions_(std::move(conditions)), vehicle_(vehicle), events_(events), policy_(settings, thrusters),
+      period_us_(std::max<uint64_t>(1000, std::min(kPeriodNs, vehicle.safety().config().command_timeout_ns / 2)) /
+                 1000) {}
+
+std::string FailsafeMonitor::start() {
+    sd_event_source* s = nullptr;
+    if (int r = sd_event_add_time_relative(event_, &s, CLOCK_MONOTONIC, period_us_, 1000, on_timer, this); r < 0)
+        return "sd_event_add_time_relative: " + errno_name(-r);
+    timer_.reset(s);
+    sd_event_source_set_enabled(s, SD_EVENT_ON);
+    vehicle_.set_failsafe_gate(this);
+    return {};
+}
+
+int FailsafeMonitor::on_timer(sd_event_source* s, uint64_t usec, void* userdata) {
+    auto* self = static_cast<FailsafeMonitor*>(userdata);
+    sd_event_source_set_time(s, usec + self->period_us_);
+    self->poll(monotonic_ns());
+    return 0;
+}
+
+void FailsafeMonitor::poll(uint64_t now) {
+    FailsafeTransitions ts;
+    for (std::size_t i = 0; i < thrusters_; ++i)
+        if (const auto r = readings_(i)) {
+            FailsafeTransitions t = policy_.observe(i, r->fault_bits, r->temperature_c, now);
+            ts.insert(ts.end(), t.begin(), t.end());
+        }
+    const auto holding = conditions_();
+    for (std::size_t c = 0; c < kFailsafeConditionCount; ++c)
+        if (condition_is_fixed(static_cast<FailsafeCondition>(c))) {
+            FailsafeTransitions t = policy_.set_condition(static_cast<FailsafeCondition>(c), holding[c], now);
+            ts.insert(ts.end(), t.begin(), t.end());
+        }
+    FailsafeTransitions due = policy_.tick(now);
+    ts.insert(ts.end(), due.begin(), due.end());
+    tell(ts);
+    carry_out(ts, now);
+    keep_surfacing(now);
+}
+
+void FailsafeMonitor::tell(const FailsafeTransitions& ts) {
+    for (const FailsafeTransition& t : ts) {
+        if (t.raised)
+            log_warning("FAILSAFE %s: the condition held for %u ms", describe(t.failsafe).c_str(),
+                        settings_.rule(t.failsafe.condition).persistence_ms);
+        else
+            log_notice("failsafe %s cleared: the condition is gone%s", describe(t.failsafe).c_str(),
+                       condition_clearing(t.failsafe.condition) == FailsafeClearing::PowerCycle
+                           ? " (the controller's power was cycled)"
+                           : "");
+        events_.failsafe(t.failsafe, t.raised);
+    }
+    if (!ts.empty())
+        events_.changed(kChangeFailsafes);
+}
+
+void FailsafeMonitor::carry_out(const FailsafeTransitions& ts, uint64_t now) {
+    std::array<bool, kMotorCount> excluded{};
+    for (std::size_t i = 0; i < thrusters_ && i < kMotorCount; ++i)
+        excluded[i] = policy_.excluded(i);
+    if (excluded != excluded_) {
+        excluded_ = excluded;
+        vehicle_.exclude(excluded);
+    }
+    for (const FailsafeTransition& t : ts) {
+        if (!t.raised)
+            continue;
+        const FailsafeAction a = t.failsafe.effective();
+        if (a == FailsafeAction::Kill) {
+            vehicle_.kill(KillSource::Failsafe, describe(t.failsafe));
+        } else if (a == FailsafeAction::Surface && surface_until_ == 0) {
+            // Nothing to drive while arming or killed: a surface then ends as it would, killed.
+            surface_reason_ = describe(t.failsafe);
+            if (!vehicle_.may_drive() || !vehicle_.surface(AxisDemand{0, 0, settings_.surface.heave, 0, 0, 0}).ok()) {
+                vehicle_.kill(KillSource::Failsafe, surface_reason_ + ": the vehicle could not drive the ascent");
+                continue;
+            }
+            surface_until_ = now + uint64_t(settings_.surface.duration_ms) * 1'000'000ull;
+            log_warning("SURFACING (%s): heave %g for %u ms, then kill", surface_reason_.c_str(),
+                        settings_.surface.heave, settings_.surface.duration_ms);
+            events_.changed(kChangeState);
+        }
+    }
+}
+
+void FailsafeMonitor::keep_surfacing(uint64_t now) {
+    if (surface_until_ == 0)
+        return;
+    if (!vehicle_.surfacing()) { // a Kill, the kill switch or another fault ended it
+        log_notice("surfacing ended by a kill (%s)", std::string(vehicle_.kill_source_name()).c_str());
+        surface_until_ = 0;
+        events_.changed(kChangeState);
+        return;
+    }
+    if (now >= surface_until_) {
+        surface_until_ = 0;
+        vehicle_.kill(KillSource::Failsafe, surface_reason_ + ": ascent done");
+        return;
+    }
+    // Again, or the command timeout would stop the ascent.
+    vehicle_.surface(AxisDemand{0, 0, settings_.surface.heave, 0, 0, 0});
+}
+
+Result FailsafeMonitor::clear_kill_refusal() const {
+    // The fixed ones are refused where they arise, by name (BusLost, ThrusterUnreachable), and
+    // at once when they end, not at this object's next reading.
+    std::vector<ActiveFailsafe> b = policy_.blocking();
+    std::erase_if(b, [this](const ActiveFailsafe& f) {
+        return condition_is_fixed(f.condition) || (overriding_ && f.condition == *overriding_);
+    });
+    if (b.empty())
+        return {};
+    std::string m = "a failsafe holds: ";
+    for (std::size_t i = 0; i < b.size(); ++i)
+        m += (i ? ", " : "") + describe(b[i]);
+    m += "; ClearKillOverride(\"" + std::string(condition_name(b.front().condition)) +
+         "\") clears the kill anyway";
+    return {Status::FailsafeActive, m};
+}
+
+Result FailsafeMonitor::clear_kill_override(std::string_view condition, std::string_view caller) {
+    const auto c = condition_from_name(condition);
+    if (!c)
+        return {Status::InvalidValue, "no failsafe condition \"" + std::string(condition) + "\""};
+    if (condition_is_fixed(*c))
+        return {Status::FailsafeActive, std::string(condition) + " is fixed at kill: it cannot be overridden"};
+    // ClearKill with the named condition's failsafes set aside (another that holds still
+    // refuses); they are overridden only when it clears the kill: a refused call changes nothing.
+    overriding_ = *c;
+    Result r = vehicle_.clear_kill();
+    overriding_.reset();
+    if (!r.ok())
+        return r;
+    if (policy_.override_condition(*c)) {
+        log_warning("FAILSAFE OVERRIDE: %s named %s in ClearKillOverride; it only warns until it clears",
+                    std::string(caller).c_str(), std::string(condition).c_str());
+        events_.changed(kChangeFailsafes);
+    }
+    return r;
+}
+
+std::string FailsafeMonitor::summary() const {
+    std::string s;
+    for (const ActiveFailsafe& f : policy_.active())
+        s += (s.empty() ? "" : ", ") + describe(f);
+    return s;
+}
+
+} // namespace caracara

@@ -1,0 +1,76 @@
+// The failsafes at work: every thruster's last status reply goes into the FailsafePolicy
+// (core/failsafe_policy) on this object's own timer, and what the policy raises is carried out
+// by the Vehicle (exclude, surface, kill) and told everywhere (VehicleEvents: D-Bus, the dive
+// recorder, STATUS=; the journal here, one line per transition).
+#pragma once
+
+#include "core/failsafe_policy.hpp"
+#include "daemon/failsafe_gate.hpp"
+#include "daemon/vehicle.hpp"
+#include "daemon/vehicle_events.hpp"
+#include "drivers/platform/event_loop.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace caracara {
+
+// A thruster's last good status reply, as the policy reads it.
+struct FailsafeReading {
+    uint8_t fault_bits = 0;                // SeaBotix IDS 8.4.2 FAULT bit order
+    std::optional<uint8_t> temperature_c;  // SeaBotix controllers only
+};
+
+class FailsafeMonitor final : public FailsafeGate {
+public:
+    using Readings = std::function<std::optional<FailsafeReading>(std::size_t thruster)>;
+    // Which of the vehicle's own (fixed) conditions hold now. The daemon already kills for them
+    // where they arise; here they are told as failsafes, and hold a ClearKill like the others.
+    using Conditions = std::function<std::array<bool, kFailsafeConditionCount>()>;
+    // Readings at 20 Hz: a status reply comes every (thrusters / status reads per tick) cycles,
+    // 160 ms for eight at 50 Hz, so a persistence time is kept to within one period. Faster
+    // when the command timeout is shorter than two periods: the ascent is re-sent at each one.
+    static constexpr uint64_t kPeriodNs = 50'000'000;
+
+    FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters, Readings readings,
+                    Conditions conditions, Vehicle& vehicle, VehicleEvents& events);
+    std::string start(); // "" or why the timer could not be made
+    void stop() { timer_.reset(); }
+
+    Result clear_kill_refusal() const override;
+    // ClearKill for a pilot who means it: the named condition's failsafes warn until it clears.
+    Result clear_kill_override(std::string_view condition, std::string_view caller);
+
+    const std::vector<ActiveFailsafe>& active() const { return policy_.active(); }
+    // "water-detect surface thruster 3, overtemp exclude thruster 2" ("" when none).
+    std::string summary() const;
+
+    // Runs one reading of every thruster and the persistence timers (the timer calls it).
+    void poll(uint64_t now);
+
+private:
+    static int on_timer(sd_event_source* s, uint64_t usec, void* userdata);
+    void tell(const FailsafeTransitions& ts);
+    void carry_out(const FailsafeTransitions& ts, uint64_t now);
+    void keep_surfacing(uint64_t now);
+
+    sd_event* event_;
+    const FailsafeSettings& settings_;
+    std::size_t thrusters_;
+    Readings readings_;
+    Conditions conditions_;
+    Vehicle& vehicle_;
+    VehicleEvents& events_;
+    FailsafePolicy policy_;
+    SourcePtr timer_;
+    uint64_t period_us_;
+    std::array<bool, kMotorCount> excluded_{};
+    std::optional<FailsafeCondition> overriding_; // set aside during ClearKillOverride's ClearKill
+    uint64_t surface_until_ = 0;                  // 0: not surfacing
+    std::string surface_reason_;
+};
+
+} // namespace caracara
