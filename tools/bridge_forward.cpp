@@ -126,10 +126,12 @@ int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vecto
         }
         if (!announced && port_listens(port)) {
             announced = true;
-            std::printf("ws://localhost:%u\n", port);
+            // The Foxglove address, then the cockpit's (the same socket serves both, docs/cockpit.md).
+            std::printf("ws://localhost:%u\nhttp://localhost:%u/\n", port, port);
             std::fflush(stdout);
             std::fprintf(stderr, "caracaractl: open ws://localhost:%u in Foxglove (Open connection, Foxglove "
-                                 "WebSocket); Ctrl-C ends the forward\n", port);
+                                 "WebSocket), or the cockpit at http://localhost:%u/ in a browser; Ctrl-C ends "
+                                 "the forward\n", port, port);
         }
         const timespec tick{0, 50'000'000};
         const int sig = sigtimedwait(&mask, nullptr, &tick);
