@@ -5,9 +5,8 @@ import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
 import fs from "node:fs";
 import net from "node:net";
-import os from "node:os";
 import path from "node:path";
-import puppeteer from "puppeteer-core";
+import { launch, openCockpit, surge } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
 import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, X_AXIS, ZERO, poll, simSpeeds, simThruster, sleep, speedByte, vget, wireLog,
   wireNext } from "./lib.mjs";
@@ -15,40 +14,16 @@ import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, X_AXIS, ZERO, poll, simSpeeds, si
 const HTTP = process.env.CARACARA_HTTP_URL;
 const ART = process.env.CARACARA_ARTIFACTS;
 const KILL_OUT = 27; // the simulator's kill output line (tests/e2e/test_paths_out.py)
-const profile = fs.mkdtempSync(path.join(os.tmpdir(), "caracara-chromium-"));
+let chromium;
 let browser;
 
 before(async () => {
-  browser = await puppeteer.launch({
-    executablePath: process.env.CARACARA_CHROMIUM, headless: true, userDataDir: profile,
-    args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-  });
+  chromium = await launch();
+  browser = chromium.browser;
 });
-after(async () => {
-  await browser?.close();
-  fs.rmSync(profile, { recursive: true, force: true });
-});
+after(async () => { await chromium?.close(); });
 
-// A page of the cockpit with a scripted standard-mapping gamepad (window.__pad) in place of
-// navigator.getGamepads, every request and console error recorded.
-async function open() {
-  const page = await browser.newPage();
-  await page.setViewport({ width: 1400, height: 900 });
-  const log = { requests: [], errors: [] };
-  page.on("request", (r) => log.requests.push(r.url()));
-  page.on("pageerror", (e) => log.errors.push(String(e)));
-  page.on("console", (m) => { if (m.type() === "error") log.errors.push(m.text()); });
-  await page.evaluateOnNewDocument(() => {
-    const pad = { id: "scripted gamepad", index: 0, connected: true, mapping: "standard", timestamp: 0,
-      axes: [0, 0, 0, 0], buttons: Array.from({ length: 17 }, () => ({ pressed: false, touched: false, value: 0 })) };
-    window.__pad = pad;
-    navigator.getGamepads = () => [pad.connected ? pad : null, null, null, null];
-  });
-  await page.goto(HTTP, { waitUntil: "load" });
-  await page.waitForFunction(() => document.getElementById("link").dataset.lost === "false", { timeout: 15000 });
-  return { page, log };
-}
+const open = () => openCockpit(browser, HTTP);
 const text = (page, sel) => page.$eval(sel, (e) => e.textContent.trim());
 const shot = (page, name) => page.screenshot({ path: path.join(ART, `${name}.png`), fullPage: true });
 const setPad = (page, fn) => page.evaluate(fn);
@@ -113,12 +88,6 @@ test("the page shows the state and the values the simulator reports, loading not
   await page.close();
 });
 
-// The mapping's default surge: -a1 through the dead zone 0.1, the expo 0.3, the gain 0.5
-// (docs/cockpit.md), computed here on its own.
-function surge(stick) {
-  const t = (Math.abs(stick) - 0.1) / 0.9;
-  return -Math.sign(stick) * (0.7 * t + 0.3 * t ** 3) * 0.5;
-}
 const xMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in X_AXIS ? speedByte(X_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
 const allZero = () => simSpeeds().every((s) => s === ZERO);
 
@@ -151,6 +120,17 @@ test("a scripted gamepad drives motion to the wire as the mixing says only while
   await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving again");
   await setPad(page, () => { window.__pad.connected = false; window.dispatchEvent(new Event("gamepaddisconnected")); });
   await poll(allZero, 2000, "zero once the gamepad is unplugged");
+  // Plugged in and held again, then the page hidden (another tab): zero, and nothing sent.
+  await setPad(page, () => { window.__pad.connected = true; });
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving again");
+  await page.evaluate(() => {
+    Object.defineProperty(document, "visibilityState", { value: "hidden", configurable: true });
+    document.dispatchEvent(new Event("visibilitychange"));
+  });
+  await poll(allZero, 2000, "zero once the page is hidden");
+  const sent3 = await page.evaluate(() => window.cockpit.sent);
+  await sleep(500);
+  assert.equal(await page.evaluate(() => window.cockpit.sent), sent3, "nothing sent while hidden");
   await page.close();
 });
 

@@ -175,8 +175,11 @@ function pad() {
 }
 
 function sendMotion(motion) {
+  const at = performance.now();
   cockpit.sent++;
-  cockpit.lastSent = { motion, at: performance.now() };
+  // When the command changed (bench/bridge_bench.mjs times a sample to the wire from here).
+  if (AXES.some((a) => motion[a] !== cockpit.lastSent?.motion[a])) cockpit.lastChange = { motion, at };
+  cockpit.lastSent = { motion, at };
   client?.publish("/command/motion", motion);
 }
 
