@@ -135,7 +135,7 @@ async function cockpit() {
       const since = wireNext();
       if (i % 2 === 0) {
         // Stick and deadman at once; the page's next tick samples and sends; then released (zero).
-        const stick = [-0.6, 0.6, -0.8, 0.8][(i / 2) % 4];
+        const stick = [-0.6, 0.6, -0.7, 0.7][(i / 2) % 4];
         const speed = speedByte(X_AXIS[2] * Math.round(surge(stick) * MOTOR_MAX));
         const before = await page.evaluate(() => window.cockpit.lastChange?.at ?? -1);
         await page.evaluate((s) => { window.__pad.axes[1] = s; window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; }, stick);
@@ -145,7 +145,7 @@ async function cockpit() {
         await page.evaluate(() => { window.__pad.buttons[4] = { pressed: false, touched: false, value: 0 }; });
         await poll(() => page.evaluate(() => window.cockpit.lastSent.motion.x === 0), 2000, "the release");
       } else {
-        const value = [0.25, -0.25, 0.35, -0.35][((i - 1) / 2) % 4];
+        const value = [0.2, -0.2, 0.3, -0.3][((i - 1) / 2) % 4];
         py.stdin.write(`${value}\n`);
         const t0 = BigInt((await lines.next()).value);
         viaDbus.push(Number((await orderAfter(since, speedByte(X_AXIS[2] * Math.round(value * MOTOR_MAX)), t0)) - t0) / 1000);
