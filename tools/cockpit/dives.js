@@ -29,7 +29,7 @@ export async function showDives(table, plotBox, token) {
 async function plot(name, box, q) {
   const r = await fetch(`/dives/${name}.json${q}`);
   if (!r.ok) { box.textContent = `cannot load ${name}: ${r.status}`; return; }
-  const { t, applied } = await r.json(); // t: seconds; applied: [motor][sample]
+  const { t, applied, end } = await r.json(); // t: seconds; applied: [motor][sample]
   const w = 1000, h = 240, tmax = Math.max(1e-3, t[t.length - 1] ?? 1);
   const svg = document.createElementNS(SVG, "svg");
   svg.setAttribute("viewBox", `0 0 ${w} ${h}`);
@@ -43,9 +43,8 @@ async function plot(name, box, q) {
     line.setAttribute("points", series.map((v, i) => `${(t[i] / tmax) * w},${h / 2 - (v / 8850) * (h / 2 - 4)}`).join(" "));
     svg.append(line);
   });
-  const title = document.createElementNS(SVG, "text");
-  title.setAttribute("x", 8); title.setAttribute("y", 16); title.setAttribute("fill", "#ccc");
-  title.textContent = `${name}: applied thrust of motors 0..7 over ${tmax.toFixed(1)} s`;
-  svg.append(title);
-  box.replaceChildren(svg);
+  const title = document.createElement("p");
+  title.className = "dim";
+  title.textContent = `${name}: applied thrust of motors 0..7 (-8850..8850) over ${tmax.toFixed(1)} s, ended: ${end}`;
+  box.replaceChildren(title, svg);
 }
