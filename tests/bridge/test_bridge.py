@@ -158,6 +158,12 @@ class BridgeRig:
         except OSError:
             return False
 
+    def check_bridge_stops_cleanly(self):
+        # SIGTERM: exit status 0, its socket removed (under ASan: no leak, which would make it non-zero).
+        self.bridge.terminate()
+        self.assertEqual(self.bridge.wait(20), 0, "caracara-bridge: " + self.bridge_output())
+        self.assertFalse(os.path.exists(self.socket))
+
     def node(self, script, **env):
         r = subprocess.run(["node", "--test", "--test-reporter=spec", script], cwd=HERE, capture_output=True, text=True,
                            timeout=300, env={**os.environ, "CARACARA_BUILD_DIR": BUILD_DIR,
@@ -273,10 +279,7 @@ class BridgeTest(BridgeRig, unittest.TestCase):
             self.assertEqual(p.wait(20), 0)
 
     def test_9_bridge_stops_cleanly(self):
-        # SIGTERM: exit status 0, its socket removed (under ASan: no leak, which would make it non-zero).
-        self.bridge.terminate()
-        self.assertEqual(self.bridge.wait(20), 0, "caracara-bridge: " + self.bridge_output())
-        self.assertFalse(os.path.exists(self.socket))
+        self.check_bridge_stops_cleanly()
 
 
 if __name__ == "__main__":

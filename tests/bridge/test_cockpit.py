@@ -41,6 +41,9 @@ class CockpitTest(BridgeRig, unittest.TestCase):
                   CARACARA_DIVES_DIR=self.rig.dives_dir)
         self.assertIsNone(self.bridge.poll(), "the bridge survived the cockpit")
 
+    def test_z_bridge_stops_cleanly(self):
+        self.check_bridge_stops_cleanly()
+
 
 if __name__ == "__main__":
     unittest.main()

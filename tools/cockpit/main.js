@@ -49,7 +49,11 @@ function show(topic, m) {
   if (topic.startsWith("/thruster/")) return showThruster(m);
   if (topic === "/teensy") return showTeensy(m);
   if (topic === "/i2c") return showI2c(m);
-  if (topic === "/events") return logEvent(m.level, m.name, m.message, m.timestamp.sec * 1000 + m.timestamp.nsec / 1e6);
+  if (topic === "/events") {
+    // A kill closes a dive and arming opens one: the list follows.
+    if (m.name === "kill" || m.name === "arming") setTimeout(() => showDives($("dives"), $("dive-plot"), token), 500);
+    return logEvent(m.level, m.name, m.message, m.timestamp.sec * 1000 + m.timestamp.nsec / 1e6);
+  }
 }
 
 function showState(m) {
