@@ -275,15 +275,6 @@ def phase_ssh(b, p, res):
         bridge.stop()
 
 
-def port_open(port):
-    import socket
-    try:
-        with socket.create_connection(("127.0.0.1", port), timeout=0.5):
-            return True
-    except OSError:
-        return False
-
-
 def phase_bridge(b, p, res):
     log("8. caracara-bridge: a property change to a client, a published motion to the wire vs SetMotion, CPU and RSS")
     bridge_exe = os.path.join(b.build, "tools", "bridge", "caracara-bridge")
@@ -330,7 +321,7 @@ def phase_bridge(b, p, res):
     # The cockpit in chromium: it needs TCP (a browser has no Unix sockets), so a second bridge
     # on loopback with a token, the page served from the source tree.
     if os.access("/usr/bin/chromium", os.X_OK):
-        from ssh_bridge import free_port
+        from ssh_bridge import free_port, port_listens
         port, token_file = free_port(), os.path.join(b.dir, "bridge.token")
         token = os.urandom(16).hex()
         with open(token_file, "w") as f:
@@ -338,7 +329,7 @@ def phase_bridge(b, p, res):
         tcp = b.spawn([bridge_exe, "--listen", f"tcp:127.0.0.1:{port}", "--token-file", token_file, "--bus-address",
                        b.bus, "--cockpit-dir", os.path.join(os.path.dirname(HERE), "tools", "cockpit")],
                       "caracara-bridge (tcp)")
-        b.wait_for(lambda: port_open(port), 10, "the bridge's TCP port")
+        b.wait_for(lambda: port_listens(port), 10, "the bridge's TCP port")
         env["CARACARA_HTTP_URL"] = f"http://127.0.0.1:{port}/?token={token}"
         res["bridge"].update(run("cockpit"))
         b.stop(tcp)

@@ -22,7 +22,7 @@ sys.path.insert(0, os.path.join(SOURCE, "bench"))
 
 import harness  # noqa: E402
 from harness import BUILD_DIR, Rig, poll  # noqa: E402
-from ssh_bridge import free_port, private_sshd  # noqa: E402
+from ssh_bridge import free_port, port_listens, private_sshd  # noqa: E402
 
 NPM_CACHE = "/var/cache/caracara-npm"
 CI = os.environ.get("CI") == "true"
@@ -152,11 +152,7 @@ class BridgeRig:
 
     @staticmethod
     def listening(port):
-        try:
-            with socket.create_connection(("127.0.0.1", port), timeout=0.5):
-                return True
-        except OSError:
-            return False
+        return port_listens(port)
 
     def check_bridge_stops_cleanly(self):
         # SIGTERM: exit status 0, its socket removed (under ASan: no leak, which would make it non-zero).
