@@ -183,7 +183,7 @@ async function clearKill(page) {
   await page.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 20000 });
 }
 
-test("the kill button and the Space and Escape keys each kill; clear-kill asks first", async () => {
+test("the kill button and the Space (while driving) and Escape keys each kill; clear-kill asks first", async () => {
   const { page } = await open();
   await page.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 20000 });
   await killedBy(page, () => page.click("#kill"));
@@ -195,8 +195,17 @@ test("the kill button and the Space and Escape keys each kill; clear-kill asks f
   await sleep(500);
   assert.equal(vget("State"), "killed");
   await clearKill(page);
-  await page.focus("#gain"); // from anywhere on the page, even a form control
+  // Space while driving, with a form control focused: killed, zero, and the page stops sending.
+  await setPad(page, () => { window.__pad.axes[1] = -0.6; window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; });
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
+  await page.focus("#gain");
   await killedBy(page, () => page.keyboard.press("Space"));
+  assert.ok(allZero());
+  await sleep(200);
+  const sent = await page.evaluate(() => window.cockpit.sent);
+  await sleep(500);
+  assert.equal(await page.evaluate(() => window.cockpit.sent), sent, "nothing sent to a killed vehicle");
+  await setPad(page, () => { window.__pad.buttons[4] = { pressed: false, touched: false, value: 0 }; });
   await clearKill(page);
   await killedBy(page, () => page.keyboard.press("Escape"));
   await clearKill(page);

@@ -148,10 +148,11 @@ function logEvent(level, name, message, ms) {
 
 // --- kill ----------------------------------------------------------------------------------------
 function kill() {
-  stopDriving();
   cockpit.kills++;
+  // The kill first: nothing of ours goes out ahead of it.
   if (!client?.publish("/command/kill", {}))
     logEvent(4, "cockpit", "kill NOT sent: no connection to the bridge (the vehicle zeroes a lost pilot's thrust)", Date.now());
+  stopDriving();
 }
 
 $("kill").addEventListener("click", kill);
@@ -203,7 +204,8 @@ function tick() {
   if (!p) return stopDriving();
   const s = sample(p, mapping);
   $("pad-motion").textContent = AXES.map((a) => `${a} ${s.motion[a].toFixed(2)}`).join(" · ");
-  if (!s.held) return stopDriving();
+  // Not ready (killed, arming, fault): nothing to send, the daemon would refuse it.
+  if (!s.held || cockpit.state?.state !== "ready") return stopDriving();
   driving = true;
   $("deadman").textContent = "HELD";
   $("deadman").className = "pill held";
