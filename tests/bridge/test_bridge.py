@@ -254,7 +254,8 @@ class BridgeTest(BridgeRig, unittest.TestCase):
         with open(token_file, "w") as f:
             f.write(token + "\n")
         p = subprocess.Popen(exe + ["--listen", "tcp:127.0.0.1:%d" % port, "--token-file", token_file,
-                                    "--bus-address", self.rig.address], stderr=subprocess.DEVNULL)
+                                    "--bus-address", self.rig.address, "--dives-dir", self.rig.dives_dir,
+                                    "--cockpit-dir", os.path.join(SOURCE, "tools", "cockpit")], stderr=subprocess.DEVNULL)
         try:
             poll(lambda: self.listening(port), 10, message="the TCP listener")
 
@@ -270,6 +271,15 @@ class BridgeTest(BridgeRig, unittest.TestCase):
             self.assertIn("401", status(b"/?token=" + token.encode() + b"0"))
             self.assertIn("101", status(b"/?token=" + token.encode()))
             self.assertIn("101", status(b"/", b"Authorization: Bearer " + token.encode() + b"\r\n"))
+
+            def plain(target):
+                with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+                    s.sendall(b"GET " + target + b" HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")
+                    return s.recv(4096).split(b"\r\n")[0].decode()
+            # The cockpit's files are the same for everyone; the dives are vehicle data: the token.
+            self.assertIn("200", plain(b"/"))
+            self.assertIn("401", plain(b"/dives/"))
+            self.assertIn("200", plain(b"/dives/?token=" + token.encode()))
         finally:
             p.terminate()
             self.assertEqual(p.wait(20), 0)
