@@ -47,11 +47,12 @@ int exit_of(int status) {
 } // namespace
 
 const char* bridge_forward_help() {
-    return "\nFoxglove (caracara-bridge on the vehicle, docs/foxglove.md):\n"
+    return "\nFoxglove and the cockpit (caracara-bridge on the vehicle, docs/foxglove.md, docs/cockpit.md):\n"
            "  -H [USER@]HOST[:PORT] bridge [--port N] [--socket PATH] [--ssh-config FILE]\n"
            "                                   Forward the vehicle's bridge socket to localhost:N\n"
-           "                                   (default 8765) with ssh -L and print the address to\n"
-           "                                   open in Foxglove; held until ^C\n";
+           "                                   (default 8765) with ssh -L and print the addresses to\n"
+           "                                   open in Foxglove (ws://) and in a browser (http://,\n"
+           "                                   the cockpit); held until ^C\n";
 }
 
 int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vector<std::string>& args) {
