@@ -242,6 +242,7 @@ test("a page whose connection drops shows it at once, with the age of the last m
   await page.waitForFunction(() => document.getElementById("link").dataset.lost === "true", { timeout: 2000 });
   await sleep(1200);
   assert.match(await text(page, "#link"), /CONNECTION LOST — last message \d+\.\d s ago/);
+  assert.ok(await page.evaluate(() => document.body.classList.contains("stale")), "the last known values dimmed");
   await shot(page, "lost");
   await page.close();
 });

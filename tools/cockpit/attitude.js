@@ -82,4 +82,4 @@ export function drawAttitude(canvas, yaw, pitch, roll) {
   ctx.fill();
 }
 
-export const degrees = (rad) => (rad * DEG).toFixed(1);
+export const degrees = (rad) => (Math.abs(rad * DEG) < 0.05 ? 0 : rad * DEG).toFixed(1);

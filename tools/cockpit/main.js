@@ -38,6 +38,8 @@ function showLink() {
   const fresh = connected && age !== null && age * 1000 < STALE_MS;
   el.className = `link ${fresh ? "up" : "down"}`;
   el.dataset.lost = fresh ? "false" : "true";
+  // What is shown is only the last thing heard: dimmed until the data is fresh again.
+  document.body.classList.toggle("stale", !fresh);
   el.textContent = fresh ? "connected"
     : `${connected ? "NO DATA" : "CONNECTION LOST"}${age === null ? "" : ` — last message ${age} s ago`}`;
 }
