@@ -32,6 +32,9 @@ class CockpitTest(BridgeRig, unittest.TestCase):
         npm_ci()
         super().setUpClass()
 
+    def test_a_gamepad_mapping(self):
+        self.node("gamepad.test.mjs")
+
     def test_cockpit_in_chromium(self):
         artifacts = os.path.join(BUILD_DIR, "tests", "cockpit-artifacts")
         os.makedirs(artifacts, exist_ok=True)

@@ -25,11 +25,12 @@ export function parseTerms(text) {
   if (s === "" || s === "0") return [];
   const terms = [];
   const re = /([+-]?)([ab])(\d{1,2})/gy;
-  let m;
-  while (re.lastIndex < s.length && (m = re.exec(s))) {
+  let at = 0;
+  for (let m; at < s.length && (m = re.exec(s)); at = re.lastIndex) {
+    if (terms.length && !m[1]) break; // terms after the first need their sign: "a1b2" is no mapping
     terms.push({ sign: m[1] === "-" ? -1 : 1, kind: m[2], index: Number(m[3]) });
   }
-  if (re.lastIndex !== s.length || !terms.length) throw new Error(`not a mapping: '${text}' (terms like -a1 or b6-b7)`);
+  if (at !== s.length || !terms.length) throw new Error(`not a mapping: '${text}' (terms like -a1 or b6-b7)`);
   return terms;
 }
 
