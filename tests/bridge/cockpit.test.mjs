@@ -134,10 +134,16 @@ test("a scripted gamepad drives motion to the wire as the mixing says only while
   await page.close();
 });
 
-test("the mapping is editable and kept in the browser's storage", async () => {
+test("the mapping and the gain (selector and d-pad) are editable and kept in the browser's storage", async () => {
   const { page } = await open();
   await page.click("details summary");
   await page.$eval("#map-x", (e) => { e.value = "a1"; e.dispatchEvent(new Event("change")); });
+  // The gamepad's d-pad up steps the gain on each press (not while held).
+  await setPad(page, () => { window.__pad.buttons[12] = { pressed: true, touched: true, value: 1 }; });
+  await page.waitForFunction(() => document.getElementById("gain").value === "0.75", { timeout: 2000 });
+  await sleep(300);
+  assert.equal(await page.$eval("#gain", (e) => e.value), "0.75", "one step per press");
+  await setPad(page, () => { window.__pad.buttons[12] = { pressed: false, touched: false, value: 0 }; });
   await page.select("#gain", "0.25");
   await page.reload({ waitUntil: "load" });
   assert.equal(await page.$eval("#map-x", (e) => e.value), "a1");

@@ -3,7 +3,7 @@
 // browser's storage. Run by test_cockpit.py; the browser test drives the same code to the wire.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { DEFAULT_MAPPING, loadMapping, parseTerms, sample, saveMapping, shape } from "../../tools/cockpit/gamepad.js";
+import { DEFAULT_MAPPING, loadMapping, parseTerms, sample, saveMapping, shape, stepGain } from "../../tools/cockpit/gamepad.js";
 
 const near = (a, b) => assert.ok(Math.abs(a - b) < 1e-9, `${a} != ${b}`);
 function pad({ axes = [0, 0, 0, 0], pressed = [], values = {} } = {}) {
@@ -62,4 +62,12 @@ test("the mapping is kept in storage; a bad stored one gives the defaults", () =
   assert.deepEqual(loadMapping(st), DEFAULT_MAPPING);
   st.setItem("caracara.cockpit.mapping", JSON.stringify({ roll: "zz" }));
   assert.deepEqual(loadMapping(st), DEFAULT_MAPPING);
+});
+
+test("the gain buttons step through the gains and stop at the ends", () => {
+  assert.equal(stepGain(0.5, 1), 0.75);
+  assert.equal(stepGain(1, 1), 1);
+  assert.equal(stepGain(0.25, -1), 0.25);
+  assert.equal(stepGain(0.6, -1), 0.5); // a gain between steps goes to its neighbours
+  assert.equal(stepGain(0.6, 1), 0.75);
 });

@@ -14,6 +14,8 @@ export const DEFAULT_MAPPING = {
   pitch: "-a3",  // right stick forward: nose up
   roll: "b15-b14", // d-pad right/left
   deadman: 4,    // left bumper, held
+  gain_up: 12,   // d-pad up: the next gain
+  gain_down: 13, // d-pad down: the one before
   deadzone: 0.1,
   expo: 0.3,
   gain: 0.5,
@@ -36,7 +38,8 @@ export function parseTerms(text) {
 
 export function validMapping(m) {
   for (const a of AXES) parseTerms(m[a]);
-  for (const [k, lo, hi] of [["deadman", 0, 31], ["deadzone", 0, 0.9], ["expo", 0, 1], ["gain", 0, 1]]) {
+  for (const [k, lo, hi] of [["deadman", 0, 31], ["gain_up", 0, 31], ["gain_down", 0, 31], ["deadzone", 0, 0.9],
+    ["expo", 0, 1], ["gain", 0, 1]]) {
     const v = Number(m[k]);
     if (!Number.isFinite(v) || v < lo || v > hi) throw new Error(`${k} must be ${lo}..${hi}`);
   }
@@ -56,6 +59,12 @@ export function loadMapping(storage = localStorage) {
 export function saveMapping(m, storage = localStorage) {
   validMapping(m);
   storage.setItem(KEY, JSON.stringify(m));
+}
+
+// The gain after a press of gain_up (+1) or gain_down (-1), within GAINS.
+export function stepGain(gain, step) {
+  const next = step > 0 ? GAINS.find((g) => g > gain) : GAINS.findLast((g) => g < gain);
+  return next ?? (step > 0 ? GAINS[GAINS.length - 1] : GAINS[0]);
 }
 
 // Dead zone then expo on one stick value in -1..1.

@@ -1,7 +1,7 @@
 // The cockpit (docs/cockpit.md): one Foxglove WebSocket client of the bridge that serves this
 // page, showing the vehicle live, killing from anywhere on the page, and piloting with a gamepad.
 import { FoxgloveClient } from "./foxglove.js";
-import { AXES, GAINS, loadMapping, sample, saveMapping, validMapping } from "./gamepad.js";
+import { AXES, GAINS, loadMapping, sample, saveMapping, stepGain, validMapping } from "./gamepad.js";
 import { degrees, drawAttitude } from "./attitude.js";
 import { showDives } from "./dives.js";
 
@@ -175,6 +175,13 @@ $("confirm-clear").addEventListener("close", () => {
 let mapping = loadMapping();
 let driving = false;       // the deadman was held at the last sample
 let sendTimer = null;
+const gainButtons = new Set(); // gain buttons held at the last sample
+
+function setGain(gain) {
+  mapping = { ...mapping, gain };
+  saveMapping(mapping);
+  $("gain").value = String(gain);
+}
 
 function pad() {
   const pads = navigator.getGamepads ? [...navigator.getGamepads()] : [];
@@ -204,6 +211,12 @@ function tick() {
   const p = document.visibilityState === "visible" ? pad() : null;
   $("pad").textContent = p ? p.id || "gamepad" : "no gamepad";
   if (!p) return stopDriving();
+  // The gain buttons act on their press, not while held.
+  const press = (i) => Boolean(p.buttons[i]?.pressed);
+  for (const [button, step] of [[mapping.gain_up, 1], [mapping.gain_down, -1]]) {
+    if (press(button) && !gainButtons.has(button)) setGain(stepGain(mapping.gain, step));
+    if (press(button)) gainButtons.add(button); else gainButtons.delete(button);
+  }
   const s = sample(p, mapping);
   $("pad-motion").textContent = AXES.map((a) => `${a} ${s.motion[a].toFixed(2)}`).join(" · ");
   // Not ready (killed, arming, fault): nothing to send, the daemon would refuse it.
@@ -221,7 +234,7 @@ window.addEventListener("pagehide", () => { stopDriving(); client?.close(); });
 function mappingForm() {
   const form = $("mapping");
   form.innerHTML = "";
-  const fields = [...AXES, "deadman", "deadzone", "expo"];
+  const fields = [...AXES, "deadman", "gain_up", "gain_down", "deadzone", "expo"];
   for (const k of fields) {
     const label = document.createElement("label");
     label.textContent = k;
@@ -251,10 +264,7 @@ function mappingForm() {
   gain.innerHTML = GAINS.map((g) => `<option value="${g}">${g * 100} %</option>`).join("");
   gain.value = String(mapping.gain);
 }
-$("gain").addEventListener("change", (e) => {
-  mapping = { ...mapping, gain: Number(e.target.value) };
-  saveMapping(mapping);
-});
+$("gain").addEventListener("change", (e) => setGain(Number(e.target.value)));
 
 // --- start ---------------------------------------------------------------------------------------
 mappingForm();
