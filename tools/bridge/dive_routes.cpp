@@ -4,6 +4,7 @@
 #include "tools/foxglove/dive_summary.hpp"
 
 #include <nlohmann/json.hpp>
+#include <optional>
 
 namespace caracara::bridge {
 
@@ -51,7 +52,6 @@ StaticFiles::Response DiveRoutes::respond(const StaticFiles::Request& request) c
                                                                    ? std::string_view::npos
                                                                    : target.find('?') - kPrefix.size());
     std::string error;
-    const auto dives = fg::summarize_dives(dir_, &error);
     auto not_found = [&](const std::string& why) {
         res.result(http::status::not_found);
         res.set(http::field::content_type, "text/plain; charset=utf-8");
@@ -61,6 +61,7 @@ StaticFiles::Response DiveRoutes::respond(const StaticFiles::Request& request) c
         res.result(http::status::method_not_allowed);
         res.set(http::field::allow, "GET, HEAD");
     } else if (rest.empty()) {
+        const auto dives = fg::summarize_dives(dir_, &error); // reads every dive: only for the list
         if (!error.empty())
             not_found("cannot list dives: " + error);
         else {
@@ -70,18 +71,18 @@ StaticFiles::Response DiveRoutes::respond(const StaticFiles::Request& request) c
     } else {
         const auto dot = rest.rfind('.');
         const std::string_view name = rest.substr(0, dot), ext = dot == std::string_view::npos ? "" : rest.substr(dot);
-        const fg::DiveSummary* found = nullptr;
-        for (const auto& d : dives)
-            if (d.file.name == std::string(name) + kDiveSuffix)
-                found = &d;
+        std::optional<DiveFile> found;
+        for (const DiveFile& f : list_dive_files(dir_, &error))
+            if (f.name == std::string(name) + kDiveSuffix)
+                found = f;
         std::vector<uint8_t> bytes;
         if (!found || (ext != ".cdive" && ext != ".mcap" && ext != ".json")) {
             not_found("no such dive");
-        } else if (!read_whole_file(found->file.path, bytes, error)) {
+        } else if (!read_whole_file(found->path, bytes, error)) {
             not_found("cannot read the dive: " + error);
         } else if (ext == ".cdive") {
             res.set(http::field::content_type, "application/octet-stream");
-            res.set(http::field::content_disposition, "attachment; filename=\"" + found->file.name + "\"");
+            res.set(http::field::content_disposition, "attachment; filename=\"" + found->name + "\"");
             res.body().assign(bytes.begin(), bytes.end());
         } else {
             const dive::Dive d = dive::decode(bytes);
