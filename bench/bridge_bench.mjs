@@ -6,6 +6,10 @@
 //            the change-to-message time, the SetLeds call included)
 //   motion:  a motion published by a client to the simulator's wire, against SetMotion over
 //            D-Bus from a python3-dbus client, alternating in the same run
+//   cockpit: a gamepad sample in the cockpit (tools/cockpit, in chromium with a scripted gamepad,
+//            at CARACARA_HTTP_URL) to the order on the wire, against SetMotion over D-Bus,
+//            alternating in the same run; the page's clock is tied to CLOCK_MONOTONIC by the
+//            tightest of 30 round trips (its half-width is printed as clock_uncertainty_us)
 //   load N S: N clients subscribed to every channel for S seconds (run.py reads the bridge's
 //            CPU and RSS meanwhile)
 import { spawn } from "node:child_process";
@@ -104,9 +108,62 @@ async function load(n, seconds) {
   return { clients: n, seconds, messages_per_client: counts };
 }
 
+// The first order to motor 2 carrying speed, after t0 (CLOCK_MONOTONIC ns); its time.
+async function orderAfter(since, speed, t0) {
+  const addr = DEFAULT_MT[2] >> 1;
+  const at = await poll(() => wireLog(since).find((e) => e.bus === "i2c" && !e.read && e.addr === addr &&
+                                                       e.data[0] === speed && e.time_ns > t0), 2000, "the order");
+  return at.time_ns;
+}
+
+async function cockpit() {
+  const { launch, openCockpit, surge } = await import("../tests/bridge/chromium.mjs");
+  const chromium = await launch();
+  try {
+    const { page } = await openCockpit(chromium.browser, process.env.CARACARA_HTTP_URL);
+    let best = null;
+    for (let i = 0; i < 30; i++) {
+      const t1 = process.hrtime.bigint();
+      const p = await page.evaluate(() => performance.now());
+      const t2 = process.hrtime.bigint();
+      if (!best || t2 - t1 < best.rtt) best = { rtt: t2 - t1, offset: (t1 + t2) / 2n - BigInt(Math.round(p * 1e6)) };
+    }
+    const py = spawn("/usr/bin/python3", ["-c", SETMOTION, BUS], { stdio: ["pipe", "pipe", "inherit"] });
+    const lines = createInterface({ input: py.stdout })[Symbol.asyncIterator]();
+    const viaPad = [], viaDbus = [];
+    for (let i = 0; i < samples; i++) {
+      const since = wireNext();
+      if (i % 2 === 0) {
+        // Stick and deadman at once; the page's next tick samples and sends; then released (zero).
+        const stick = [-0.6, 0.6, -0.7, 0.7][(i / 2) % 4];
+        const speed = speedByte(X_AXIS[2] * Math.round(surge(stick) * MOTOR_MAX));
+        const before = await page.evaluate(() => window.cockpit.lastChange?.at ?? -1);
+        await page.evaluate((s) => { window.__pad.axes[1] = s; window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; }, stick);
+        const at = await poll(() => page.evaluate((b) => (window.cockpit.lastChange?.at > b ? window.cockpit.lastChange.at : null), before), 2000, "the sample");
+        const t0 = BigInt(Math.round(at * 1e6)) + best.offset;
+        viaPad.push(Number((await orderAfter(since, speed, t0)) - t0) / 1000);
+        await page.evaluate(() => { window.__pad.buttons[4] = { pressed: false, touched: false, value: 0 }; });
+        await poll(() => page.evaluate(() => window.cockpit.lastSent.motion.x === 0), 2000, "the release");
+      } else {
+        const value = [0.2, -0.2, 0.3, -0.3][((i - 1) / 2) % 4];
+        py.stdin.write(`${value}\n`);
+        const t0 = BigInt((await lines.next()).value);
+        viaDbus.push(Number((await orderAfter(since, speedByte(X_AXIS[2] * Math.round(value * MOTOR_MAX)), t0)) - t0) / 1000);
+      }
+      await sleep(10 + Math.random() * 20);
+    }
+    py.stdin.end();
+    return { cockpit_pad_to_wire_us: stats(viaPad), dbus_setmotion_to_wire_us_cockpit_run: stats(viaDbus),
+      clock_uncertainty_us: Number(best.rtt) / 2000 };
+  } finally {
+    await chromium.close();
+  }
+}
+
 let result;
 if (mode === "latency") result = await latency();
 else if (mode === "motion") result = await motion();
+else if (mode === "cockpit") result = await cockpit();
 else if (mode === "load") result = await load(Number(process.argv[3]), Number(process.argv[4]));
-else throw new Error("mode: latency | motion | load N SECONDS");
+else throw new Error("mode: latency | motion | cockpit | load N SECONDS");
 console.log(JSON.stringify(result));

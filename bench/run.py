@@ -318,6 +318,23 @@ def phase_bridge(b, p, res):
                                          **json.loads(out.strip().splitlines()[-1])}
     res["bridge"]["rss_peak_kib"] = status_kib(br.pid, "VmHWM")
     b.stop(br)
+    # The cockpit in chromium: it needs TCP (a browser has no Unix sockets), so a second bridge
+    # on loopback with a token, the page served from the source tree.
+    if os.access("/usr/bin/chromium", os.X_OK):
+        from ssh_bridge import free_port, port_listens
+        port, token_file = free_port(), os.path.join(b.dir, "bridge.token")
+        token = os.urandom(16).hex()
+        with open(token_file, "w") as f:
+            f.write(token + "\n")
+        tcp = b.spawn([bridge_exe, "--listen", f"tcp:127.0.0.1:{port}", "--token-file", token_file, "--bus-address",
+                       b.bus, "--cockpit-dir", os.path.join(os.path.dirname(HERE), "tools", "cockpit")],
+                      "caracara-bridge (tcp)")
+        b.wait_for(lambda: port_listens(port), 10, "the bridge's TCP port")
+        env["CARACARA_HTTP_URL"] = f"http://127.0.0.1:{port}/?token={token}"
+        res["bridge"].update(run("cockpit"))
+        b.stop(tcp)
+    else:
+        log("   no /usr/bin/chromium: the cockpit row is left out (apt-get install chromium)")
     b.stop_daemon()
     b.stop_sim()
 
@@ -743,6 +760,11 @@ def rows_from(res, p):
             mb["p50"] / md["p50"], "info", None, "us")
         row("8. bridge: published motion to the wire p99 (vs SetMotion over D-Bus)", mb["p99"], md["p99"],
             mb["p99"] / md["p99"], "info", None, "us")
+        if "cockpit_pad_to_wire_us" in br:
+            cp, cd = br["cockpit_pad_to_wire_us"], br["dbus_setmotion_to_wire_us_cockpit_run"]
+            for q in ("p50", "p99"):
+                row(f"8. cockpit: gamepad sample in the page to the wire {q} (vs SetMotion over D-Bus; clock "
+                    f"+-{br['clock_uncertainty_us']:.0f} us)", cp[q], cd[q], cp[q] / cd[q], "info", None, "us")
         for k, v in sorted(br["load"].items()):
             row(f"8. bridge CPU, {k} client(s) subscribed to everything", v["cpu_percent"], None, None, "info", None,
                 "%")

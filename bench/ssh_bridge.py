@@ -55,6 +55,15 @@ def free_port():
         return s.getsockname()[1]
 
 
+def port_listens(port):
+    """True when something accepts a connection on 127.0.0.1:port."""
+    try:
+        with socket.create_connection(("127.0.0.1", port), timeout=0.5):
+            return True
+    except OSError:
+        return False
+
+
 def private_sshd(d, port, log):
     """Makes a private sshd's files in d (host and client keys, authorized_keys, sshd_config
     for 127.0.0.1:port, keys only, no PAM, stream-local forwarding allowed, a passwd with its

@@ -47,11 +47,12 @@ int exit_of(int status) {
 } // namespace
 
 const char* bridge_forward_help() {
-    return "\nFoxglove (caracara-bridge on the vehicle, docs/foxglove.md):\n"
+    return "\nFoxglove and the cockpit (caracara-bridge on the vehicle, docs/foxglove.md, docs/cockpit.md):\n"
            "  -H [USER@]HOST[:PORT] bridge [--port N] [--socket PATH] [--ssh-config FILE]\n"
            "                                   Forward the vehicle's bridge socket to localhost:N\n"
-           "                                   (default 8765) with ssh -L and print the address to\n"
-           "                                   open in Foxglove; held until ^C\n";
+           "                                   (default 8765) with ssh -L and print the addresses to\n"
+           "                                   open in Foxglove (ws://) and in a browser (http://,\n"
+           "                                   the cockpit); held until ^C\n";
 }
 
 int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vector<std::string>& args) {
@@ -126,10 +127,12 @@ int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vecto
         }
         if (!announced && port_listens(port)) {
             announced = true;
-            std::printf("ws://localhost:%u\n", port);
+            // The Foxglove address, then the cockpit's (the same socket serves both, docs/cockpit.md).
+            std::printf("ws://localhost:%u\nhttp://localhost:%u/\n", port, port);
             std::fflush(stdout);
             std::fprintf(stderr, "caracaractl: open ws://localhost:%u in Foxglove (Open connection, Foxglove "
-                                 "WebSocket); Ctrl-C ends the forward\n", port);
+                                 "WebSocket), or the cockpit at http://localhost:%u/ in a browser; Ctrl-C ends "
+                                 "the forward\n", port, port);
         }
         const timespec tick{0, 50'000'000};
         const int sig = sigtimedwait(&mask, nullptr, &tick);

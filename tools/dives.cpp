@@ -6,6 +6,7 @@
 #include "drivers/protocol/seabotix.hpp"
 #include "tools/client.hpp"
 #include "tools/foxglove/dive_mcap.hpp"
+#include "tools/foxglove/dive_summary.hpp"
 #include "tools/render.hpp"
 
 #include <cerrno>
@@ -208,32 +209,22 @@ std::string local_time(uint64_t unix_ms) {
     return buf;
 }
 
-std::string end_of(const dive::Dive& d) {
-    if (!d.ok())
-        return std::string(dive::read_error_name(d.error));
-    return d.ended ? d.end.reason : "open";
-}
-
 int cmd_dives(const DiveOptions& o) {
     std::string err;
-    const auto files = caracara::list_dive_files(o.dir, &err);
+    const auto dives = caracara::foxglove::summarize_dives(o.dir, &err);
     if (!err.empty())
         throw Failure{kExitRefused, "cannot list dives: " + err};
     std::cout << strf("%-34s %-19s %9s %8s %7s  %s\n", "DIVE", "START", "DURATION", "SAMPLES", "SIZE", "END");
-    for (const caracara::DiveFile& f : files) {
-        std::vector<uint8_t> bytes;
-        std::string rerr;
-        if (!caracara::read_whole_file(f.path, bytes, rerr)) {
-            std::cout << strf("%-34s %s\n", f.name.c_str(), rerr.c_str());
+    for (const auto& d : dives) {
+        if (!d.read_error.empty()) {
+            std::cout << strf("%-34s %s\n", d.file.name.c_str(), d.read_error.c_str());
             continue;
         }
-        const dive::Dive d = dive::decode(bytes);
-        const uint32_t last = d.ended ? d.end.t_100us : d.samples.empty() ? 0 : d.samples.back().t_100us;
-        std::cout << strf("%-34s %-19s %8.1fs %8zu %6.0fK  %s\n", f.name.c_str(),
-                          d.error == dive::ReadError::NotADive ? "?" : local_time(d.header.start_unix_ms).c_str(),
-                          seconds(last), d.samples.size(), static_cast<double>(f.size) / 1024.0, end_of(d).c_str());
+        std::cout << strf("%-34s %-19s %8.1fs %8zu %6.0fK  %s\n", d.file.name.c_str(),
+                          d.is_dive ? local_time(d.start_unix_ms).c_str() : "?", d.seconds, d.samples,
+                          static_cast<double>(d.file.size) / 1024.0, d.end.c_str());
     }
-    std::cout << strf("%zu dive%s in %s\n", files.size(), files.size() == 1 ? "" : "s", o.dir.c_str());
+    std::cout << strf("%zu dive%s in %s\n", dives.size(), dives.size() == 1 ? "" : "s", o.dir.c_str());
     return kExitOk;
 }
 
@@ -307,7 +298,7 @@ int cmd_plot(const DiveOptions& o) {
     }
     const std::string script = plot_script();
     const std::string title = path.substr(path.rfind('/') + 1) + "  (" + local_time(d.header.start_unix_ms) +
-                              ", ended: " + end_of(d) + ")";
+                              ", ended: " + caracara::foxglove::dive_end(d) + ")";
     const pid_t pid = ::fork();
     if (pid == 0) {
         // Debian's interpreter, the one python3-matplotlib is installed for (not a python3

@@ -8,3 +8,12 @@ set_tests_properties(e2e_bridge PROPERTIES
                      ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
                      TIMEOUT 600
                      LABELS "e2e;bridge")
+
+# The cockpit in Debian's chromium (headless, puppeteer-core) through the same kind of forward.
+add_test(NAME e2e_cockpit
+         COMMAND /usr/bin/python3 -m unittest -v test_cockpit
+         WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR})
+set_tests_properties(e2e_cockpit PROPERTIES
+                     ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
+                     TIMEOUT 600
+                     LABELS "e2e;bridge;cockpit")

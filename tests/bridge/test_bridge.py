@@ -22,7 +22,7 @@ sys.path.insert(0, os.path.join(SOURCE, "bench"))
 
 import harness  # noqa: E402
 from harness import BUILD_DIR, Rig, poll  # noqa: E402
-from ssh_bridge import free_port, private_sshd  # noqa: E402
+from ssh_bridge import free_port, port_listens, private_sshd  # noqa: E402
 
 NPM_CACHE = "/var/cache/caracara-npm"
 CI = os.environ.get("CI") == "true"
@@ -90,7 +90,10 @@ def connect_as(path, *setpriv):
     return r.stdout.strip() or r.stderr.strip()
 
 
-class BridgeTest(unittest.TestCase):
+class BridgeRig:
+    """The rig, the bridge on a Unix socket (serving the cockpit's files from the source tree), the
+    private sshd and an ssh -L forward to it at cls.port; shared with test_cockpit.py."""
+
     @classmethod
     def setUpClass(cls):
         npm_ci()
@@ -110,7 +113,9 @@ class BridgeTest(unittest.TestCase):
             cls.socket = os.path.join(cls.sockdir, "bridge.sock")
             cls.bridge_log = open(os.path.join(cls.rig.dir, "caracara-bridge.log"), "ab")
             cls.bridge = subprocess.Popen(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge"),
-                                           "--listen", "unix:" + cls.socket, "--bus-address", cls.rig.address],
+                                           "--listen", "unix:" + cls.socket, "--bus-address", cls.rig.address,
+                                           "--cockpit-dir", os.path.join(SOURCE, "tools", "cockpit"),
+                                           "--dives-dir", cls.rig.dives_dir],
                                           stdout=cls.bridge_log, stderr=subprocess.STDOUT)
             cls.procs.append(cls.bridge)
             poll(lambda: os.path.exists(cls.socket) or cls.bridge.poll() is not None, 10, message="the bridge's socket")
@@ -145,6 +150,16 @@ class BridgeTest(unittest.TestCase):
             cls.sshd.stop()
         cls.rig.stop()
 
+    @staticmethod
+    def listening(port):
+        return port_listens(port)
+
+    def check_bridge_stops_cleanly(self):
+        # SIGTERM: exit status 0, its socket removed (under ASan: no leak, which would make it non-zero).
+        self.bridge.terminate()
+        self.assertEqual(self.bridge.wait(20), 0, "caracara-bridge: " + self.bridge_output())
+        self.assertFalse(os.path.exists(self.socket))
+
     def node(self, script, **env):
         r = subprocess.run(["node", "--test", "--test-reporter=spec", script], cwd=HERE, capture_output=True, text=True,
                            timeout=300, env={**os.environ, "CARACARA_BUILD_DIR": BUILD_DIR,
@@ -153,6 +168,8 @@ class BridgeTest(unittest.TestCase):
         self.assertEqual(r.returncode, 0, "node --test %s failed" % script)
         return r.stdout
 
+
+class BridgeTest(BridgeRig, unittest.TestCase):
     def test_1_reference_client_through_ssh_forward(self):
         self.node("bridge.test.mjs", CARACARA_WS_URL="ws://127.0.0.1:%d" % self.port)
         self.assertIsNone(self.bridge.poll(), "the bridge survived every test")
@@ -169,6 +186,7 @@ class BridgeTest(unittest.TestCase):
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
             self.assertEqual(p.stdout.readline().strip(), "ws://localhost:%d" % port)
+            self.assertEqual(p.stdout.readline().strip(), "http://localhost:%d/" % port)
             # A WebSocket upgrade with the Foxglove subprotocol through the forward.
             with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
                 s.sendall(b"GET / HTTP/1.1\r\nHost: localhost\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
@@ -236,7 +254,8 @@ class BridgeTest(unittest.TestCase):
         with open(token_file, "w") as f:
             f.write(token + "\n")
         p = subprocess.Popen(exe + ["--listen", "tcp:127.0.0.1:%d" % port, "--token-file", token_file,
-                                    "--bus-address", self.rig.address], stderr=subprocess.DEVNULL)
+                                    "--bus-address", self.rig.address, "--dives-dir", self.rig.dives_dir,
+                                    "--cockpit-dir", os.path.join(SOURCE, "tools", "cockpit")], stderr=subprocess.DEVNULL)
         try:
             poll(lambda: self.listening(port), 10, message="the TCP listener")
 
@@ -252,23 +271,21 @@ class BridgeTest(unittest.TestCase):
             self.assertIn("401", status(b"/?token=" + token.encode() + b"0"))
             self.assertIn("101", status(b"/?token=" + token.encode()))
             self.assertIn("101", status(b"/", b"Authorization: Bearer " + token.encode() + b"\r\n"))
+
+            def plain(target):
+                with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+                    s.sendall(b"GET " + target + b" HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")
+                    return s.recv(4096).split(b"\r\n")[0].decode()
+            # The cockpit's files are the same for everyone; the dives are vehicle data: the token.
+            self.assertIn("200", plain(b"/"))
+            self.assertIn("401", plain(b"/dives/"))
+            self.assertIn("200", plain(b"/dives/?token=" + token.encode()))
         finally:
             p.terminate()
             self.assertEqual(p.wait(20), 0)
 
-    @staticmethod
-    def listening(port):
-        try:
-            with socket.create_connection(("127.0.0.1", port), timeout=0.5):
-                return True
-        except OSError:
-            return False
-
     def test_9_bridge_stops_cleanly(self):
-        # SIGTERM: exit status 0, its socket removed (under ASan: no leak, which would make it non-zero).
-        self.bridge.terminate()
-        self.assertEqual(self.bridge.wait(20), 0, "caracara-bridge: " + self.bridge_output())
-        self.assertFalse(os.path.exists(self.socket))
+        self.check_bridge_stops_cleanly()
 
 
 if __name__ == "__main__":

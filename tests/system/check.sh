@@ -384,6 +384,18 @@ check "the bridge's socket is caracara:caracara, mode 0660" \
 check "pilot (group caracara): a Foxglove WebSocket upgrade on the socket answers 101" as pilot perl -e "$WS_UPGRADE"
 denied_socket() { local err; err=$(runuser -u tester -- perl -e "$WS_UPGRADE" 2>&1) && return 1; echo "$err" | grep -q "Permission denied"; }
 check "tester (not in the group): the socket refuses the connection (Permission denied)" denied_socket
+# The cockpit (docs/cockpit.md): a plain GET on the same socket: the installed page, and the
+# recorded dives the bridge reads from caracarad's LogsDirectory. perl -e CODE PATH TEXT.
+HTTP_GET='use IO::Socket::UNIX;
+my ($path, $want) = @ARGV;
+my $s = IO::Socket::UNIX->new(Peer => "/run/caracara-bridge/bridge.sock") or die "connect: $!\n";
+print $s "GET $path HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n";
+my $all = do { local $/; <$s> };
+exit($all =~ m{^HTTP/1.1 200} && index($all, $want) >= 0 ? 0 : 1);'
+check "pilot: the installed cockpit (/usr/share/caracara/cockpit) is served on the socket" \
+  as pilot perl -e "$HTTP_GET" / "<title>Caracara cockpit</title>"
+check "pilot: the bridge lists the recorded dives (/var/log/caracara, read only)" \
+  as pilot perl -e "$HTTP_GET" /dives/ "["
 
 # --- 7b. the topside: caracaractl -H, busctl -H and a python3-dbus script over SSH (check-topside.sh)
 . "$(dirname "$0")/check-topside.sh"

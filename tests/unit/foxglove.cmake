@@ -1,2 +1,3 @@
-# The MCAP writer, the Foxglove channel catalogue, the bridge's client protocol and send queue (tools/foxglove, tools/bridge).
-caracara_unit_test(test_foxglove SOURCES unit/test_mcap_writer.cpp unit/test_send_queue.cpp LIBS caracara_foxglove caracara_bridge_protocol)
+# The MCAP writer, the Foxglove channel catalogue, the bridge's client protocol, send queue and static files (tools/foxglove, tools/bridge).
+caracara_unit_test(test_foxglove SOURCES unit/test_mcap_writer.cpp unit/test_send_queue.cpp unit/test_static_files.cpp
+                   LIBS caracara_foxglove caracara_bridge_protocol caracara_bridge_files)

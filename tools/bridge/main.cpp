@@ -14,6 +14,8 @@
 namespace {
 
 constexpr const char* kDefaultSocket = "/run/caracara-bridge/bridge.sock";
+constexpr const char* kDefaultCockpit = "/usr/share/caracara/cockpit";
+constexpr const char* kDefaultDives = "/var/log/caracara"; // caracarad's LogsDirectory
 
 void help() {
     std::cout << "caracara-bridge [OPTIONS...]\n\n"
@@ -24,6 +26,9 @@ void help() {
                  "  --token-file FILE          The token every TCP client must bring (?token= or\n"
                  "                             Authorization: Bearer)\n"
                  "  --max-clients N            Clients at once (default 16)\n"
+                 "  --cockpit-dir DIR          The cockpit's files, served to browsers on the same socket\n"
+                 "                             (default " << kDefaultCockpit << "; docs/cockpit.md)\n"
+                 "  --dives-dir DIR            The recorded dives the cockpit lists (default " << kDefaultDives << ")\n"
                  "  --system | --user | --bus-address ADDR   The bus caracarad is on (default: system)\n"
                  "  -h --help                  Show this help\n";
 }
@@ -38,6 +43,8 @@ int usage(const std::string& m) {
 int main(int argc, char** argv) {
     caracara::bridge::ListenConfig listen{kDefaultSocket, "", 0, 16};
     caracara::bridge::SessionConfig session;
+    session.cockpit_dir = kDefaultCockpit;
+    session.dives_dir = kDefaultDives;
     std::string token_file;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -60,6 +67,14 @@ int main(int argc, char** argv) {
             } else {
                 return usage("--listen takes unix:PATH or tcp:ADDRESS:PORT, not '" + l + "'");
             }
+        } else if (a == "--cockpit-dir") {
+            session.cockpit_dir = value();
+            if (session.cockpit_dir.empty())
+                return usage("--cockpit-dir needs a directory");
+        } else if (a == "--dives-dir") {
+            session.dives_dir = value();
+            if (session.dives_dir.empty())
+                return usage("--dives-dir needs a directory");
         } else if (a == "--token-file") {
             token_file = value();
         } else if (a == "--max-clients") {

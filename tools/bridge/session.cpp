@@ -1,5 +1,8 @@
 #include "tools/bridge/session.hpp"
 
+#include "tools/bridge/dive_routes.hpp"
+#include "tools/bridge/static_files.hpp"
+
 #include "tools/foxglove/channels.hpp"
 
 #include <boost/algorithm/string/predicate.hpp>
@@ -114,6 +117,10 @@ void Session::reject(http::status status, std::string body) {
     res->body() = std::move(body) + "\n";
     res->keep_alive(false);
     res->prepare_payload();
+    answer(std::move(res));
+}
+
+void Session::answer(std::shared_ptr<http::response<http::string_body>> res) {
     http::async_write(ws_.next_layer(), *res, [self = shared_from_this(), res](boost::system::error_code, std::size_t) {
         boost::system::error_code ignored;
         self->ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
@@ -123,10 +130,17 @@ void Session::reject(http::status status, std::string body) {
 void Session::on_request(boost::system::error_code ec) {
     if (ec)
         return; // not HTTP, or gone before the request
+    // A plain GET of the cockpit's files: the same for everyone, so without the token (the page
+    // passes its own URL's token to its WebSocket and to /dives/; no vehicle data comes without it).
+    const bool upgrade = websocket::is_upgrade(request_);
+    const bool dives = view(request_.target()).starts_with(DiveRoutes::kPrefix);
+    if (!upgrade && !dives)
+        return answer(std::make_shared<http::response<http::string_body>>(
+            StaticFiles(config_.cockpit_dir).respond(request_)));
     if (!config_.token.empty() && !same(token_of(request_), config_.token))
         return reject(http::status::unauthorized, "caracara-bridge: a valid token is required");
-    if (!websocket::is_upgrade(request_))
-        return reject(http::status::bad_request, "caracara-bridge speaks the Foxglove WebSocket protocol (ws://)");
+    if (!upgrade)
+        return answer(std::make_shared<http::response<http::string_body>>(DiveRoutes(config_.dives_dir).respond(request_)));
     if (!offers_subprotocol(request_))
         return reject(http::status::bad_request, std::string("caracara-bridge needs the subprotocol ") + kSubprotocol);
     try {

@@ -27,6 +27,8 @@ struct SessionConfig {
     std::string token;                  // required in the request when not empty (TCP)
     std::size_t max_message_bytes = 64 * 1024;
     std::size_t max_queued = 256;       // messageData frames waiting for a slow client
+    std::string cockpit_dir;            // the cockpit's files, served to plain HTTP GETs (docs/cockpit.md)
+    std::string dives_dir;              // the recorded dives, under /dives/ (with the token, on TCP)
 };
 
 class Session : public std::enable_shared_from_this<Session> {
@@ -44,6 +46,7 @@ private:
 
     void on_request(boost::system::error_code ec);
     void reject(boost::beast::http::status status, std::string body);
+    void answer(std::shared_ptr<boost::beast::http::response<boost::beast::http::string_body>> res);
     void on_accept(boost::system::error_code ec);
     void read();
     void on_frame(boost::system::error_code ec);

@@ -1,0 +1,94 @@
+// Gamepad piloting (docs/cockpit.md): the Gamepad API's standard mapping to the six motion
+// axes. Each axis is a sum of terms ("-a1", "b7-b6": aN a stick axis, bN a button's value),
+// each stick term through a dead zone and an expo curve, then times the gain. Nothing moves
+// unless the deadman button is held.
+export const AXES = ["x", "y", "z", "yaw", "pitch", "roll"];
+export const GAINS = [0.25, 0.5, 0.75, 1.0];
+const KEY = "caracara.cockpit.mapping";
+
+export const DEFAULT_MAPPING = {
+  x: "-a1",      // left stick forward: surge
+  y: "a0",       // left stick right: sway
+  z: "b6-b7",    // left trigger up, right trigger down: heave
+  yaw: "a2",     // right stick right
+  pitch: "-a3",  // right stick forward: nose up
+  roll: "b15-b14", // d-pad right/left
+  deadman: 4,    // left bumper, held
+  gain_up: 12,   // d-pad up: the next gain
+  gain_down: 13, // d-pad down: the one before
+  deadzone: 0.1,
+  expo: 0.3,
+  gain: 0.5,
+};
+
+// "b6-b7" -> [{sign:1,kind:"b",index:6},{sign:-1,kind:"b",index:7}]; throws on anything else.
+export function parseTerms(text) {
+  const s = String(text).replace(/\s+/g, "");
+  if (s === "" || s === "0") return [];
+  const terms = [];
+  const re = /([+-]?)([ab])(\d{1,2})/gy;
+  let at = 0;
+  for (let m; at < s.length && (m = re.exec(s)); at = re.lastIndex) {
+    if (terms.length && !m[1]) break; // terms after the first need their sign: "a1b2" is no mapping
+    terms.push({ sign: m[1] === "-" ? -1 : 1, kind: m[2], index: Number(m[3]) });
+  }
+  if (at !== s.length || !terms.length) throw new Error(`not a mapping: '${text}' (terms like -a1 or b6-b7)`);
+  return terms;
+}
+
+export function validMapping(m) {
+  for (const a of AXES) parseTerms(m[a]);
+  for (const [k, lo, hi] of [["deadman", 0, 31], ["gain_up", 0, 31], ["gain_down", 0, 31], ["deadzone", 0, 0.9],
+    ["expo", 0, 1], ["gain", 0, 1]]) {
+    const v = Number(m[k]);
+    if (!Number.isFinite(v) || v < lo || v > hi) throw new Error(`${k} must be ${lo}..${hi}`);
+  }
+  return true;
+}
+
+export function loadMapping(storage = localStorage) {
+  try {
+    const m = { ...DEFAULT_MAPPING, ...JSON.parse(storage.getItem(KEY) ?? "{}") };
+    validMapping(m);
+    return m;
+  } catch {
+    return { ...DEFAULT_MAPPING };
+  }
+}
+
+export function saveMapping(m, storage = localStorage) {
+  validMapping(m);
+  storage.setItem(KEY, JSON.stringify(m));
+}
+
+// The gain after a press of gain_up (+1) or gain_down (-1), within GAINS.
+export function stepGain(gain, step) {
+  const next = step > 0 ? GAINS.find((g) => g > gain) : GAINS.findLast((g) => g < gain);
+  return next ?? (step > 0 ? GAINS[GAINS.length - 1] : GAINS[0]);
+}
+
+// Dead zone then expo on one stick value in -1..1.
+export function shape(v, deadzone, expo) {
+  const a = Math.min(1, Math.abs(v));
+  if (a <= deadzone) return 0;
+  const t = (a - deadzone) / (1 - deadzone);
+  return Math.sign(v) * ((1 - expo) * t + expo * t * t * t);
+}
+
+// A gamepad's state -> {held, motion: {x..roll}}; motion is all zero unless the deadman is held.
+export function sample(pad, mapping) {
+  const button = (i) => pad.buttons[i]?.value ?? (pad.buttons[i]?.pressed ? 1 : 0);
+  const held = Boolean(pad.buttons[mapping.deadman]?.pressed);
+  const motion = {};
+  for (const axis of AXES) {
+    let v = 0;
+    if (held) {
+      for (const t of parseTerms(mapping[axis])) {
+        const raw = t.kind === "a" ? (pad.axes[t.index] ?? 0) : button(t.index);
+        v += t.sign * shape(raw, mapping.deadzone, mapping.expo);
+      }
+    }
+    motion[axis] = Math.max(-1, Math.min(1, v * mapping.gain)) || 0;
+  }
+  return { held, motion };
+}
