@@ -30,7 +30,8 @@ void help() {
                  "                             (default " << kDefaultCockpit << "; docs/cockpit.md)\n"
                  "  --dives-dir DIR            The recorded dives the cockpit lists (default " << kDefaultDives << ")\n"
                  "  --system | --user | --bus-address ADDR   The bus caracarad is on (default: system)\n"
-                 "  -h --help                  Show this help\n";
+                 "  -h --help                  Show this help\n"
+                 "  --version                  Show the version\n";
 }
 
 int usage(const std::string& m) {
@@ -51,6 +52,9 @@ int main(int argc, char** argv) {
         auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
         if (a == "-h" || a == "--help") {
             help();
+            return 0;
+        } else if (a == "--version") {
+            std::cout << "caracara-bridge " << CARACARA_VERSION << '\n';
             return 0;
         } else if (a == "--listen") {
             const std::string l = value();
