@@ -14,30 +14,19 @@ void Announcer::request(uint32_t changes) {
             sd_event_source_set_priority(s, kAnnouncePriority);
         }
     }
-    if (source_) {
+    if (source_)
         sd_event_source_set_enabled(source_.get(), SD_EVENT_ONESHOT);
-        return;
-    }
-    do // no event loop to defer to: every part now
-        on_flush(nullptr, this);
-    while (part_ != 0);
+    else
+        on_flush(nullptr, this); // no event loop to defer to: now
 }
 
 int Announcer::on_flush(sd_event_source*, void* userdata) {
     auto* self = static_cast<Announcer*>(userdata);
-    if (self->part_ == 0) {
-        uint32_t changes = self->pending_;
-        self->pending_ = 0;
-        if ((changes & kTelemetryTick) && ++self->ticks_ % 5 == 0)
-            changes |= kCounterTick;
-        self->flushing_ = changes;
-    }
-    const bool more = self->flush_(self->flushing_, self->part_++);
-    if (!more)
-        self->part_ = 0;
-    // The next part, or the changes that came in meanwhile.
-    if (self->source_ && (more || self->pending_))
-        sd_event_source_set_enabled(self->source_.get(), SD_EVENT_ONESHOT);
+    uint32_t changes = self->pending_;
+    self->pending_ = 0;
+    if ((changes & kTelemetryTick) && ++self->ticks_ % 5 == 0)
+        changes |= kCounterTick;
+    self->flush_(changes);
     return 0;
 }
 

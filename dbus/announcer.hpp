@@ -7,7 +7,6 @@
 #include "drivers/sdbus/sdbus.hpp"
 
 #include <cstdint>
-#include <cstddef>
 #include <functional>
 
 namespace caracara::dbus {
@@ -19,9 +18,7 @@ inline constexpr uint32_t kCounterTick = 1u << 17;
 
 class Announcer {
 public:
-    // Announces part `part` (an object) of a flush of `changes`; true if a part follows. One part
-    // per dispatch: a kill switch edge or a Kill() call waits for one object's signal at most.
-    using Flush = std::function<bool(uint32_t changes, std::size_t part)>;
+    using Flush = std::function<void(uint32_t changes)>;
     Announcer(sd_bus* bus, Flush flush) : bus_(bus), flush_(std::move(flush)) {}
     // VehicleChange flags and/or kTelemetryTick.
     void request(uint32_t changes);
@@ -32,8 +29,6 @@ private:
     sd_bus* bus_;
     Flush flush_;
     uint32_t pending_ = 0;
-    uint32_t flushing_ = 0; // the changes of the flush under way
-    std::size_t part_ = 0;  // its next part; 0: none under way
     uint64_t ticks_ = 0;
     SourcePtr source_;
 };

@@ -7,7 +7,7 @@ namespace caracara::dbus {
 
 VehicleService::VehicleService(sd_bus* bus, VehicleDaemon& daemon)
     : bus_(bus), vehicle_(bus, {daemon.vehicle(), daemon.teensy(), daemon.loop(), daemon.config().control}), teensy_(bus, daemon.teensy()), bus_object_(bus, daemon.bus().monitor()),
-      clients_(bus, daemon.vehicle()), announcer_(bus, [this](uint32_t changes, std::size_t part) { return announce(changes, part); }) {
+      clients_(bus, daemon.vehicle()), announcer_(bus, [this](uint32_t changes) { announce(changes); }) {
     for (size_t i = 0; i < daemon.bus().size(); ++i)
         thrusters_.push_back(std::make_unique<ThrusterObject>(bus, daemon.bus(), i));
     // The dive recorder writes who called beside each state change: the sender of the message
@@ -41,18 +41,12 @@ int VehicleService::start() {
     return sd_bus_request_name(bus_, kBusName, 0);
 }
 
-bool VehicleService::announce(uint32_t changes, std::size_t part) {
-    // The vehicle, each thruster, the Teensy, the bus: one object per part.
-    const std::size_t n = thrusters_.size();
-    if (part == 0)
-        vehicle_.announce(changes);
-    else if (part <= n)
-        thrusters_[part - 1]->announce(changes);
-    else if (part == n + 1)
-        teensy_.announce(changes);
-    else
-        bus_object_.announce(changes);
-    return part < n + 2;
+void VehicleService::announce(uint32_t changes) {
+    vehicle_.announce(changes);
+    for (auto& t : thrusters_)
+        t->announce(changes);
+    teensy_.announce(changes);
+    bus_object_.announce(changes);
 }
 
 } // namespace caracara::dbus

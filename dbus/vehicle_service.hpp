@@ -31,8 +31,7 @@ public:
     void bus_restored(uint32_t pulses, double milliseconds) override { bus_object_.emit_restored(pulses, milliseconds); }
 
 private:
-    // Part `part` of a flush (one object); true if another follows.
-    bool announce(uint32_t changes, std::size_t part);
+    void announce(uint32_t changes);
 
     sd_bus* bus_;
     VehicleEvents* events_ = nullptr;
