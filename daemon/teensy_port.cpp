@@ -106,6 +106,7 @@ void TeensyPort::link_lost() {
 }
 
 void TeensyPort::poll() {
+    worker_.collect(); // the last poll's result, if it is in
     if (poll_out_ || !open_)
         return;
     const unsigned sensors = static_cast<unsigned>(tm_.distances.size());
@@ -128,7 +129,7 @@ void TeensyPort::poll() {
             }
             poll_.err = poll_.ok ? 0 : spi_.last_errno();
         },
-        [this] { poll_done(); });
+        [this] { poll_done(); }, false);
 }
 
 void TeensyPort::poll_done() {

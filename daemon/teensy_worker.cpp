@@ -59,7 +59,7 @@ void TeensyWorker::stop() {
     }
 }
 
-void TeensyWorker::submit(Work work, Done done) {
+void TeensyWorker::submit(Work work, Done done, bool wake) {
     if (!running()) {
         if (work)
             work();
@@ -71,7 +71,7 @@ void TeensyWorker::submit(Work work, Done done) {
     ++outstanding_;
     {
         std::lock_guard lk(mu_);
-        queue_.push_back({std::move(work), std::move(done)});
+        queue_.push_back({std::move(work), std::move(done), wake});
     }
     wake_.notify_one();
 }
@@ -90,7 +90,9 @@ void TeensyWorker::run() {
         lk.lock();
         published_ = link_.counters();
         done_.push_back(std::move(job.done));
-        if (queue_.empty()) {
+        wake_owed_ = wake_owed_ || job.wake;
+        if (queue_.empty() && wake_owed_) {
+            wake_owed_ = false;
             const uint64_t one = 1;
             [[maybe_unused]] const ssize_t n = ::write(efd_, &one, sizeof one);
         }
@@ -109,6 +111,7 @@ void TeensyWorker::deliver() {
     {
         std::lock_guard lk(mu_);
         delivering_.swap(done_);
+        wake_owed_ = false;
         if (!delivering_.empty())
             counters_ = published_;
     }

@@ -36,8 +36,12 @@ public:
     void stop();
     bool running() const { return thread_.joinable(); }
 
-    // Before start and after stop the work runs at once, on the caller's thread.
-    void submit(Work work, Done done);
+    // Before start and after stop the work runs at once, on the caller's thread. `wake`: the
+    // loop is woken for its `done`; without it, `done` waits for the next wake-up or collect()
+    // (the cycle's poll: its result is taken at the next cycle, at no wake-up of its own).
+    void submit(Work work, Done done, bool wake = true);
+    // Runs the `done` of the jobs finished so far (loop thread).
+    void collect() { deliver(); }
     bool idle() const { return outstanding_ == 0; }
     // The link's counters as of the last finished job.
     const TeensyLinkCounters& counters() const { return counters_; }
@@ -46,6 +50,7 @@ private:
     struct Job {
         Work work;
         Done done;
+        bool wake = true;
     };
     static int on_done(sd_event_source*, int fd, uint32_t, void* userdata);
     void run();
@@ -60,6 +65,7 @@ private:
     std::condition_variable wake_;
     std::deque<Job> queue_;
     std::vector<Done> done_;
+    bool wake_owed_ = false; // under mu_: a job in done_ wants the loop woken
     std::vector<Done> delivering_; // loop thread; reused
     bool stopping_ = false;
 
