@@ -177,7 +177,15 @@ void ControlLoop::cycle() {
     ++cycles_;
     in_cycle_ = true;
     schedule_.start_cycle(settings_.status_reads_per_tick, teensy_.is_open());
+    // The cycle's transfers are handed to the bus worker right here (a few microseconds: no
+    // transfer runs on this thread), not in another event-loop iteration; unless the work has
+    // stepped aside for the announcements, when it resumes after them.
+    // The work source stays on if it returns early (input waiting), as when dispatched.
     schedule_work();
+    int work_on = SD_EVENT_OFF;
+    sd_event_source_get_enabled(work_source_.get(), &work_on);
+    if (work_on != SD_EVENT_OFF)
+        on_work(work_source_.get(), this);
     publish_telemetry_if_due(t);
 }
 
