@@ -1,27 +1,12 @@
 #include "daemon/teensy_worker.hpp"
 
-#include "drivers/platform/io_error.hpp"
-
-#include <cerrno>
-#include <sys/eventfd.h>
-#include <unistd.h>
-
 namespace caracara {
 
 std::string TeensyWorker::start(sd_event* event, int64_t priority) {
     if (running())
         return {};
-    efd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-    if (efd_ < 0)
-        return "eventfd: " + errno_name(errno);
-    sd_event_source* s = nullptr;
-    if (int r = sd_event_add_io(event, &s, efd_, EPOLLIN, on_done, this); r < 0) {
-        ::close(efd_);
-        efd_ = -1;
-        return "sd_event_add_io: " + errno_name(-r);
-    }
-    source_.reset(s);
-    sd_event_source_set_priority(s, priority);
+    if (std::string e = waker_.open(event, priority, [this] { deliver(); }); !e.empty())
+        return e;
     stopping_ = false;
     // Signals stay blocked in this thread as in the one that made it (see BusWorker::start).
     thread_ = std::thread([this] { run(); });
@@ -52,11 +37,7 @@ void TeensyWorker::stop() {
             j.done();
     }
     outstanding_ = 0;
-    source_.reset();
-    if (efd_ >= 0) {
-        ::close(efd_);
-        efd_ = -1;
-    }
+    waker_.close();
 }
 
 void TeensyWorker::submit(Work work, Done done, bool wake) {
@@ -93,17 +74,9 @@ void TeensyWorker::run() {
         wake_owed_ = wake_owed_ || job.wake;
         if (queue_.empty() && wake_owed_) {
             wake_owed_ = false;
-            const uint64_t one = 1;
-            [[maybe_unused]] const ssize_t n = ::write(efd_, &one, sizeof one);
+            waker_.wake();
         }
     }
-}
-
-int TeensyWorker::on_done(sd_event_source*, int fd, uint32_t, void* userdata) {
-    uint64_t count = 0;
-    [[maybe_unused]] const ssize_t n = ::read(fd, &count, sizeof count);
-    static_cast<TeensyWorker*>(userdata)->deliver();
-    return 0;
 }
 
 void TeensyWorker::deliver() {

@@ -6,6 +6,7 @@
 // counters through the copy made after the last job.
 #pragma once
 
+#include "daemon/loop_waker.hpp"
 #include "drivers/devices/teensy_link.hpp"
 #include "drivers/platform/event_loop.hpp"
 
@@ -52,7 +53,6 @@ private:
         Done done;
         bool wake = true;
     };
-    static int on_done(sd_event_source*, int fd, uint32_t, void* userdata);
     void run();
     void deliver();
 
@@ -69,8 +69,7 @@ private:
     std::vector<Done> delivering_; // loop thread; reused
     bool stopping_ = false;
 
-    int efd_ = -1;
-    SourcePtr source_;
+    LoopWaker waker_;
     std::thread thread_;
 };
 
