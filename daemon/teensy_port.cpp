@@ -49,9 +49,9 @@ int TeensyPort::open() {
 void TeensyPort::close() {
     if (turn_done_)
         finish_turn({Status::Hardware, "the daemon is shutting down"});
+    worker_.stop(); // after the frame on the wire; what was queued (a Stop of the way out) still runs
     turn_source_.reset();
     reopen_timer_.reset();
-    worker_.stop();
     spi_.close();
     open_ = false;
 }
@@ -192,8 +192,15 @@ Result TeensyPort::set_leds(int red, int green, int blue, Completion done) {
     if (!open_)
         return {Status::LinkError, "the Teensy is not connected"};
     const std::array<uint8_t, 3> want{static_cast<uint8_t>(red), static_cast<uint8_t>(green), static_cast<uint8_t>(blue)};
+    // A packet stream repeats its LEDs at every packet: while the same values are on their way
+    // (a slow Teensy), they are not queued again.
+    if (!done && leds_out_ == want)
+        return {};
+    leds_out_ = want;
     command([this, red, green, blue] { return link_.set_leds(red, green, blue); }, "Set LEDs",
             [this, want, done = std::move(done)](const Result& r) {
+                if (leds_out_ == want)
+                    leds_out_.reset();
                 if (r.ok()) {
                     leds_ = want;
                     events_.changed(kChangeLeds);

@@ -20,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -101,6 +102,7 @@ private:
     bool open_ = false; // loop thread: the SPI node is open (as far as the loop knows)
     TeensyTelemetry tm_;
     std::array<uint8_t, 3> leds_{};
+    std::optional<std::array<uint8_t, 3>> leds_out_; // handed to the worker, not answered yet
     bool wheels_moving_ = false;
     unsigned poll_index_ = 0;
     bool poll_out_ = false;
