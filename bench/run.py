@@ -419,7 +419,7 @@ def phase_wire(b, p, res):
 
 
 def phase_faults(b, p, res):
-    log("6. kill to the kill output, healthy and with one thruster holding every transfer 0.9 s")
+    log("6. kill to the kill output: healthy, one thruster holding every transfer 0.9 s, the Teensy holding every frame 0.5 s")
     b.start_sim(realistic=True)
     ks = b.sim_has_kill_switch()
     # i2c.timeout_ms = 1000: the adapter waits as long as a Raspberry Pi's kernel does by default.
@@ -430,19 +430,21 @@ def phase_faults(b, p, res):
     b.start_daemon(cfg)
     n = max(4, p["kill_samples"] // 4)
     out = {}
-    for hung in (False, True):
-        key = "hung" if hung else "healthy"
-        b.busctl("call", "org.caracara.Simulator1", "/org/caracara/Simulator1/thruster/3",
-                 "org.caracara.Simulator1.Thruster", "SetHang", "u", "900" if hung else "0")
-        out[key] = {"dbus": b.client("kill2output", "--samples", n, "--source", "dbus", "--seed", 61 + hung)}
+    thruster = ("/org/caracara/Simulator1/thruster/3", "org.caracara.Simulator1.Thruster")
+    teensy = ("/org/caracara/Simulator1/teensy", "org.caracara.Simulator1.Teensy")
+    # healthy; thruster 3 holding each transfer 0.9 s; the Teensy answering each SPI frame
+    # 0.5 s late (its worker is stuck that long, the loop must not be).
+    for seed, (key, hang) in enumerate((("healthy", None), ("hung", (thruster, "900")), ("teensy_hung", (teensy, "500")))):
+        if hang:
+            b.busctl("call", "org.caracara.Simulator1", hang[0][0], hang[0][1], "SetHang", "u", hang[1])
+        out[key] = {"dbus": b.client("kill2output", "--samples", n, "--source", "dbus", "--seed", 61 + seed)}
         if ks:
-            out[key]["switch"] = b.client("kill2output", "--samples", n, "--source", "switch", "--seed", 71 + hung)
-        if hung:
+            out[key]["switch"] = b.client("kill2output", "--samples", n, "--source", "switch", "--seed", 71 + seed)
+        if hang:
             b.busctl("call", "org.caracara.Vehicle1", "/org/caracara/Vehicle1", "org.caracara.Vehicle1", "ClearKill",
                      check=False)
             out[key]["rtt"] = b.client("rtt", "--calls", max(200, p["rtt_calls"] // 4), "--warmup", 50)
-    b.busctl("call", "org.caracara.Simulator1", "/org/caracara/Simulator1/thruster/3",
-             "org.caracara.Simulator1.Thruster", "SetHang", "u", "0")
+            b.busctl("call", "org.caracara.Simulator1", hang[0][0], hang[0][1], "SetHang", "u", "0")
     res["faults"] = out
     b.stop_daemon()
     b.stop_sim()
@@ -632,7 +634,7 @@ def rows_from(res, p):
     if "rtt" in res:
         st, pg = res["rtt"]["setthrust_us"], res["rtt"]["ping_us"]
         r50, r99 = st["p50"] / pg["p50"], st["p99"] / pg["p99"]
-        row("1. SetThrust round trip p50 (vs Peer.Ping)", st["p50"], pg["p50"], r50, "<= 1.3x", r50 <= 1.3, "us")
+        row("1. SetThrust round trip p50 (vs Peer.Ping)", st["p50"], pg["p50"], r50, "<= 1.2x", r50 <= 1.2, "us")
         row("1. SetThrust round trip p99 (vs Peer.Ping)", st["p99"], pg["p99"], r99, "<= 2x", r99 <= 2.0, "us")
         rf, pk = res["rtt"].get("refused_setthrust_us"), res["rtt"].get("ping_while_killed_us")
         if rf and rf["n"]:
@@ -659,8 +661,10 @@ def rows_from(res, p):
             fl = c["floor_us"]
             row(f"2. command to wire p50, {label}", c["last_us"]["p50"], fl, c["last_us"]["p50"] / fl,
                 "info", None, "us")
+            # Issue 25's goal: the seam floor measured in the same blocks, plus 0.5 ms.
+            seam99 = w["seam"]["burst_us"]["p99"] if "seam" in w else fl
             row(f"2. command to wire p99, {label}", c["last_us"]["p99"], fl, c["last_us"]["p99"] / fl,
-                "<= floor + 1 ms", c["last_us"]["p99"] <= fl + 1000, "us")
+                "<= seam p99 + 0.5 ms", c["last_us"]["p99"] <= seam99 + 500, "us")
             if "seam" in w:
                 sb = w["seam"]["burst_us"]
                 row(f"   seam floor p50 (floor program, 8 orders), {label}", sb["p50"], fl, sb["p50"] / fl,
@@ -669,7 +673,7 @@ def rows_from(res, p):
                     "info", None, "us")
             k = w["kill_dbus"]
             row(f"3. Kill() to wire p99, {label}", k["all_zero_us"]["p99"], k["floor_us"],
-                k["all_zero_us"]["p99"] / k["floor_us"], "<= 1.5x", k["all_zero_us"]["p99"] <= 1.5 * k["floor_us"],
+                k["all_zero_us"]["p99"] / k["floor_us"], "<= 1.25x", k["all_zero_us"]["p99"] <= 1.25 * k["floor_us"],
                 "us")
             if "kill_switch" in w:
                 k = w["kill_switch"]
@@ -678,8 +682,8 @@ def rows_from(res, p):
                 fig = ("3. kill switch edge to wire p99" if k.get("start") == "edge"
                        else "3. SetKillSwitch call to wire p99 (no edge in the wire log)")
                 row(f"{fig}, {label}", k["all_zero_us"]["p99"], k["floor_us"],
-                    k["all_zero_us"]["p99"] / k["floor_us"], "<= 1.5x",
-                    k["all_zero_us"]["p99"] <= 1.5 * k["floor_us"], "us")
+                    k["all_zero_us"]["p99"] / k["floor_us"], "<= 1.25x",
+                    k["all_zero_us"]["p99"] <= 1.25 * k["floor_us"], "us")
                 v = k.get("edge_via_dbus_us")
                 if v and v["n"]:
                     hop = k["dbus_to_edge_us"]["p50"]
@@ -689,7 +693,8 @@ def rows_from(res, p):
             rows.append({"figure": "3. kill switch edge: not available in this build", "value": None, "floor": None,
                          "ratio": None, "target": "", "met": None, "unit": ""})
     if "faults" in res:
-        for key, label in (("healthy", "healthy bus"), ("hung", "a thruster holding each transfer 0.9 s")):
+        for key, label in (("healthy", "healthy bus"), ("hung", "a thruster holding each transfer 0.9 s"),
+                           ("teensy_hung", "the Teensy holding each SPI frame 0.5 s")):
             f = res["faults"].get(key, {})
             for src, name in (("dbus", "Kill()"), ("switch", "kill switch edge")):
                 k = f.get(src)
@@ -698,7 +703,7 @@ def rows_from(res, p):
                 v = k["kill_output_us"]
                 row(f"6. {name} to kill output p50, {label}", v["p50"], None, None, "info", None, "us")
                 row(f"6. {name} to kill output p99, {label} ({k['missing']} missing)", v["p99"], None, None,
-                    "<= 1000 us", v["p99"] <= 1000 and k["missing"] == 0, "us")
+                    "<= 500 us", v["p99"] <= 500 and k["missing"] == 0, "us")
             r = f.get("rtt")
             if r:
                 pg = r["ping_us"]
@@ -712,17 +717,19 @@ def rows_from(res, p):
     if "cost" in res:
         c = res["cost"]
         cg = c.get("callgrind", {})
-        for key, label in (("idle", "no commands"), ("stream", f"{cg.get('stream_hz', 20)} Hz SetThrust stream")):
+        for key, label, goal in (("idle", "no commands", 25000),
+                                 ("stream", f"{cg.get('stream_hz', 20)} Hz SetThrust stream", 55000)):
             if key in cg:
                 v = cg[key]["ir_per_tick"]
                 row(f"5. instructions per tick, 50 Hz, {label}", v, c["floor_ir_per_cycle"],
-                    v / c["floor_ir_per_cycle"], "<= 100000", v <= 100000, "Ir")
+                    v / c["floor_ir_per_cycle"], f"<= {goal}", v <= goal, "Ir")
         for key, fkey, label in (("cpu_idle", "floor_cpu_idle", "no commands"),
                                  ("cpu_stream", "floor_cpu_stream", f"{cg.get('stream_hz', 20)} Hz stream")):
             if c.get(key):
                 fl = (c.get(fkey) or {}).get("percent")
                 v = c[key]["percent"]
-                row(f"5. CPU at 50 Hz, {label} (% of a core)", v, fl, v / fl if fl else None, "< 1%", v < 1.0, "%")
+                row(f"5. CPU at 50 Hz, {label} (% of a core)", v, fl, v / fl if fl else None, "<= 1.2x floor",
+                    bool(fl) and v <= 1.2 * fl, "%")
         if c.get("cpu_idle"):
             v = c["cpu_idle"]["tick_rate_hz"]
             row("   achieved tick rate at loop_rate_hz=50", v, 50.0, v / 50.0, ">= 0.99x", v >= 49.5, "Hz")

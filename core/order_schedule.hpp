@@ -25,6 +25,8 @@ public:
     void start_cycle(uint32_t status_reads, bool teensy);
     void mark_order(std::size_t i) { order_due_ |= 1u << i; }
     bool any_order_due() const { return order_due_ != 0; }
+    // Nothing left of the cycle to hand out.
+    bool empty() const { return order_due_ == 0 && status_due_ == 0 && !teensy_due_; }
     // The bus is closed (recovery) or the orders were all sent at once (a kill's zeros).
     void drop_orders() { order_due_ = 0; }
     void drop_bus_work();

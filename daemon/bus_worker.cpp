@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
-#include <sys/eventfd.h>
 #include <unistd.h>
 
 namespace caracara {
@@ -27,17 +26,8 @@ std::string BusWorker::start(sd_event* event, int64_t priority, DoneFn done) {
     on_done_ = std::move(done);
     if (running())
         return {};
-    efd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-    if (efd_ < 0)
-        return "eventfd: " + errno_name(errno);
-    sd_event_source* s = nullptr;
-    if (int r = sd_event_add_io(event, &s, efd_, EPOLLIN, on_done, this); r < 0) {
-        ::close(efd_);
-        efd_ = -1;
-        return "sd_event_add_io: " + errno_name(-r);
-    }
-    source_.reset(s);
-    sd_event_source_set_priority(s, priority);
+    if (std::string e = waker_.open(event, priority, [this] { deliver(); }); !e.empty())
+        return e;
     stopping_ = false;
     // Signals stay blocked in this thread as in the one that made it (main blocks them before
     // the daemon starts): the loop's signal sources must see them.
@@ -60,11 +50,7 @@ void BusWorker::stop() {
     outstanding_ = 0;
     for (std::size_t i = 0; i < views_.size(); ++i)
         views_[i] = published_[i];
-    source_.reset();
-    if (efd_ >= 0) {
-        ::close(efd_);
-        efd_ = -1;
-    }
+    waker_.close();
 }
 
 void BusWorker::submit(const BusJob& in, bool replace) {
@@ -144,9 +130,7 @@ void BusWorker::run() {
         // books stay fresh when the bus never rests: a wake-up per transfer would cost the loop
         // more than the transfer when the device answers at once.
         if (queue_.empty() || done_.size() >= kWakeEvery) {
-            const uint64_t one = 1;
-            // A full counter (never, at 2^64 - 1) would only merge wake-ups.
-            [[maybe_unused]] const ssize_t n = ::write(efd_, &one, sizeof one);
+            waker_.wake();
         }
     }
 }
@@ -162,13 +146,6 @@ BusJobDone BusWorker::transfer(const BusJob& job) {
     if (gate)
         gate->leave();
     return {job, e, false};
-}
-
-int BusWorker::on_done(sd_event_source*, int fd, uint32_t, void* userdata) {
-    uint64_t count = 0;
-    [[maybe_unused]] const ssize_t n = ::read(fd, &count, sizeof count);
-    static_cast<BusWorker*>(userdata)->deliver();
-    return 0;
 }
 
 void BusWorker::deliver() {

@@ -7,6 +7,7 @@
 // Finished jobs come back through an eventfd that the worker owns as an event source.
 #pragma once
 
+#include "daemon/loop_waker.hpp"
 #include "drivers/devices/bus_gate.hpp"
 #include "drivers/devices/thruster_driver.hpp"
 #include "drivers/platform/event_loop.hpp"
@@ -84,7 +85,6 @@ public:
     const ThrusterDriver& view(std::size_t i) const { return views_[i]; }
 
 private:
-    static int on_done(sd_event_source*, int fd, uint32_t, void* userdata);
     void run();
     void deliver();
     // The job's transfer, unless a kill overtook it (`skipped`) or the gate is closed.
@@ -106,8 +106,7 @@ private:
     bool stopping_ = false;
     bool busy_ = false; // a job is on the wire
 
-    int efd_ = -1;
-    SourcePtr source_;
+    LoopWaker waker_;
     DoneFn on_done_;
     std::thread thread_;
 };

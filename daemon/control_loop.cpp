@@ -107,13 +107,7 @@ int ControlLoop::on_work(sd_event_source*, void* userdata) {
             return 0;
         }
         if (w == Work::None) {
-            self->in_cycle_ = false;
-            self->last_cycle_ns_ = monotonic_ns();
-            const bool flat_out = self->settings_.loop_rate_hz == 0 && !self->bus_.recovering();
-            if (flat_out || self->cycle_overrun_)
-                self->step_aside(); // on_resume starts the next cycle
-            else
-                sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
+            self->end_cycle();
             return 0;
         }
         if (self->input_pending())
@@ -122,11 +116,23 @@ int ControlLoop::on_work(sd_event_source*, void* userdata) {
     return 0;
 }
 
+void ControlLoop::end_cycle() {
+    in_cycle_ = false;
+    last_cycle_ns_ = monotonic_ns();
+    const bool flat_out = settings_.loop_rate_hz == 0 && !bus_.recovering();
+    if (flat_out || cycle_overrun_)
+        step_aside(); // on_resume starts the next cycle
+    else
+        sd_event_source_set_enabled(work_source_.get(), SD_EVENT_OFF);
+}
+
 void ControlLoop::bus_done(const BusJob& job) {
     if (!started_ || !bus_.idle())
         return; // more of a kill's zeros to come
     if (job.kind == BusJobKind::Order && !schedule_.any_order_due())
         step_aside(); // the orders are out: announce, then the rest
+    else if (in_cycle_ && schedule_.empty())
+        end_cycle(); // the cycle's last transfer: closed here, not by another dispatch of the work
     else
         schedule_work();
 }
@@ -171,7 +177,15 @@ void ControlLoop::cycle() {
     ++cycles_;
     in_cycle_ = true;
     schedule_.start_cycle(settings_.status_reads_per_tick, teensy_.is_open());
+    // The cycle's transfers are handed to the bus worker right here (a few microseconds: no
+    // transfer runs on this thread), not in another event-loop iteration; unless the work has
+    // stepped aside for the announcements, when it resumes after them.
+    // The work source stays on if it returns early (input waiting), as when dispatched.
     schedule_work();
+    int work_on = SD_EVENT_OFF;
+    sd_event_source_get_enabled(work_source_.get(), &work_on);
+    if (work_on != SD_EVENT_OFF)
+        on_work(work_source_.get(), this);
     publish_telemetry_if_due(t);
 }
 

@@ -63,6 +63,7 @@ private:
     static int on_work(sd_event_source*, void* userdata);
     static int on_resume(sd_event_source*, void* userdata);
     void cycle();
+    void end_cycle();
     Work work_one();
     bool input_pending() const;
     void step_aside();

@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
 
     // Made before the daemon so that it outlives it: the daemon's lines tell it their kill output.
     EmergencyStop estop;
-    VehicleDaemon daemon(event.get(), *hw.io, hw.bus_io(), *hw.gpio, *cr.config);
+    VehicleDaemon daemon(event.get(), *hw.io, hw.bus_io(), hw.spi_io(), *hw.gpio, *cr.config);
     if (std::string e = daemon.start(); !e.empty()) {
         log_error("%s", e.c_str());
         sd_notifyf(0, "STATUS=%s", e.c_str());

@@ -311,10 +311,10 @@ Result Vehicle::surface(const AxisDemand& ascent) {
     return r;
 }
 
-Result Vehicle::set_leds(int red, int green, int blue) {
+Result Vehicle::set_leds(int red, int green, int blue, Completion done) {
     if (powered_off())
         return state_error();
-    return teensy_.set_leds(red, green, blue);
+    return teensy_.set_leds(red, green, blue, std::move(done));
 }
 
 void Vehicle::client_left(std::string_view unique_name) {

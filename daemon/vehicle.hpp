@@ -50,7 +50,8 @@ public:
     void kill(KillSource source, std::string_view reason, Completion done);
     void power_off(std::string_view confirmation, Completion done);
     void apply_packet(std::span<const int32_t> words, std::string_view client, Completion done);
-    Result set_leds(int red, int green, int blue);
+    // An error at once, or {} and `done` (if any) once the Teensy answered.
+    Result set_leds(int red, int green, int blue, Completion done = nullptr);
     // Selects a thrust profile by name; the current command goes out again under it at once.
     Result set_profile(std::string_view name);
     void client_left(std::string_view unique_name);

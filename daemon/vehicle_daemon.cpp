@@ -5,12 +5,13 @@
 
 namespace caracara {
 
-VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, GpioBackend& gpio, DaemonConfig config)
+VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, DeviceIo& spi_io, GpioBackend& gpio,
+                             DaemonConfig config)
     : event_(event),
       config_(std::move(config)),
       bus_(bus_io, config_, events_),
       lines_(event, gpio, config_.gpio),
-      teensy_(event, io, config_.spi, vehicle_, events_),
+      teensy_(event, spi_io, config_.spi, vehicle_, events_),
       vehicle_(config_, bus_, lines_, teensy_, events_),
       loop_(event, config_.control, vehicle_, bus_, teensy_, lines_, events_),
       recovery_(event, config_, io, gpio, bus_, loop_, vehicle_, events_),
@@ -55,6 +56,8 @@ std::string VehicleDaemon::start() {
         log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
                     errno_name(-r).c_str());
     teensy_.stop_motion(); // the wheels too may have been left running by an earlier instance
+    if (std::string e = teensy_.start(kWorkPriority); !e.empty())
+        return e;
     if (std::string e = vehicle_.start(event_); !e.empty())
         return e;
     bus_.health().set_gate(&vehicle_); // a thruster that stopped answering kills the vehicle

@@ -26,8 +26,10 @@ namespace caracara {
 
 class VehicleDaemon {
 public:
-    // `bus_io` carries the I2C transfers on the bus worker's thread; `io` everything else.
-    VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, GpioBackend& gpio, DaemonConfig config);
+    // `bus_io` carries the I2C transfers on the bus worker's thread, `spi_io` the Teensy's frames
+    // on the Teensy worker's; `io` everything else.
+    VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, DeviceIo& spi_io, GpioBackend& gpio,
+                  DaemonConfig config);
     ~VehicleDaemon() { shutdown(); }
     VehicleDaemon(const VehicleDaemon&) = delete;
     VehicleDaemon& operator=(const VehicleDaemon&) = delete;

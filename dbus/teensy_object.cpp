@@ -13,35 +13,42 @@ namespace {
 
 TeensyPort& ctl(void* userdata) { return *static_cast<TeensyPort*>(userdata); }
 
+// Every Teensy command is carried by its worker: replied to when the Teensy answered (other
+// calls are served meanwhile), or at once when refused before anything was sent.
+int reply_when_done(sd_bus_message* m, const Result& started) { return started.ok() ? 1 : reply(m, started); }
+
 int m_set_speed(sd_bus_message* m, void* userdata, sd_bus_error*) {
     int32_t left = 0, right = 0;
     if (int r = sd_bus_message_read(m, "ii", &left, &right); r < 0)
         return r;
-    return reply(m, ctl(userdata).set_speed(left, right, sender(m)));
+    return reply_when_done(m, ctl(userdata).set_speed(left, right, sender(m), reply_later(m)));
 }
 
 int m_stop(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint8_t duty = 0;
     if (int r = sd_bus_message_read(m, "y", &duty); r < 0)
         return r;
-    return reply(m, ctl(userdata).stop(duty));
+    return reply_when_done(m, ctl(userdata).stop(duty, reply_later(m)));
 }
 
 int m_servo(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint8_t id = 0, degrees = 0;
     if (int r = sd_bus_message_read(m, "yy", &id, &degrees); r < 0)
         return r;
-    return reply(m, ctl(userdata).servo(id, degrees));
+    return reply_when_done(m, ctl(userdata).servo(id, degrees, reply_later(m)));
 }
 
 int m_distance(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint8_t sensor = 0;
     if (int r = sd_bus_message_read(m, "y", &sensor); r < 0)
         return r;
-    uint16_t mm = 0;
-    if (Result res = ctl(userdata).distance(sensor, mm); !res.ok())
-        return reply(m, res);
-    return sd_bus_reply_method_return(m, "q", mm);
+    auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
+    return reply_when_done(m, ctl(userdata).distance(sensor, [held](const Result& res, uint16_t mm) {
+        if (!res.ok())
+            reply(held.get(), res);
+        else
+            sd_bus_reply_method_return(held.get(), "q", mm);
+    }));
 }
 
 int turn(sd_bus_message* m, void* userdata, bool absolute) {
@@ -49,8 +56,7 @@ int turn(sd_bus_message* m, void* userdata, bool absolute) {
     if (int r = sd_bus_message_read(m, "d", &radians); r < 0)
         return r;
     // Replied to when the Teensy confirms; other calls are served meanwhile.
-    Result res = ctl(userdata).turn(radians, absolute, sender(m), reply_later(m));
-    return res.ok() ? 1 : reply(m, res);
+    return reply_when_done(m, ctl(userdata).turn(radians, absolute, sender(m), reply_later(m)));
 }
 
 int m_turn(sd_bus_message* m, void* userdata, sd_bus_error*) { return turn(m, userdata, false); }

@@ -83,7 +83,9 @@ int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint8_t red = 0, green = 0, blue = 0;
     if (int r = sd_bus_message_read(m, "yyy", &red, &green, &blue); r < 0)
         return r;
-    return reply(m, ctl(userdata).set_leds(red, green, blue));
+    // Replied to when the Teensy answered; other calls are served meanwhile.
+    const Result res = ctl(userdata).set_leds(red, green, blue, reply_later(m));
+    return res.ok() ? 1 : reply(m, res);
 }
 
 using D = const Parts&;

@@ -66,6 +66,7 @@ size_t DeviceOps::handle(DeviceSession& session, std::span<const uint8_t> req, s
     Request q{*this, session, simproto::Reader(req), simproto::Writer(reply), {}, Op::Open, reply};
     wire_ns = 0;
     held_ns_ = 0;
+    on_spi_ = false;
     if (!q.r.header(q.h) || (q.h.op & simproto::kReplyBit)) {
         // Not even a header we understand: answer with a bare error so the client is not left hanging.
         q.op = static_cast<Op>(q.h.op & ~simproto::kReplyBit);
@@ -197,9 +198,13 @@ uint64_t DeviceOps::spi_message(Request& q) {
     if (!q.r.ok() || !q.r.at_end())
         return q.bad(-EBADMSG);
     SpiPort* port = vehicle_.spi_port(dev->path);
-    const uint64_t start = vehicle_.wire_start(monotonic_ns());
+    const uint64_t start = vehicle_.spi_wire_start(monotonic_ns());
     uint64_t wire = 0;
     int res = vehicle_.spi_message(*port, xfers, start, wire);
+    on_spi_ = true;
+    // A hung Teensy: the message is answered only after the hang (the daemon's SPI worker waits).
+    held_ns_ = uint64_t{port->hang_ms} * 1'000'000ull;
+    wire += held_ns_;
     q.begin(res);
     for (auto& x : xfers)
         if (x.want_rx)

@@ -27,6 +27,8 @@ public:
     // Of the last request's wire time, how long a slave held the clock (a hung device): the
     // reply waits that long even when the wire's own timing is not simulated.
     uint64_t last_held_ns() const { return held_ns_; }
+    // The last request's wire was the SPI bus's (each bus keeps its own time).
+    bool last_on_spi() const { return on_spi_; }
     // A client that went away releases its GPIO lines, as the kernel does for a process.
     void release(DeviceSession& session);
 
@@ -52,6 +54,7 @@ private:
     SimVehicle& vehicle_;
     uint64_t bad_requests_ = 0;
     uint64_t held_ns_ = 0;
+    bool on_spi_ = false;
 };
 
 } // namespace caracara::sim

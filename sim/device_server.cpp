@@ -144,9 +144,10 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
     uint64_t due_ns = 0;
     if (self->vehicle_.realistic_timing() && wire_ns > 0) {
         // Realistic timing: the reply leaves when the transaction is over on the wire, and the
-        // wire is shared, so a transaction waits for the one before it.
-        uint64_t& free_at = self->vehicle_.bus_free_at();
-        free_at = self->vehicle_.wire_start(monotonic_ns()) + wire_ns;
+        // wire is shared, so a transaction waits for the one before it on the same bus.
+        const bool spi = self->ops_.last_on_spi();
+        uint64_t& free_at = spi ? self->vehicle_.spi_free_at() : self->vehicle_.bus_free_at();
+        free_at = (spi ? self->vehicle_.spi_wire_start(monotonic_ns()) : self->vehicle_.wire_start(monotonic_ns())) + wire_ns;
         due_ns = free_at;
     } else if (const uint64_t held = self->ops_.last_held_ns(); held > 0) {
         due_ns = monotonic_ns() + held; // a hung device holds the transfer in any timing mode
@@ -154,18 +155,21 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
         self->send_reply(*c);
         return 0;
     }
-    // Other clients (the GPIO lines' connection) are served meanwhile, as the kernel serves
-    // other file descriptors while one I2C transfer waits.
-    if (due_ns <= monotonic_ns() + kSpinLimitNs) {
-        // Short waits block the simulator right here: an event-loop timer would add its own
-        // wake-up lateness to every order.
+    // Only the spun tail of a wait blocks the simulator: the other clients (the GPIO lines'
+    // connection, the other bus) are served meanwhile, as the kernel serves a GPIO ioctl while
+    // an I2C transfer is on the wire. The timer fires early by the tail, which absorbs its
+    // wake-up lateness.
+    if (due_ns <= monotonic_ns() + kSpinTailNs) {
         wait_until(due_ns);
         self->send_reply(*c);
         return 0;
     }
+    c->due_ns = due_ns;
     sd_event_source_set_enabled(c->io.get(), SD_EVENT_OFF);
     sd_event_source* t = nullptr;
-    if (sd_event_add_time(self->event_, &t, CLOCK_MONOTONIC, due_ns / 1000, 1, on_reply_due, c) < 0) {
+    const uint64_t wake_ns = due_ns - (due_ns - monotonic_ns() <= kSpinLimitNs ? kSpinTailNs : 0);
+    if (sd_event_add_time(self->event_, &t, CLOCK_MONOTONIC, wake_ns / 1000, 1, on_reply_due, c) < 0) {
+        wait_until(due_ns);
         self->send_reply(*c);
         sd_event_source_set_enabled(c->io.get(), SD_EVENT_ON);
         return 0;
@@ -176,6 +180,8 @@ int DeviceServer::on_client(sd_event_source*, int fd, uint32_t revents, void* us
 
 int DeviceServer::on_reply_due(sd_event_source*, uint64_t, void* userdata) {
     auto* c = static_cast<Client*>(userdata);
+    if (c->due_ns - monotonic_ns() <= kSpinTailNs)
+        wait_until(c->due_ns); // the spun tail (nothing to spin when the timer came late)
     c->server->send_reply(*c);
     sd_event_source_set_enabled(c->io.get(), SD_EVENT_ON);
     c->reply_timer.reset();

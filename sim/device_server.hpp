@@ -32,6 +32,7 @@ private:
         int fd = -1;
         dbus::SourcePtr io;
         dbus::SourcePtr reply_timer;
+        uint64_t due_ns = 0; // when the held reply is due
         DeviceSession session;
         // One reply buffer per client, reused for every request (the hot path of the seam).
         std::array<uint8_t, simproto::kMaxMessage> reply{};

@@ -44,8 +44,18 @@ int m_random_busy(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     return sd_bus_reply_method_return(m, "");
 }
 
+// A hung Teensy (or its SPI controller): every message is answered `ms` late; 0 ends it.
+int m_set_hang(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    uint32_t ms = 0;
+    if (int r = sd_bus_message_read(m, "u", &ms); r < 0)
+        return r;
+    static_cast<SimVehicle*>(userdata)->teensy_port().hang_ms = ms;
+    return sd_bus_reply_method_return(m, "");
+}
+
 int m_clear(sd_bus_message* m, void* userdata, sd_bus_error*) {
     teensy(userdata).clear_faults();
+    static_cast<SimVehicle*>(userdata)->teensy_port().hang_ms = 0;
     return sd_bus_reply_method_return(m, "");
 }
 
@@ -109,10 +119,12 @@ constexpr dbus::Member kMembers[] = {
     property<[](V v) { return spi(v).last_transfers; }>("SpiLastTransfers"),
     property<[](V v) { return spi(v).last_speed_hz; }>("SpiLastSpeedHz"),
     property<[](V v) { return spi(v).last_delay_usecs; }>("SpiLastDelayUsecs"),
+    property<[](V v) { return spi(v).hang_ms; }>("HangMs"),
     member(SD_BUS_METHOD_WITH_ARGS("InjectFault", SD_BUS_ARGS("s", fault, "u", frames), SD_BUS_NO_RESULT, m_inject, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetRandomBusy", SD_BUS_ARGS("d", probability, "t", seed), SD_BUS_NO_RESULT, m_random_busy,
                                    kUnpriv)),
     member(SD_BUS_METHOD("ClearFaults", "", "", m_clear, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("SetHang", SD_BUS_ARGS("u", ms), SD_BUS_NO_RESULT, m_set_hang, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetDistance", SD_BUS_ARGS("y", sensor, "q", millimeters), SD_BUS_NO_RESULT, m_set_distance,
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("CommandCount", SD_BUS_ARGS("y", command), SD_BUS_RESULT("t", received, "t", executed),

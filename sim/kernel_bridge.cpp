@@ -227,12 +227,12 @@ void KernelBridge::handle_spi(std::span<const uint8_t> payload, int32_t& result)
     port.bits_per_word = km.bits_per_word ? km.bits_per_word : 8;
     if (km.max_speed_hz)
         port.max_speed_hz = km.max_speed_hz;
-    const uint64_t start = vehicle_.wire_start(monotonic_ns());
+    const uint64_t start = vehicle_.spi_wire_start(monotonic_ns());
     uint64_t wire = 0;
     result = vehicle_.spi_message(port, xfers, start, wire);
     if (vehicle_.realistic_timing()) {
-        vehicle_.bus_free_at() = start + wire;
-        sleep_until(vehicle_.bus_free_at());
+        vehicle_.spi_free_at() = start + wire;
+        sleep_until(vehicle_.spi_free_at());
     }
     for (auto& x : xfers)
         if (x.want_rx)

@@ -42,6 +42,8 @@ struct SpiPort {
     uint32_t last_transfers = 0;
     uint32_t last_speed_hz = 0;
     uint16_t last_delay_usecs = 0;
+    // A hung slave (caracara-sim's Teensy fault SetHang): every message is answered this late.
+    uint32_t hang_ms = 0;
 };
 
 class SimVehicle {
@@ -92,6 +94,10 @@ public:
     // When a transaction asked for at `now_ns` starts on the wire: at once, or in real-time
     // mode once the one before it is over.
     uint64_t wire_start(uint64_t now_ns) const { return realistic_ ? std::max(now_ns, bus_free_at_) : now_ns; }
+    // The SPI bus is a wire of its own (another controller on the SBC): a Teensy frame never
+    // waits for an I2C transaction, nor the other way round.
+    uint64_t& spi_free_at() { return spi_free_at_; }
+    uint64_t spi_wire_start(uint64_t now_ns) const { return realistic_ ? std::max(now_ns, spi_free_at_) : now_ns; }
 
 private:
     SimConfig cfg_;
@@ -113,6 +119,7 @@ private:
     uint64_t binds_ = 0;
     bool realistic_ = false;
     uint64_t bus_free_at_ = 0;
+    uint64_t spi_free_at_ = 0;
 };
 
 } // namespace caracara::sim

@@ -21,13 +21,16 @@ bool make_hardware(const std::string& spec, Hardware& out, std::string& error) {
             return false;
         }
         auto bus_io = std::make_unique<SimDeviceIo>();
-        if (int r = bus_io->connect(spec.substr(4)); r < 0) {
-            error = "cannot connect to caracara-sim at " + spec.substr(4) + ": " + errno_name(-r);
-            return false;
-        }
+        auto spi_io = std::make_unique<SimDeviceIo>();
+        for (SimDeviceIo* c : {bus_io.get(), spi_io.get()})
+            if (int r = c->connect(spec.substr(4)); r < 0) {
+                error = "cannot connect to caracara-sim at " + spec.substr(4) + ": " + errno_name(-r);
+                return false;
+            }
         out.gpio = make_sim_gpio_backend(*io);
         out.io = std::move(io);
         out.bus_io_own = std::move(bus_io);
+        out.spi_io_own = std::move(spi_io);
         return true;
     }
     error = "--hardware must be 'linux' or 'sim:SOCKET', got '" + spec + "'";

@@ -17,6 +17,9 @@ struct Hardware {
     // (the kill output) or the Teensy behind it. Null on Linux, where `io` is stateless.
     std::unique_ptr<DeviceIo> bus_io_own;
     DeviceIo& bus_io() { return bus_io_own ? *bus_io_own : *io; }
+    // The same for the Teensy's SPI frames, carried by the Teensy worker's thread.
+    std::unique_ptr<DeviceIo> spi_io_own;
+    DeviceIo& spi_io() { return spi_io_own ? *spi_io_own : *io; }
 };
 
 // "linux": the kernel's device nodes and libgpiod. "sim:SOCKET": a running caracara-sim.

@@ -10,6 +10,11 @@ never a figure loosened until a slow run passes."""
 # ~1 s the kill would wait behind the transfer on the event loop's thread.
 HUNG_KILL_OUTPUT_MS_MAX = 20.0
 
+# A hung Teensy (each SPI frame held 2 s): its frames are on the TeensyWorker's thread, so a
+# Ping or a SetThrust answers as on a healthy vehicle (quick bench 6: Ping p99 0.3-0.9 ms). The
+# bound is far inside one held frame, which is what a call waiting behind the Teensy would take.
+HUNG_TEENSY_DBUS_MS_MAX = 500.0
+
 # After a device vanished (the simulator gone: GPIO chip, adapter, SPI), the daemon idles:
 # at most 2 % of one core, measured over 10 s (issue 20), and its log grows by a bounded number
 # of lines (one line per source when it goes, none per reopen attempt; 10 leaves room for the

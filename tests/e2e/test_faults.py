@@ -7,7 +7,7 @@ import time
 import unittest
 
 
-from bounds import (HUNG_KILL_OUTPUT_MS_MAX, VANISHED_CPU_PERCENT_MAX, VANISHED_LOG_LINES_MAX,
+from bounds import (HUNG_KILL_OUTPUT_MS_MAX, HUNG_TEENSY_DBUS_MS_MAX, VANISHED_CPU_PERCENT_MAX, VANISHED_LOG_LINES_MAX,
                     VANISHED_WINDOW_S)
 from harness import (ERR, MOTORS, ZERO, Rig, error_name, poll, speed_byte)
 from test_paths_out import KILL_OUT, cpu_seconds
@@ -137,6 +137,84 @@ class HungThrusterTest(unittest.TestCase):
         # Three timeouts in a row (3 s here): the thruster is unreachable, and keeps its last order.
         poll(lambda: self.rig.state() == "killed", 5, message="the hung thruster did not kill")
         self.assertEqual(self.rig.vget("KillSource"), "device")
+
+
+# A hung Teensy holds each SPI frame this long; the kill output and D-Bus must answer well
+# inside it (bounds.py: HUNG_KILL_OUTPUT_MS_MAX, HUNG_TEENSY_DBUS_MS_MAX).
+TEENSY_HANG_MS = 2000
+
+
+class HungTeensyTest(unittest.TestCase):
+    """The Teensy answers each SPI frame 2 s late (simulator fault SetHang): its frames are
+    carried off the event loop, so a kill, a kill switch edge and D-Bus do not wait for one."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.rig = Rig(control={"arming_delay_ms": 0, "command_timeout_ms": 60000})
+        cls.rig.start()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.rig.sim_teensy_call("SetHang", 0, signature="u")
+        cls.rig.stop_checked()
+
+    def hang(self):
+        rig = self.rig
+        rig.sim_teensy_call("SetHang", 0, signature="u")
+        rig.reset()
+        rig.thrust([1500] * MOTORS)
+        rig.wait_sim_speeds([speed_byte(1500)] * MOTORS)
+        frames = rig.sim_teensy("Frames")
+        rig.sim_teensy_call("SetHang", TEENSY_HANG_MS, signature="u")
+        # The next poll frame is held from now on: wait until one went in.
+        poll(lambda: rig.sim_teensy("Frames") > frames, 5, message="the Teensy was not polled")
+        time.sleep(0.1)
+
+    def test_kill_and_switch_reach_the_kill_output_at_once(self):
+        lat = []
+        for source in ("dbus", "switch"):
+            self.hang()
+            since = self.rig.wire_next()
+            t0 = time.monotonic_ns()
+            if source == "dbus":
+                self.rig.vcall("Kill", timeout=10)
+            else:
+                self.rig.sim_call("SetKillSwitch", True, signature="b")
+            try:
+                edge = poll(lambda: next((e for e in self.rig.wire_log(since)[1]
+                                          if e.bus == "gpio" and e.addr == KILL_OUT and e.data == b"\x01"), None), 5,
+                            message="no kill output edge")
+                if source == "switch":
+                    t0 = next(e for e in self.rig.wire_log(since)[1]
+                              if e.bus == "gpio" and e.addr == KILL_SWITCH).time_ns
+                lat.append((edge.time_ns - t0) / 1e6)
+                # Every thruster holds zero, the Teensy notwithstanding.
+                self.rig.wait_sim_speeds([speed_byte(0)] * MOTORS)
+            finally:
+                if source == "switch":
+                    self.rig.sim_call("SetKillSwitch", False, signature="b")
+        print("\nKill() / kill switch -> kill output with the Teensy holding each frame %d ms: %.2f / %.2f ms" %
+              (TEENSY_HANG_MS, lat[0], lat[1]))
+        self.assertLess(max(lat), HUNG_KILL_OUTPUT_MS_MAX)
+
+    def test_dbus_keeps_answering(self):
+        self.hang()
+        vehicle = self.rig.obj("org.caracara.Vehicle1", "/org/caracara/Vehicle1")
+        ping = vehicle.get_dbus_method("Ping", "org.freedesktop.DBus.Peer")
+        calls = []
+        end = time.monotonic() + 2.5  # more than one held frame
+        while time.monotonic() < end:
+            t0 = time.monotonic_ns()
+            ping()
+            calls.append((time.monotonic_ns() - t0) / 1e6)
+            t0 = time.monotonic_ns()
+            self.rig.thrust([1000] * MOTORS)
+            calls.append((time.monotonic_ns() - t0) / 1e6)
+        print("\nwith the Teensy holding each frame %d ms: %d Ping/SetThrust p50 %.2f max %.2f ms" %
+              (TEENSY_HANG_MS, len(calls), statistics.median(calls), max(calls)))
+        self.assertLess(max(calls), HUNG_TEENSY_DBUS_MS_MAX)
+        # The loop kept cycling: the thrusters got the last command.
+        self.rig.wait_sim_speeds([speed_byte(1000)] * MOTORS)
 
 
 class HungThrusterDefaultTimeoutTest(unittest.TestCase):

@@ -22,7 +22,7 @@ DaemonConfig parse(const std::string& control) {
 DaemonRig::DaemonRig(const std::string& control) : config_(parse(control)), io_(wire_, config_), gpio_(wire_) {
     if (sd_event_new(&event_) < 0)
         throw std::runtime_error("sd_event_new");
-    daemon_ = std::make_unique<VehicleDaemon>(event_, io_, io_, gpio_, config_);
+    daemon_ = std::make_unique<VehicleDaemon>(event_, io_, io_, io_, gpio_, config_);
     if (std::string e = daemon_->start(); !e.empty())
         throw std::runtime_error(e);
 }
