@@ -42,4 +42,8 @@ echo "== test $dir (arm64 under qemu-aarch64-static)"
 junit=()
 [ -z "${CARACARA_CTEST_JUNIT:-}" ] || junit=(--output-junit "$CARACARA_CTEST_JUNIT"
   --test-output-size-passed 1048576 --test-output-size-failed 1048576)
-ctest --test-dir "$dir" --output-on-failure -j"$(nproc)" --timeout 900 "${junit[@]}"
+# The bridge's and the cockpit's end-to-end tests (label bridge) drive it from node and Chromium
+# on the host through an ssh forward; under qemu-user their timing-bound steps time out (the
+# first CI run of them: /vehicle/motors not matched within 10 s). The arm64 bridge is built
+# here and its protocol, MCAP and file-serving code run under qemu in test_foxglove.
+ctest --test-dir "$dir" --output-on-failure -j"$(nproc)" --timeout 900 -LE bridge "${junit[@]}"

@@ -230,7 +230,7 @@ class BridgeTest(BridgeRig, unittest.TestCase):
         self.assertTrue(dives, "no dive recorded")
         dive = os.path.join(self.rig.dives_dir, dives[0])
         out = os.path.join(self.rig.dir, "dive.mcap")
-        ctl = [os.path.join(BUILD_DIR, "tools", "caracaractl")]
+        ctl = harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "caracaractl")]
         r = subprocess.run(ctl + ["export", dive, "--format", "mcap", "--out", out], capture_output=True, text=True)
         self.assertEqual(r.returncode, 0, r.stderr)
         samples = subprocess.run(ctl + ["export", dive], capture_output=True, text=True, check=True).stdout
