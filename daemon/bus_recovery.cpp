@@ -1,12 +1,8 @@
 #include "daemon/bus_recovery.hpp"
 
 #include "core/clock.hpp"
-#include "drivers/platform/line_spec.hpp"
 #include "daemon/log.hpp"
-#include "drivers/devices/i2c_bus_clear.hpp"
 #include "drivers/platform/io_error.hpp"
-
-#include <cerrno>
 
 namespace caracara {
 
@@ -20,9 +16,8 @@ BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& 
                          ThrusterBus& bus, ControlLoop& loop, Vehicle& vehicle, VehicleEvents& events)
     : event_(event),
       config_(config),
-      io_(io),
-      gpio_(gpio),
       bus_(bus),
+      steps_(config, io, gpio, bus),
       loop_(loop),
       vehicle_(vehicle),
       events_(events),
@@ -83,13 +78,7 @@ void BusRecovery::reopen() {
         schedule(kIdlePollNs); // not under a transfer on the worker's thread
         return;
     }
-    bus_.close();
-    bus_.mux().invalidate();
-    // Quietly: one line when it went, one when it is back (ThrusterBus::note). The emergency
-    // stop's connection to the node is renewed with it (a restarted simulator).
-    release_node_holder();
-    if (bus_.open() == 0)
-        reopen_node_holder();
+    steps_.reopen_adapter();
     schedule(kReopenNs);
 }
 
@@ -139,36 +128,20 @@ void BusRecovery::attempt() {
     }
     policy_.next_attempt();
     phase_ = Phase::Idle;
-    bus_.close(); // before unbinding: the driver cannot go while the node is open
-    bus_.mux().invalidate();
-    const bool rebind = !rc.driver_id.empty();
-    if (rebind)
-        release_node_holder(); // nor while anyone else has it open (found on a real kernel)
-    if (rebind) {
-        if (int r = sysfs_write(io_, rc.unbind_path, rc.driver_id); r < 0 && r != -ENODEV)
-            log_warning("unbinding %s via %s: %s", rc.driver_id.c_str(), rc.unbind_path.c_str(), errno_name(-r).c_str());
-    }
-    BusClearResult bc = i2c_bus_clear(gpio_, line_spec(*config_.gpio.scl), line_spec(*config_.gpio.sda));
+    const BusClearResult bc = steps_.clear();
     last_pulses_ = bc.pulses;
-    if (rebind) {
-        // Even after a failed clear: the node must come back for the next attempt.
-        if (int r = sysfs_write(io_, rc.bind_path, rc.driver_id); r < 0 && r != -EBUSY)
-            log_warning("binding %s via %s: %s", rc.driver_id.c_str(), rc.bind_path.c_str(), errno_name(-r).c_str());
-    }
     if (!bc.ok()) {
         failed(bc.message);
         return;
     }
-    log_info("bus clear: SDA released after %u clock pulses, STOP sent", bc.pulses);
     node_deadline_ns_ = monotonic_ns() + ms_to_ns(rc.device_wait_ms);
     phase_ = Phase::WaitingNode;
     wait_node();
 }
 
 void BusRecovery::wait_node() {
-    const int r = bus_.open();
+    const int r = steps_.open_node();
     if (r == 0) {
-        reopen_node_holder();
         finish();
         return;
     }
@@ -214,18 +187,6 @@ void BusRecovery::verify() {
                tm.last_recovery_ms, policy_.attempt());
     events_.bus_restored(last_pulses_, tm.last_recovery_ms);
     events_.changed(kChangeBus | (was_lost ? kChangeState : 0u));
-}
-
-void BusRecovery::release_node_holder() {
-    if (node_holder_)
-        node_holder_->release();
-}
-
-void BusRecovery::reopen_node_holder() {
-    if (!node_holder_)
-        return;
-    if (std::string why = node_holder_->reopen(); !why.empty())
-        log_warning("emergency stop not re-armed: %s", why.c_str());
 }
 
 void BusRecovery::failed(const std::string& why) {

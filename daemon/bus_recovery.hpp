@@ -1,6 +1,5 @@
-// Recovering a locked I2C bus (NXP UM10204 section 3.1.16 "Bus clear"; Linux i2c_generic_scl_recovery): close the adapter, unbind
-// its platform driver, clock SCL through the GPIO lines until SDA is released and send a STOP,
-// rebind, wait for the device node, re-send the current orders (a pending kill first). Bounded
+// Recovering a locked I2C bus: the steps (BusRecoverySteps: close, unbind, bus clear, rebind),
+// then wait for the device node, re-send the current orders (a pending kill first). Bounded
 // attempts with backoff (RecoveryPolicy); when they are used up, or the lockup outlasts the
 // command timeout, the bus is reported lost and the vehicle killed (source bus), and slow
 // retries go on in the background. Owns its timers.
@@ -8,11 +7,11 @@
 
 #include "core/config.hpp"
 #include "core/recovery_policy.hpp"
+#include "daemon/bus_recovery_steps.hpp"
 #include "daemon/control_loop.hpp"
 #include "daemon/thruster_bus.hpp"
 #include "daemon/vehicle.hpp"
 #include "daemon/vehicle_events.hpp"
-#include "drivers/devices/i2c_node_holder.hpp"
 #include "drivers/platform/device_io.hpp"
 #include "drivers/platform/event_loop.hpp"
 #include "drivers/platform/gpio_backend.hpp"
@@ -30,7 +29,7 @@ public:
     void bus_locked_up(const std::string& reason) override;
     // The other holder of the I2C node (the emergency stop's connection), let go of while the
     // driver is unbound and taken again once it is back. Null: none.
-    void set_node_holder(I2cNodeHolder* holder) { node_holder_ = holder; }
+    void set_node_holder(I2cNodeHolder* holder) { steps_.set_node_holder(holder); }
     void stop() {
         timer_.reset();
         lost_timer_.reset();
@@ -46,17 +45,14 @@ private:
     void verify(); // once the re-sent orders are done: did any thruster answer?
     void reopen(); // lost without recovery configured: the adapter's node opened anew
     void failed(const std::string& why);
-    void release_node_holder();
-    void reopen_node_holder();
     // The thrusters cannot be reached: the vehicle is killed (source bus) and stays so.
     void declare_lost(const std::string& why);
     static int on_lost_timer(sd_event_source*, uint64_t usec, void* userdata);
 
     sd_event* event_;
     const DaemonConfig& config_;
-    DeviceIo& io_;
-    GpioBackend& gpio_;
     ThrusterBus& bus_;
+    BusRecoverySteps steps_;
     ControlLoop& loop_; // the orders standing now, re-sent once the bus is back
     Vehicle& vehicle_;
     VehicleEvents& events_;
@@ -66,7 +62,6 @@ private:
     uint32_t last_pulses_ = 0;
     SourcePtr timer_;
     SourcePtr lost_timer_; // a lockup longer than the command timeout is a lost bus
-    I2cNodeHolder* node_holder_ = nullptr;
 };
 
 } // namespace caracara

@@ -1,6 +1,5 @@
 #include "daemon/bus_worker.hpp"
 
-#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <unistd.h>
@@ -67,20 +66,7 @@ void BusWorker::submit(const BusJob& in, bool replace) {
     ++outstanding_;
     {
         std::lock_guard lk(mu_);
-        if (job.kind == BusJobKind::Order) {
-            // Orders go before the status reads, and a newer order for a thruster replaces one
-            // still queued for it: a new command waits at most for the transfer on the wire.
-            for (auto it = queue_.begin(); replace && it != queue_.end(); ++it)
-                if (it->kind == BusJobKind::Order && it->index == job.index) {
-                    queue_.erase(it);
-                    --outstanding_;
-                    break;
-                }
-            auto pos = std::find_if(queue_.begin(), queue_.end(), [](const BusJob& j) { return j.kind != BusJobKind::Order; });
-            queue_.insert(pos, job);
-        } else {
-            queue_.push_back(job);
-        }
+        outstanding_ -= queue_.push(job, replace);
     }
     wake_.notify_one();
 }
@@ -93,12 +79,7 @@ void BusWorker::submit_first(std::span<const BusJob> jobs) {
     }
     {
         std::lock_guard lk(mu_);
-        outstanding_ -= queue_.size();
-        queue_.clear();
-        for (BusJob j : jobs) {
-            j.epoch = epoch_.load();
-            queue_.push_back(j);
-        }
+        outstanding_ -= queue_.replace_all(jobs, epoch_.load());
     }
     outstanding_ += jobs.size();
     wake_.notify_one();
@@ -106,8 +87,7 @@ void BusWorker::submit_first(std::span<const BusJob> jobs) {
 
 void BusWorker::drop_queued() {
     std::lock_guard lk(mu_);
-    outstanding_ -= queue_.size();
-    queue_.clear();
+    outstanding_ -= queue_.clear();
 }
 
 void BusWorker::run() {
@@ -116,8 +96,7 @@ void BusWorker::run() {
         wake_.wait(lk, [this] { return stopping_ || !queue_.empty(); });
         if (stopping_)
             return;
-        const BusJob job = queue_.front();
-        queue_.pop_front();
+        const BusJob job = queue_.pop();
         busy_ = true;
         lk.unlock();
         const BusJobDone d = transfer(job); // nothing held

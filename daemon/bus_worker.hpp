@@ -1,22 +1,21 @@
 // The thread that carries the I2C transfers, so that the event loop never waits on the bus:
 // a hung thruster holds a transfer for up to the adapter's timeout, and a Kill, a kill switch
 // edge, D-Bus and the watchdog must not queue behind it. The loop hands over one job at a
-// time (an order or a status read); a kill puts its zero orders in front of whatever is
-// queued. Only this thread touches the drivers, the mux state and the adapter's descriptor
-// while a job is out; the loop reads each driver through the copy made after its last job.
+// time (an order or a status read), kept in order by its BusJobQueue. Only this thread
+// touches the drivers, the mux state and the adapter's descriptor while a job is out; the
+// loop reads each driver through the copy made after its last job.
 // Finished jobs come back through an eventfd that the worker owns as an event source.
 #pragma once
 
+#include "daemon/bus_job_queue.hpp"
 #include "daemon/loop_waker.hpp"
 #include "drivers/devices/bus_gate.hpp"
 #include "drivers/devices/thruster_driver.hpp"
 #include "drivers/platform/event_loop.hpp"
-#include "drivers/platform/io_error.hpp"
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -26,25 +25,6 @@
 #include <vector>
 
 namespace caracara {
-
-enum class BusJobKind : uint8_t { Order, Status };
-
-// Where zero orders go: in front of everything queued, which is dropped (a kill), or behind
-// it (a command timeout or a client that left: what it had sent goes out first).
-enum class ZeroOrder { First, Behind };
-
-struct BusJob {
-    BusJobKind kind = BusJobKind::Order;
-    uint32_t index = 0;
-    int32_t value = 0;  // the motor value of an order
-    uint64_t epoch = 0; // hold_orders() count when it was handed over (set by submit)
-};
-
-struct BusJobDone {
-    BusJob job;
-    IoError error = IoError::None;
-    bool skipped = false; // a non-zero order that a kill overtook: never sent
-};
 
 class BusWorker {
 public:
@@ -100,7 +80,7 @@ private:
     mutable std::mutex mu_;
     std::condition_variable wake_;      // the worker: a job or stop
     std::condition_variable finished_;  // wait_idle: a job finished
-    std::deque<BusJob> queue_;
+    BusJobQueue queue_;
     std::vector<BusJobDone> done_;
     std::vector<BusJobDone> delivering_; // loop thread; reused
     bool stopping_ = false;
