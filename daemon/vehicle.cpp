@@ -11,6 +11,7 @@ namespace caracara {
 
 namespace {
 constexpr const char* kPowerOffConfirmation = "power-off";
+static_assert(DeadlineTimer::kNever == SafetyMachine::kNoDeadline);
 } // namespace
 
 Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
@@ -20,7 +21,9 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       lines_(lines),
       teensy_(teensy),
       events_(events),
+      actuator_(bus, lines, teensy),
       safety_(safety_config(config), false, monotonic_ns()),
+      deadline_([this] { tick(monotonic_ns()); }),
       demand_(config.control.budget_policy, *find_profile(config, config.control.profile)) {}
 
 Result Vehicle::state_error() const {
@@ -45,29 +48,11 @@ void Vehicle::handle(const SafetyAction& a) {
         demand_.clear();
         changes |= kChangeMotors | kChangeController;
     }
-    // A kill reaches the kill output first: it is one GPIO write, and the zero orders behind it
-    // are bus transfers that a hung device can delay. Releasing it (arming) waits for the zeros.
-    const bool assert_first = a.state_changed && safety_.kill_output_asserted();
     if (safety_.kill_output_asserted())
         surfacing_ = false; // a kill ends an ascent at once
-    if (assert_first) {
-        bus_.hold_orders();
-        lines_.set_kill_output(true);
-    }
-    if (a.zero_outputs) {
-        // A kill's zeros go before anything queued; a timeout's or a departed client's go
-        // behind what that client had sent.
-        orders_->zero_all(safety_.kill_output_asserted() ? ZeroOrder::First : ZeroOrder::Behind);
-        // The wheels are motors too. A kill or power-off stops them itself, and tells a
-        // running turn why.
-        if (!safety_.kill_output_asserted())
-            teensy_.stop_if_moving();
-    }
-    if (a.state_changed) {
+    actuator_.carry_out(a, safety_.kill_output_asserted());
+    if (a.state_changed)
         changes |= kChangeState;
-        if (!assert_first)
-            lines_.set_kill_output(safety_.kill_output_asserted());
-    }
     if (a.command_stale)
         log_info("command stream silent for %llu ms: thrusters to zero",
                  static_cast<unsigned long long>(config_.control.command_timeout_ms));
@@ -75,45 +60,17 @@ void Vehicle::handle(const SafetyAction& a) {
     arm_deadline();
 }
 
-void Vehicle::arm_deadline() {
-    // The end of arming and the command timeout land on their own timer, at the time the
-    // safety machine names, not at the next tick. Re-armed only when that time moves: this runs
-    // on every cycle.
-    const uint64_t at = safety_.next_deadline();
-    if (!deadline_ || at == deadline_at_)
-        return;
-    deadline_at_ = at;
-    if (at == SafetyMachine::kNoDeadline) {
-        sd_event_source_set_enabled(deadline_.get(), SD_EVENT_OFF);
-        return;
-    }
-    sd_event_source_set_time(deadline_.get(), at / 1000);
-    sd_event_source_set_enabled(deadline_.get(), SD_EVENT_ONESHOT);
-}
-
 std::string Vehicle::start(sd_event* event) {
-    sd_event_source* s = nullptr;
-    // Accuracy 1 us, like the loop's tick: the timeout is measured against its configured value.
-    if (int r = sd_event_add_time(event, &s, CLOCK_MONOTONIC, 0, 1, on_deadline, this); r < 0)
-        return "sd_event_add_time: " + errno_name(-r);
-    deadline_.reset(s);
-    sd_event_source_set_enabled(s, SD_EVENT_OFF);
+    std::string error = deadline_.start(event);
     arm_deadline();
-    return {};
-}
-
-int Vehicle::on_deadline(sd_event_source*, uint64_t, void* userdata) {
-    auto* self = static_cast<Vehicle*>(userdata);
-    self->deadline_at_ = SafetyMachine::kNoDeadline; // a one-shot source is off once it fired
-    self->tick(monotonic_ns());
-    return 0;
+    return error;
 }
 
 void Vehicle::demand_changed() {
     MotorValues orders{};
     for (size_t i = 0; i < kMotorCount; ++i)
         orders[i] = order_value(i);
-    orders_->demand_changed(orders);
+    actuator_.hand_down(orders);
 }
 
 Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
@@ -231,21 +188,17 @@ Result Vehicle::kill(KillSource source, std::string_view reason) {
     if (!was_killed && safety_.state() == SafetyState::Killed)
         log_warning("KILLED by %s%s%s", std::string(kill_source_name()).c_str(), reason.empty() ? "" : ": ",
                     std::string(reason).c_str());
-    teensy_.stop_motion();
-    teensy_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
+    actuator_.stop_wheels();
+    actuator_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
     return {};
 }
 
-void Vehicle::after_zeros(Completion done, Result r) {
-    bus_.when_idle([done = std::move(done), r = std::move(r)] { done(r); });
-}
-
 void Vehicle::kill(KillSource source, std::string_view reason, Completion done) {
-    after_zeros(std::move(done), kill(source, reason));
+    actuator_.after_zeros(std::move(done), kill(source, reason));
 }
 
 void Vehicle::power_off(std::string_view confirmation, Completion done) {
-    after_zeros(std::move(done), power_off(confirmation));
+    actuator_.after_zeros(std::move(done), power_off(confirmation));
 }
 
 void Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client, Completion done) {
@@ -254,7 +207,7 @@ void Vehicle::apply_packet(std::span<const int32_t> words, std::string_view clie
     const SafetyState after = safety_.state();
     // An error too: a refused packet that carried a kill still killed, and its zeros go first.
     if (after != before && (after == SafetyState::Killed || after == SafetyState::PoweredOff))
-        after_zeros(std::move(done), std::move(r));
+        actuator_.after_zeros(std::move(done), std::move(r));
     else
         done(r);
 }
@@ -287,12 +240,10 @@ Result Vehicle::power_off(std::string_view confirmation) {
     if (a.error == SafetyError::PoweredOff)
         return {Status::PoweredOff, a.message};
     handle(a);
-    orders_->zero_all(ZeroOrder::First); // thrusters first, whatever handle() decided
+    actuator_.power_off(); // thrusters first, whatever handle() decided; then the line
     log_warning("POWER-OFF confirmed: thrusters to zero%s", lines_.has_power_off() ? ", then the power-off line" : "");
-    // The power-off line once the zeros are on the wire (the bus worker's thread).
-    bus_.when_idle([this] { lines_.assert_power_off(); });
-    teensy_.stop_motion();
-    teensy_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
+    actuator_.stop_wheels();
+    actuator_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
 }
 
@@ -335,9 +286,9 @@ void Vehicle::kill_switch_read(bool set) {
     else if (!set)
         log_notice("kill switch released; ClearKill re-arms the vehicle");
     if (set && !was_killed)
-        teensy_.stop_motion();
+        actuator_.stop_wheels();
     if (set)
-        teensy_.cancel_turn({Status::Killed, "the kill switch was set during the turn"});
+        actuator_.cancel_turn({Status::Killed, "the kill switch was set during the turn"});
 }
 
 std::string_view Vehicle::state_name() const {

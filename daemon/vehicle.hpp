@@ -1,7 +1,8 @@
 // The vehicle as callers see it: the safety state machine, the commands (thrust, motion,
 // packet, kill, clear, power-off, LEDs), requested/applied values with the budget, and who
-// is commanding. Every safety action is carried out here, on the bus, the safety lines and
-// the Teensy, in the order docs/architecture.md gives (kill output first, then the zeros).
+// is commanding. What the safety machine decides is carried out by its SafetyActuator (on
+// the bus, the safety lines and the Teensy); the end of arming and the command timeout come
+// from its DeadlineTimer.
 #pragma once
 
 #include "core/budget.hpp"
@@ -12,8 +13,10 @@
 #include "core/status.hpp"
 #include "daemon/command_gate.hpp"
 #include "daemon/completion.hpp"
+#include "daemon/deadline_timer.hpp"
 #include "daemon/demand_listener.hpp"
 #include "daemon/failsafe_gate.hpp"
+#include "daemon/safety_actuator.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/teensy_port.hpp"
 #include "daemon/thruster_bus.hpp"
@@ -33,10 +36,10 @@ public:
     Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
             VehicleEvents& events);
     // Where the motor values go down to the thrusters (the control loop).
-    void set_demand_listener(DemandListener* orders) { orders_ = orders; }
+    void set_demand_listener(DemandListener* orders) { actuator_.set_demand_listener(orders); }
     // Makes the deadline timer (end of arming, command timeout). "" or why it could not.
     std::string start(sd_event* event);
-    void stop() { deadline_.reset(); }
+    void stop() { deadline_.stop(); }
 
     Result set_thrust(std::span<const int32_t> values, std::string_view client);
     Result set_motion(const AxisDemand& demand, std::string_view client);
@@ -93,11 +96,8 @@ public:
     bool surfacing() const { return surfacing_; }
 
 private:
-    static int on_deadline(sd_event_source*, uint64_t usec, void* userdata);
     Result apply_packet(std::span<const int32_t> words, std::string_view client);
-    // `done(r)` once the transfers handed to the bus so far are on the wire.
-    void after_zeros(Completion done, Result r);
-    void arm_deadline();
+    void arm_deadline() { deadline_.arm(safety_.next_deadline()); }
     void handle(const SafetyAction& a);
     Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);
     // Hands the orders standing now down (DemandListener::demand_changed).
@@ -108,10 +108,9 @@ private:
     SafetyLines& lines_;
     TeensyPort& teensy_;
     VehicleEvents& events_;
-    DemandListener* orders_ = nullptr;
+    SafetyActuator actuator_;
     SafetyMachine safety_;
-    SourcePtr deadline_;
-    uint64_t deadline_at_ = SafetyMachine::kNoDeadline; // what deadline_ is armed for
+    DeadlineTimer deadline_;
 
     MotorDemand demand_;
     const FailsafeGate* failsafe_gate_ = nullptr;
