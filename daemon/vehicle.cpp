@@ -24,7 +24,7 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       actuator_(bus, lines, teensy),
       safety_(safety_config(config), false, monotonic_ns()),
       deadline_([this] { tick(monotonic_ns()); }),
-      demand_(config.control.budget_policy, *find_profile(config, config.control.profile)) {}
+      motors_(config, safety_, *this, deadline_, actuator_, events) {}
 
 Result Vehicle::state_error() const {
     // Nothing moves while the thrusters cannot be reached: no order could get there, and each
@@ -45,11 +45,11 @@ Result Vehicle::state_error() const {
 void Vehicle::handle(const SafetyAction& a) {
     uint32_t changes = 0;
     if (a.clear_commands) {
-        demand_.clear();
+        motors_.clear();
         changes |= kChangeMotors | kChangeController;
     }
     if (safety_.kill_output_asserted())
-        surfacing_ = false; // a kill ends an ascent at once
+        motors_.end_surfacing(); // a kill ends an ascent at once
     actuator_.carry_out(a, safety_.kill_output_asserted());
     if (a.state_changed)
         changes |= kChangeState;
@@ -66,35 +66,8 @@ std::string Vehicle::start(sd_event* event) {
     return error;
 }
 
-void Vehicle::demand_changed() {
-    MotorValues orders{};
-    for (size_t i = 0; i < kMotorCount; ++i)
-        orders[i] = order_value(i);
-    actuator_.hand_down(orders);
-}
-
-Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
-    if (surfacing_ && client != kFailsafeClient)
-        return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
-    const BudgetResult b = demand_.evaluate(wanted);
-    if (!b.ok())
-        return {status_of(b.error), b.message};
-    if (Result r = state_error(); !r.ok())
-        return r;
-    const std::string previous = safety_.commanding_client();
-    SafetyAction a = safety_.accept_command(monotonic_ns(), client);
-    if (!a.ok())
-        return state_error();
-    arm_deadline();
-    // A stream re-sending the same command changes nothing worth announcing.
-    const bool changed = demand_.take(wanted, b, mix_saturated);
-    demand_changed();
-    events_.changed((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
-    return {};
-}
-
 Result Vehicle::accept_command(std::string_view client) {
-    if (surfacing_)
+    if (motors_.surfacing())
         return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
     if (Result r = state_error(); !r.ok())
         return r;
@@ -105,41 +78,6 @@ Result Vehicle::accept_command(std::string_view client) {
     if (previous != safety_.commanding_client())
         events_.changed(kChangeController);
     return {};
-}
-
-Result Vehicle::set_profile(std::string_view name) {
-    const ThrustProfile* p = find_profile(config_, name);
-    if (!p)
-        return {Status::UnknownProfile,
-                "no thrust profile \"" + std::string(name) + "\"; known: " + profile_names(config_)};
-    if (p == &demand_.profile())
-        return {};
-    log_notice("thrust profile %s (factor %g)", p->name.c_str(), p->factor);
-    // The command standing now goes out under the new factor at once.
-    const bool changed = demand_.set_profile(*p);
-    demand_changed();
-    events_.changed(kChangeProfile | (changed ? kChangeMotors : 0u));
-    return {};
-}
-
-Result Vehicle::set_thrust(std::span<const int32_t> values, std::string_view client) {
-    if (values.size() != kMotorCount)
-        return {Status::InvalidLength, "SetThrust needs exactly 8 motor values, got " + std::to_string(values.size())};
-    MotorValues m{};
-    for (size_t i = 0; i < kMotorCount; ++i) {
-        if (values[i] < -kMotorMax || values[i] > kMotorMax)
-            return {Status::OutOfRange, "motor " + std::to_string(i) + ": " + std::to_string(values[i]) +
-                                            " is outside -8850..8850"};
-        m[i] = values[i];
-    }
-    return accept_motors(m, false, client);
-}
-
-Result Vehicle::set_motion(const AxisDemand& demand, std::string_view client) {
-    MixResult mr = mix(demand, config_.mixing);
-    if (mr.error != MixError::None)
-        return {status_of(mr.error), mr.message};
-    return accept_motors(mr.motors, mr.saturated, client);
 }
 
 Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client) {
@@ -174,7 +112,7 @@ Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view cl
         set_leds(p.red, p.green, p.blue);
         return {};
     }
-    Result r = accept_motors(p.motors, false, client);
+    Result r = motors_.accept(p.motors, false, client);
     if (!r.ok())
         return r;
     if (teensy_.leds() != std::array<uint8_t, 3>{p.red, p.green, p.blue})
@@ -245,21 +183,6 @@ Result Vehicle::power_off(std::string_view confirmation) {
     actuator_.stop_wheels();
     actuator_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
-}
-
-void Vehicle::exclude(const std::array<bool, kMotorCount>& excluded) {
-    const bool changed = demand_.set_excluded(excluded);
-    demand_changed();
-    events_.changed(changed ? kChangeMotors : 0u);
-}
-
-Result Vehicle::surface(const AxisDemand& ascent) {
-    MixResult mr = mix(ascent, config_.mixing);
-    if (mr.error != MixError::None)
-        return {status_of(mr.error), mr.message};
-    Result r = accept_motors(mr.motors, mr.saturated, kFailsafeClient);
-    surfacing_ = r.ok();
-    return r;
 }
 
 Result Vehicle::set_leds(int red, int green, int blue, Completion done) {
