@@ -20,6 +20,7 @@
 #include "daemon/safety_lines.hpp"
 #include "daemon/teensy_port.hpp"
 #include "daemon/thruster_bus.hpp"
+#include "daemon/vehicle_condition.hpp"
 #include "daemon/vehicle_events.hpp"
 #include "drivers/platform/event_loop.hpp"
 
@@ -62,7 +63,7 @@ public:
     void tick(uint64_t now_ns) { handle(safety_.tick(now_ns)); }
 
     void kill_switch_read(bool set) override;
-    Result state_error() const override;
+    Result state_error() const override { return condition_.state_error(); }
     bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
     Result accept_command(std::string_view client) override;
     // A line or device went away under the daemon (SafetyLines, TeensyPort): killed, source fault.
@@ -74,19 +75,19 @@ public:
     bool kill_output_asserted() const { return safety_.kill_output_asserted(); }
 
     const SafetyMachine& safety() const { return safety_; }
-    std::string_view state_name() const;
-    std::string_view kill_source_name() const;
+    std::string_view state_name() const { return condition_.state_name(); }
+    std::string_view kill_source_name() const { return condition_.kill_source_name(); }
     const MotorValues& motor_values() const { return motors_.demand().applied(); }
     const MotorValues& requested_values() const { return motors_.demand().requested(); }
     int32_t budget_limit() const { return motors_.demand().limit(); }
     bool saturated() const { return motors_.demand().saturated(); }
-    int64_t command_age_ms() const;
+    int64_t command_age_ms() const { return condition_.command_age_ms(); }
     const std::string& controller_client() const { return safety_.commanding_client(); }
     const ThrustProfile& profile() const { return motors_.demand().profile(); }
 
     // Failsafes (daemon/failsafe_monitor decides, the Vehicle carries out).
     static constexpr std::string_view kFailsafeClient = MotorCommands::kFailsafeClient;
-    void set_failsafe_gate(const FailsafeGate* gate) { failsafe_gate_ = gate; }
+    void set_failsafe_gate(const FailsafeGate* gate) { condition_.set_failsafe_gate(gate); }
     void exclude(const std::array<bool, kMotorCount>& excluded) { motors_.exclude(excluded); }
     Result surface(const AxisDemand& ascent) { return motors_.surface(ascent); }
     bool surfacing() const { return motors_.surfacing(); }
@@ -106,7 +107,7 @@ private:
     DeadlineTimer deadline_;
 
     MotorCommands motors_;
-    const FailsafeGate* failsafe_gate_ = nullptr;
+    VehicleCondition condition_;
 };
 
 } // namespace caracara
