@@ -501,8 +501,8 @@ def callgrind_window(b, pid, seconds, name):
 
 CG_FUNCTIONS = {
     "on_tick": r"ControlLoop::on_tick\(",
-    "on_work (bus transactions)": r"ControlLoop::on_work\(",
-    "deadline timer": r"Vehicle::on_deadline\(",
+    "on_work (bus transactions)": r"BusWorkDispatch::on_work\(",
+    "deadline timer": r"DeadlineTimer::on_time\(",
     "telemetry": r"VehicleService::telemetry\(",
     "vehicle_changed": r"VehicleService::vehicle_changed\(",
     "SetThrust handler": r"m_set_thrust\(",

@@ -5,12 +5,12 @@
 #include "core/status_of.hpp"
 
 #include "daemon/log.hpp"
-#include "drivers/platform/io_error.hpp"
 
 namespace caracara {
 
 namespace {
 constexpr const char* kPowerOffConfirmation = "power-off";
+static_assert(DeadlineTimer::kNever == SafetyMachine::kNoDeadline);
 } // namespace
 
 Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
@@ -20,54 +20,23 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       lines_(lines),
       teensy_(teensy),
       events_(events),
+      actuator_(bus, lines, teensy),
       safety_(safety_config(config), false, monotonic_ns()),
-      demand_(config.control.budget_policy, *find_profile(config, config.control.profile)) {}
-
-Result Vehicle::state_error() const {
-    // Nothing moves while the thrusters cannot be reached: no order could get there, and each
-    // thruster keeps whatever it was last told. Killed too, but this is what to fix first.
-    if (bus_.monitor().telemetry().state == BusState::Lost && safety_.state() != SafetyState::PoweredOff)
-        return {Status::BusLost, "the I2C bus to the thrusters is lost (" + bus_.monitor().telemetry().last_recovery_error +
-                                     "); the vehicle stays killed until it is back and ClearKill is called"};
-    switch (safety_.state()) {
-    case SafetyState::Ready: return {};
-    case SafetyState::Arming: return {Status::Arming, "the vehicle is arming; commands are accepted when it is ready"};
-    case SafetyState::Killed:
-        return {Status::Killed, "the vehicle is killed (" + std::string(kill_source_name()) + "); call ClearKill first"};
-    case SafetyState::PoweredOff: return {Status::PoweredOff, "the vehicle is powered off"};
-    }
-    return {Status::Hardware, "unknown state"};
-}
+      deadline_([this] { tick(monotonic_ns()); }),
+      motors_(config, safety_, *this, deadline_, actuator_, events),
+      condition_(safety_, bus, lines) {}
 
 void Vehicle::handle(const SafetyAction& a) {
     uint32_t changes = 0;
     if (a.clear_commands) {
-        demand_.clear();
+        motors_.clear();
         changes |= kChangeMotors | kChangeController;
     }
-    // A kill reaches the kill output first: it is one GPIO write, and the zero orders behind it
-    // are bus transfers that a hung device can delay. Releasing it (arming) waits for the zeros.
-    const bool assert_first = a.state_changed && safety_.kill_output_asserted();
     if (safety_.kill_output_asserted())
-        surfacing_ = false; // a kill ends an ascent at once
-    if (assert_first) {
-        bus_.hold_orders();
-        lines_.set_kill_output(true);
-    }
-    if (a.zero_outputs) {
-        // A kill's zeros go before anything queued; a timeout's or a departed client's go
-        // behind what that client had sent.
-        orders_->zero_all(safety_.kill_output_asserted() ? ZeroOrder::First : ZeroOrder::Behind);
-        // The wheels are motors too. A kill or power-off stops them itself, and tells a
-        // running turn why.
-        if (!safety_.kill_output_asserted())
-            teensy_.stop_if_moving();
-    }
-    if (a.state_changed) {
+        motors_.end_surfacing(); // a kill ends an ascent at once
+    actuator_.carry_out(a, safety_.kill_output_asserted());
+    if (a.state_changed)
         changes |= kChangeState;
-        if (!assert_first)
-            lines_.set_kill_output(safety_.kill_output_asserted());
-    }
     if (a.command_stale)
         log_info("command stream silent for %llu ms: thrusters to zero",
                  static_cast<unsigned long long>(config_.control.command_timeout_ms));
@@ -75,69 +44,14 @@ void Vehicle::handle(const SafetyAction& a) {
     arm_deadline();
 }
 
-void Vehicle::arm_deadline() {
-    // The end of arming and the command timeout land on their own timer, at the time the
-    // safety machine names, not at the next tick. Re-armed only when that time moves: this runs
-    // on every cycle.
-    const uint64_t at = safety_.next_deadline();
-    if (!deadline_ || at == deadline_at_)
-        return;
-    deadline_at_ = at;
-    if (at == SafetyMachine::kNoDeadline) {
-        sd_event_source_set_enabled(deadline_.get(), SD_EVENT_OFF);
-        return;
-    }
-    sd_event_source_set_time(deadline_.get(), at / 1000);
-    sd_event_source_set_enabled(deadline_.get(), SD_EVENT_ONESHOT);
-}
-
 std::string Vehicle::start(sd_event* event) {
-    sd_event_source* s = nullptr;
-    // Accuracy 1 us, like the loop's tick: the timeout is measured against its configured value.
-    if (int r = sd_event_add_time(event, &s, CLOCK_MONOTONIC, 0, 1, on_deadline, this); r < 0)
-        return "sd_event_add_time: " + errno_name(-r);
-    deadline_.reset(s);
-    sd_event_source_set_enabled(s, SD_EVENT_OFF);
+    std::string error = deadline_.start(event);
     arm_deadline();
-    return {};
-}
-
-int Vehicle::on_deadline(sd_event_source*, uint64_t, void* userdata) {
-    auto* self = static_cast<Vehicle*>(userdata);
-    self->deadline_at_ = SafetyMachine::kNoDeadline; // a one-shot source is off once it fired
-    self->tick(monotonic_ns());
-    return 0;
-}
-
-void Vehicle::demand_changed() {
-    MotorValues orders{};
-    for (size_t i = 0; i < kMotorCount; ++i)
-        orders[i] = order_value(i);
-    orders_->demand_changed(orders);
-}
-
-Result Vehicle::accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
-    if (surfacing_ && client != kFailsafeClient)
-        return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
-    const BudgetResult b = demand_.evaluate(wanted);
-    if (!b.ok())
-        return {status_of(b.error), b.message};
-    if (Result r = state_error(); !r.ok())
-        return r;
-    const std::string previous = safety_.commanding_client();
-    SafetyAction a = safety_.accept_command(monotonic_ns(), client);
-    if (!a.ok())
-        return state_error();
-    arm_deadline();
-    // A stream re-sending the same command changes nothing worth announcing.
-    const bool changed = demand_.take(wanted, b, mix_saturated);
-    demand_changed();
-    events_.changed((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
-    return {};
+    return error;
 }
 
 Result Vehicle::accept_command(std::string_view client) {
-    if (surfacing_)
+    if (motors_.surfacing())
         return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
     if (Result r = state_error(); !r.ok())
         return r;
@@ -148,41 +62,6 @@ Result Vehicle::accept_command(std::string_view client) {
     if (previous != safety_.commanding_client())
         events_.changed(kChangeController);
     return {};
-}
-
-Result Vehicle::set_profile(std::string_view name) {
-    const ThrustProfile* p = find_profile(config_, name);
-    if (!p)
-        return {Status::UnknownProfile,
-                "no thrust profile \"" + std::string(name) + "\"; known: " + profile_names(config_)};
-    if (p == &demand_.profile())
-        return {};
-    log_notice("thrust profile %s (factor %g)", p->name.c_str(), p->factor);
-    // The command standing now goes out under the new factor at once.
-    const bool changed = demand_.set_profile(*p);
-    demand_changed();
-    events_.changed(kChangeProfile | (changed ? kChangeMotors : 0u));
-    return {};
-}
-
-Result Vehicle::set_thrust(std::span<const int32_t> values, std::string_view client) {
-    if (values.size() != kMotorCount)
-        return {Status::InvalidLength, "SetThrust needs exactly 8 motor values, got " + std::to_string(values.size())};
-    MotorValues m{};
-    for (size_t i = 0; i < kMotorCount; ++i) {
-        if (values[i] < -kMotorMax || values[i] > kMotorMax)
-            return {Status::OutOfRange, "motor " + std::to_string(i) + ": " + std::to_string(values[i]) +
-                                            " is outside -8850..8850"};
-        m[i] = values[i];
-    }
-    return accept_motors(m, false, client);
-}
-
-Result Vehicle::set_motion(const AxisDemand& demand, std::string_view client) {
-    MixResult mr = mix(demand, config_.mixing);
-    if (mr.error != MixError::None)
-        return {status_of(mr.error), mr.message};
-    return accept_motors(mr.motors, mr.saturated, client);
 }
 
 Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client) {
@@ -217,7 +96,7 @@ Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view cl
         set_leds(p.red, p.green, p.blue);
         return {};
     }
-    Result r = accept_motors(p.motors, false, client);
+    Result r = motors_.accept(p.motors, false, client);
     if (!r.ok())
         return r;
     if (teensy_.leds() != std::array<uint8_t, 3>{p.red, p.green, p.blue})
@@ -231,21 +110,17 @@ Result Vehicle::kill(KillSource source, std::string_view reason) {
     if (!was_killed && safety_.state() == SafetyState::Killed)
         log_warning("KILLED by %s%s%s", std::string(kill_source_name()).c_str(), reason.empty() ? "" : ": ",
                     std::string(reason).c_str());
-    teensy_.stop_motion();
-    teensy_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
+    actuator_.stop_wheels();
+    actuator_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
     return {};
 }
 
-void Vehicle::after_zeros(Completion done, Result r) {
-    bus_.when_idle([done = std::move(done), r = std::move(r)] { done(r); });
-}
-
 void Vehicle::kill(KillSource source, std::string_view reason, Completion done) {
-    after_zeros(std::move(done), kill(source, reason));
+    actuator_.after_zeros(std::move(done), kill(source, reason));
 }
 
 void Vehicle::power_off(std::string_view confirmation, Completion done) {
-    after_zeros(std::move(done), power_off(confirmation));
+    actuator_.after_zeros(std::move(done), power_off(confirmation));
 }
 
 void Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client, Completion done) {
@@ -254,23 +129,14 @@ void Vehicle::apply_packet(std::span<const int32_t> words, std::string_view clie
     const SafetyState after = safety_.state();
     // An error too: a refused packet that carried a kill still killed, and its zeros go first.
     if (after != before && (after == SafetyState::Killed || after == SafetyState::PoweredOff))
-        after_zeros(std::move(done), std::move(r));
+        actuator_.after_zeros(std::move(done), std::move(r));
     else
         done(r);
 }
 
 Result Vehicle::clear_kill() {
-    if (bus_.monitor().telemetry().state == BusState::Lost && safety_.state() == SafetyState::Killed)
-        return {Status::BusLost, "the I2C bus to the thrusters is not back yet; the kill stays"};
-    if (const auto i = bus_.health().first_unreachable(); i && safety_.state() == SafetyState::Killed)
-        return {Status::ThrusterUnreachable,
-                "thruster " + std::to_string(*i) + " does not answer (last " +
-                    std::string(io_error_name(bus_.thruster(*i).last_error())) + "); the kill stays"};
-    if (lines_.kill_output_missing() && safety_.state() == SafetyState::Killed)
-        return {Status::Hardware, "the kill output line is gone (asked for again once a second); the kill stays"};
-    if (failsafe_gate_ && safety_.state() == SafetyState::Killed)
-        if (Result r = failsafe_gate_->clear_kill_refusal(); !r.ok())
-            return r;
+    if (Result r = condition_.clear_kill_refusal(); !r.ok())
+        return r;
     SafetyAction a = safety_.clear_kill(monotonic_ns());
     if (!a.ok())
         return {status_of(a.error), a.message};
@@ -287,28 +153,11 @@ Result Vehicle::power_off(std::string_view confirmation) {
     if (a.error == SafetyError::PoweredOff)
         return {Status::PoweredOff, a.message};
     handle(a);
-    orders_->zero_all(ZeroOrder::First); // thrusters first, whatever handle() decided
+    actuator_.power_off(); // thrusters first, whatever handle() decided; then the line
     log_warning("POWER-OFF confirmed: thrusters to zero%s", lines_.has_power_off() ? ", then the power-off line" : "");
-    // The power-off line once the zeros are on the wire (the bus worker's thread).
-    bus_.when_idle([this] { lines_.assert_power_off(); });
-    teensy_.stop_motion();
-    teensy_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
+    actuator_.stop_wheels();
+    actuator_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
-}
-
-void Vehicle::exclude(const std::array<bool, kMotorCount>& excluded) {
-    const bool changed = demand_.set_excluded(excluded);
-    demand_changed();
-    events_.changed(changed ? kChangeMotors : 0u);
-}
-
-Result Vehicle::surface(const AxisDemand& ascent) {
-    MixResult mr = mix(ascent, config_.mixing);
-    if (mr.error != MixError::None)
-        return {status_of(mr.error), mr.message};
-    Result r = accept_motors(mr.motors, mr.saturated, kFailsafeClient);
-    surfacing_ = r.ok();
-    return r;
 }
 
 Result Vehicle::set_leds(int red, int green, int blue, Completion done) {
@@ -335,30 +184,9 @@ void Vehicle::kill_switch_read(bool set) {
     else if (!set)
         log_notice("kill switch released; ClearKill re-arms the vehicle");
     if (set && !was_killed)
-        teensy_.stop_motion();
+        actuator_.stop_wheels();
     if (set)
-        teensy_.cancel_turn({Status::Killed, "the kill switch was set during the turn"});
-}
-
-std::string_view Vehicle::state_name() const {
-    // A vehicle that could run but reaches none of its thrusters is in fault, whatever it was asked.
-    const SafetyState s = safety_.state();
-    if ((s == SafetyState::Ready || s == SafetyState::Arming) && bus_.monitor().telemetry().state == BusState::Lost)
-        return "fault";
-    return caracara::state_name(s);
-}
-
-std::string_view Vehicle::kill_source_name() const {
-    if (safety_.state() != SafetyState::Killed)
-        return "";
-    return caracara::kill_source_name(safety_.kill_source());
-}
-
-int64_t Vehicle::command_age_ms() const {
-    const uint64_t last = safety_.last_command_at();
-    if (last == 0)
-        return -1;
-    return static_cast<int64_t>((monotonic_ns() - last) / 1'000'000ull);
+        actuator_.cancel_turn({Status::Killed, "the kill switch was set during the turn"});
 }
 
 } // namespace caracara

@@ -1,10 +1,10 @@
 // The vehicle as callers see it: the safety state machine, the commands (thrust, motion,
-// packet, kill, clear, power-off, LEDs), requested/applied values with the budget, and who
-// is commanding. Every safety action is carried out here, on the bus, the safety lines and
-// the Teensy, in the order docs/architecture.md gives (kill output first, then the zeros).
+// packet, kill, clear, power-off, LEDs) and who is commanding. The motor commands and their
+// values (requested, applied, the budget) are its MotorCommands' job; what the safety machine
+// decides is carried out by its SafetyActuator (on the bus, the safety lines and the Teensy);
+// the end of arming and the command timeout come from its DeadlineTimer.
 #pragma once
 
-#include "core/budget.hpp"
 #include "core/config.hpp"
 #include "core/mixing.hpp"
 #include "core/motor_demand.hpp"
@@ -12,11 +12,15 @@
 #include "core/status.hpp"
 #include "daemon/command_gate.hpp"
 #include "daemon/completion.hpp"
+#include "daemon/deadline_timer.hpp"
 #include "daemon/demand_listener.hpp"
 #include "daemon/failsafe_gate.hpp"
+#include "daemon/motor_commands.hpp"
+#include "daemon/safety_actuator.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/teensy_port.hpp"
 #include "daemon/thruster_bus.hpp"
+#include "daemon/vehicle_condition.hpp"
 #include "daemon/vehicle_events.hpp"
 #include "drivers/platform/event_loop.hpp"
 
@@ -33,13 +37,14 @@ public:
     Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
             VehicleEvents& events);
     // Where the motor values go down to the thrusters (the control loop).
-    void set_demand_listener(DemandListener* orders) { orders_ = orders; }
+    void set_demand_listener(DemandListener* orders) { actuator_.set_demand_listener(orders); }
     // Makes the deadline timer (end of arming, command timeout). "" or why it could not.
     std::string start(sd_event* event);
-    void stop() { deadline_.reset(); }
+    void stop() { deadline_.stop(); }
 
-    Result set_thrust(std::span<const int32_t> values, std::string_view client);
-    Result set_motion(const AxisDemand& demand, std::string_view client);
+    // The motor commands are its MotorCommands' job.
+    Result set_thrust(std::span<const int32_t> values, std::string_view client) { return motors_.set_thrust(values, client); }
+    Result set_motion(const AxisDemand& demand, std::string_view client) { return motors_.set_motion(demand, client); }
     Result kill(KillSource source, std::string_view reason = {});
     Result clear_kill();
     Result power_off(std::string_view confirmation);
@@ -52,70 +57,57 @@ public:
     void apply_packet(std::span<const int32_t> words, std::string_view client, Completion done);
     // An error at once, or {} and `done` (if any) once the Teensy answered.
     Result set_leds(int red, int green, int blue, Completion done = nullptr);
-    // Selects a thrust profile by name; the current command goes out again under it at once.
-    Result set_profile(std::string_view name);
+    Result set_profile(std::string_view name) { return motors_.set_profile(name); }
     void client_left(std::string_view unique_name);
     // Once per cycle: arming and the command timeout.
     void tick(uint64_t now_ns) { handle(safety_.tick(now_ns)); }
 
     void kill_switch_read(bool set) override;
-    Result state_error() const override;
+    Result state_error() const override { return condition_.state_error(); }
     bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
     Result accept_command(std::string_view client) override;
     // A line or device went away under the daemon (SafetyLines, TeensyPort): killed, source fault.
     void device_lost(std::string_view why) override { kill(KillSource::Device, why); }
 
     // What thruster i is to be ordered now: its applied value while the vehicle may drive.
-    int32_t order_value(size_t i) const { return safety_.may_drive() ? demand_.applied()[i] : 0; }
+    int32_t order_value(size_t i) const { return motors_.order_value(i); }
     bool may_drive() const { return safety_.may_drive(); }
     bool kill_output_asserted() const { return safety_.kill_output_asserted(); }
 
     const SafetyMachine& safety() const { return safety_; }
-    std::string_view state_name() const;
-    std::string_view kill_source_name() const;
-    const MotorValues& motor_values() const { return demand_.applied(); }
-    const MotorValues& requested_values() const { return demand_.requested(); }
-    int32_t budget_limit() const { return demand_.limit(); }
-    bool saturated() const { return demand_.saturated(); }
-    int64_t command_age_ms() const;
+    std::string_view state_name() const { return condition_.state_name(); }
+    std::string_view kill_source_name() const { return condition_.kill_source_name(); }
+    const MotorValues& motor_values() const { return motors_.demand().applied(); }
+    const MotorValues& requested_values() const { return motors_.demand().requested(); }
+    int32_t budget_limit() const { return motors_.demand().limit(); }
+    bool saturated() const { return motors_.demand().saturated(); }
+    int64_t command_age_ms() const { return condition_.command_age_ms(); }
     const std::string& controller_client() const { return safety_.commanding_client(); }
-    const ThrustProfile& profile() const { return demand_.profile(); }
+    const ThrustProfile& profile() const { return motors_.demand().profile(); }
 
     // Failsafes (daemon/failsafe_monitor decides, the Vehicle carries out).
-    static constexpr std::string_view kFailsafeClient = "failsafe"; // who drives an ascent
-    void set_failsafe_gate(const FailsafeGate* gate) { failsafe_gate_ = gate; }
-    // These thrusters to zero and out of the budget's count; the standing command goes on.
-    void exclude(const std::array<bool, kMotorCount>& excluded);
-    // The ascent, through the mixing and the budget, as client kFailsafeClient (called again
-    // to keep it past the command timeout); every other motion command gets Surfacing until
-    // a kill ends it.
-    Result surface(const AxisDemand& ascent);
-    bool surfacing() const { return surfacing_; }
+    static constexpr std::string_view kFailsafeClient = MotorCommands::kFailsafeClient;
+    void set_failsafe_gate(const FailsafeGate* gate) { condition_.set_failsafe_gate(gate); }
+    void exclude(const std::array<bool, kMotorCount>& excluded) { motors_.exclude(excluded); }
+    Result surface(const AxisDemand& ascent) { return motors_.surface(ascent); }
+    bool surfacing() const { return motors_.surfacing(); }
 
 private:
-    static int on_deadline(sd_event_source*, uint64_t usec, void* userdata);
     Result apply_packet(std::span<const int32_t> words, std::string_view client);
-    // `done(r)` once the transfers handed to the bus so far are on the wire.
-    void after_zeros(Completion done, Result r);
-    void arm_deadline();
+    void arm_deadline() { deadline_.arm(safety_.next_deadline()); }
     void handle(const SafetyAction& a);
-    Result accept_motors(const MotorValues& wanted, bool mix_saturated, std::string_view client);
-    // Hands the orders standing now down (DemandListener::demand_changed).
-    void demand_changed();
 
     const DaemonConfig& config_;
     ThrusterBus& bus_;
     SafetyLines& lines_;
     TeensyPort& teensy_;
     VehicleEvents& events_;
-    DemandListener* orders_ = nullptr;
+    SafetyActuator actuator_;
     SafetyMachine safety_;
-    SourcePtr deadline_;
-    uint64_t deadline_at_ = SafetyMachine::kNoDeadline; // what deadline_ is armed for
+    DeadlineTimer deadline_;
 
-    MotorDemand demand_;
-    const FailsafeGate* failsafe_gate_ = nullptr;
-    bool surfacing_ = false;
+    MotorCommands motors_;
+    VehicleCondition condition_;
 };
 
 } // namespace caracara
