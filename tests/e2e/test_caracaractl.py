@@ -17,7 +17,8 @@ OK, REFUSED, USAGE, UNAVAILABLE, DENIED = 0, 1, 2, 3, 4
 
 
 def ctl_available():
-    return os.access(binary("caracaractl"), os.X_OK)
+    # Under CI (CI=true) a caracaractl that is not built fails these tests instead of skipping them.
+    return os.access(binary("caracaractl"), os.X_OK) or os.environ.get("CI") == "true"
 
 
 @unittest.skipUnless(ctl_available(), "caracaractl is not built")
