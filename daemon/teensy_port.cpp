@@ -37,6 +37,8 @@ void TeensyPort::stop_if_moving() {
 }
 
 Result TeensyPort::set_leds(int red, int green, int blue, Completion done) {
+    if (gate_.powered_off())
+        return gate_.state_error();
     for (int v : {red, green, blue})
         if (v < 0 || v > 255)
             return {Status::OutOfRange, "LED values are 0..255"};

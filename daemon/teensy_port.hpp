@@ -43,7 +43,7 @@ public:
     void cancel_turn(const Result& r) { turn_.cancel(r); }
 
     // Each returns an error at once (and never calls `done`), or {} and calls `done` (if any)
-    // with the Teensy's answer once the frame is over.
+    // with the Teensy's answer once the frame is over. The LEDs are refused once powered off.
     Result set_leds(int red, int green, int blue, Completion done);
     // Wheels and turns are motors: a command from `client`, under the command timeout.
     Result set_speed(int left, int right, std::string_view client, Completion done);

@@ -1,24 +1,18 @@
 #include "daemon/vehicle.hpp"
 
 #include "core/clock.hpp"
-#include "core/packet.hpp"
 #include "core/status_of.hpp"
 
 #include "daemon/log.hpp"
 
 namespace caracara {
 
-namespace {
-constexpr const char* kPowerOffConfirmation = "power-off";
 static_assert(DeadlineTimer::kNever == SafetyMachine::kNoDeadline);
-} // namespace
 
 Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
                  VehicleEvents& events)
     : config_(config),
-      bus_(bus),
       lines_(lines),
-      teensy_(teensy),
       events_(events),
       actuator_(bus, lines, teensy),
       safety_(safety_config(config), false, monotonic_ns()),
@@ -64,46 +58,6 @@ Result Vehicle::accept_command(std::string_view client) {
     return {};
 }
 
-Result Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client) {
-    PacketResult pr = decode_packet(words);
-    // The packet's author asked for a kill: it happens even when another field is refused,
-    // and the call still returns that field's error with nothing else changed.
-    if (pr.kill_requested && !powered_off())
-        kill(KillSource::Packet, "packet killState=" + std::to_string(words[kPacketKill]));
-    if (!pr.ok())
-        return {status_of(pr.error), pr.message};
-    if (powered_off())
-        return state_error();
-    const Packet& p = pr.packet;
-    if (p.kill) {
-        // The seed: a non-zero killState stops the motors until a zero is sent. Kill first,
-        // then a power-off the same packet asks for.
-        if (p.power_off)
-            return power_off(kPowerOffConfirmation);
-        set_leds(p.red, p.green, p.blue);
-        return {};
-    }
-    if (p.power_off)
-        return power_off(kPowerOffConfirmation);
-    if (safety_.state() == SafetyState::Killed) {
-        if (safety_.kill_source() != KillSource::Packet)
-            return state_error();
-        // killState 0 is the packet's "all clear": it clears a packet kill (arming follows).
-        SafetyAction a = safety_.clear_kill(monotonic_ns());
-        if (!a.ok())
-            return {status_of(a.error), a.message};
-        handle(a);
-        set_leds(p.red, p.green, p.blue);
-        return {};
-    }
-    Result r = motors_.accept(p.motors, false, client);
-    if (!r.ok())
-        return r;
-    if (teensy_.leds() != std::array<uint8_t, 3>{p.red, p.green, p.blue})
-        set_leds(p.red, p.green, p.blue);
-    return {};
-}
-
 Result Vehicle::kill(KillSource source, std::string_view reason) {
     const bool was_killed = safety_.state() == SafetyState::Killed;
     handle(safety_.kill(source, monotonic_ns(), reason));
@@ -123,25 +77,20 @@ void Vehicle::power_off(std::string_view confirmation, Completion done) {
     actuator_.after_zeros(std::move(done), power_off(confirmation));
 }
 
-void Vehicle::apply_packet(std::span<const int32_t> words, std::string_view client, Completion done) {
-    const SafetyState before = safety_.state();
-    Result r = apply_packet(words, client);
-    const SafetyState after = safety_.state();
-    // An error too: a refused packet that carried a kill still killed, and its zeros go first.
-    if (after != before && (after == SafetyState::Killed || after == SafetyState::PoweredOff))
-        actuator_.after_zeros(std::move(done), std::move(r));
-    else
-        done(r);
-}
-
 Result Vehicle::clear_kill() {
     if (Result r = condition_.clear_kill_refusal(); !r.ok())
         return r;
+    if (Result r = clear(); !r.ok())
+        return r;
+    log_notice("kill cleared; arming for %u ms", config_.control.arming_delay_ms);
+    return {};
+}
+
+Result Vehicle::clear() {
     SafetyAction a = safety_.clear_kill(monotonic_ns());
     if (!a.ok())
         return {status_of(a.error), a.message};
     handle(a);
-    log_notice("kill cleared; arming for %u ms", config_.control.arming_delay_ms);
     return {};
 }
 
@@ -158,12 +107,6 @@ Result Vehicle::power_off(std::string_view confirmation) {
     actuator_.stop_wheels();
     actuator_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
-}
-
-Result Vehicle::set_leds(int red, int green, int blue, Completion done) {
-    if (powered_off())
-        return state_error();
-    return teensy_.set_leds(red, green, blue, std::move(done));
 }
 
 void Vehicle::client_left(std::string_view unique_name) {

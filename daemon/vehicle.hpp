@@ -1,5 +1,6 @@
 // The vehicle as callers see it: the safety state machine, the commands (thrust, motion,
-// packet, kill, clear, power-off, LEDs) and who is commanding. The motor commands and their
+// kill, clear, power-off) and who is commanding; the legacy packet is read by its
+// PacketHandler, which asks the Vehicle for each of these. The motor commands and their
 // values (requested, applied, the budget) are its MotorCommands' job; what the safety machine
 // decides is carried out by its SafetyActuator (on the bus, the safety lines and the Teensy);
 // the end of arming and the command timeout come from its DeadlineTimer.
@@ -47,16 +48,20 @@ public:
     Result set_motion(const AxisDemand& demand, std::string_view client) { return motors_.set_motion(demand, client); }
     Result kill(KillSource source, std::string_view reason = {});
     Result clear_kill();
+    // A packet's "all clear" (killState 0): clears a kill only the packet made.
+    Result clear_packet_kill() { return clear(); }
+    static constexpr const char* kPowerOffConfirmation = "power-off";
     Result power_off(std::string_view confirmation);
+    // A packet's motor values, as SetThrust's.
+    Result drive(const MotorValues& values, std::string_view client) { return motors_.accept(values, false, client); }
     // The calls that stop the thrusters hand their result to `done` once the zero orders they
     // put on the bus are on the wire (the bus worker's thread): a caller that gets it knows
     // the thrusters were told zero. The loop does not wait for them; the kill output was
-    // asserted before any of them. A packet that neither kills nor powers off is done at once.
+    // asserted before any of them.
     void kill(KillSource source, std::string_view reason, Completion done);
     void power_off(std::string_view confirmation, Completion done);
-    void apply_packet(std::span<const int32_t> words, std::string_view client, Completion done);
-    // An error at once, or {} and `done` (if any) once the Teensy answered.
-    Result set_leds(int red, int green, int blue, Completion done = nullptr);
+    // `done(r)` once the zeros handed to the bus so far are on the wire.
+    void after_zeros(Completion done, Result r) { actuator_.after_zeros(std::move(done), std::move(r)); }
     Result set_profile(std::string_view name) { return motors_.set_profile(name); }
     void client_left(std::string_view unique_name);
     // Once per cycle: arming and the command timeout.
@@ -93,14 +98,12 @@ public:
     bool surfacing() const { return motors_.surfacing(); }
 
 private:
-    Result apply_packet(std::span<const int32_t> words, std::string_view client);
+    Result clear();
     void arm_deadline() { deadline_.arm(safety_.next_deadline()); }
     void handle(const SafetyAction& a);
 
     const DaemonConfig& config_;
-    ThrusterBus& bus_;
     SafetyLines& lines_;
-    TeensyPort& teensy_;
     VehicleEvents& events_;
     SafetyActuator actuator_;
     SafetyMachine safety_;

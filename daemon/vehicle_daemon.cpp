@@ -13,6 +13,7 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
       lines_(event, gpio, config_.gpio),
       teensy_(event, spi_io, config_.spi, vehicle_, events_),
       vehicle_(config_, bus_, lines_, teensy_, events_),
+      packets_(vehicle_, teensy_),
       loop_(event, config_.control, vehicle_, bus_, teensy_, lines_, events_),
       recovery_(event, config_, io, gpio, bus_, loop_, vehicle_, events_),
       status_(event, vehicle_, bus_, loop_),

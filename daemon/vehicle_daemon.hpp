@@ -9,6 +9,7 @@
 #include "daemon/dive_recorder.hpp"
 #include "daemon/dive_writer.hpp"
 #include "daemon/failsafe_monitor.hpp"
+#include "daemon/packet_handler.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/service_status.hpp"
 #include "daemon/teensy_port.hpp"
@@ -48,6 +49,7 @@ public:
     VehicleEvents& events() { return events_; }
     Vehicle& vehicle() { return vehicle_; }
     const Vehicle& vehicle() const { return vehicle_; }
+    PacketHandler& packets() { return packets_; }
     ThrusterBus& bus() { return bus_; }
     const ThrusterBus& bus() const { return bus_; }
     TeensyPort& teensy() { return teensy_; }
@@ -75,6 +77,7 @@ private:
     SafetyLines lines_;
     TeensyPort teensy_;
     Vehicle vehicle_;
+    PacketHandler packets_;
     ControlLoop loop_;
     BusRecovery recovery_;
     ServiceStatus status_;

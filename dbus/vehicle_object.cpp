@@ -45,8 +45,8 @@ int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error*) {
     std::vector<int32_t> v;
     if (int r = read_ints(m, v); r < 0)
         return r;
-    // Replied to when the vehicle says the packet is done (Vehicle::apply_packet).
-    ctl(userdata).apply_packet(v, sender(m), reply_later(m));
+    // Replied to when the vehicle says the packet is done (PacketHandler::apply).
+    static_cast<Parts*>(userdata)->packets.apply(v, sender(m), reply_later(m));
     return 1;
 }
 
@@ -84,7 +84,7 @@ int m_set_leds(sd_bus_message* m, void* userdata, sd_bus_error*) {
     if (int r = sd_bus_message_read(m, "yyy", &red, &green, &blue); r < 0)
         return r;
     // Replied to when the Teensy answered; other calls are served meanwhile.
-    const Result res = ctl(userdata).set_leds(red, green, blue, reply_later(m));
+    const Result res = static_cast<Parts*>(userdata)->teensy.set_leds(red, green, blue, reply_later(m));
     return res.ok() ? 1 : reply(m, res);
 }
 

@@ -4,6 +4,7 @@
 #include "core/config.hpp"
 #include "daemon/control_loop.hpp"
 #include "daemon/failsafe_monitor.hpp"
+#include "daemon/packet_handler.hpp"
 #include "daemon/teensy_port.hpp"
 #include "daemon/vehicle.hpp"
 #include "dbus/announced_object.hpp"
@@ -12,11 +13,12 @@ namespace caracara::dbus {
 
 class VehicleObject {
 public:
-    // What the object drives and shows: the vehicle, the Teensy's LEDs, the loop's cycle
+    // What the object drives and shows: the vehicle, its legacy packet, the Teensy's LEDs, the loop's cycle
     // count, the control settings and the failsafes (active ones, ClearKillOverride).
     struct Parts {
         Vehicle& vehicle;
-        const TeensyPort& teensy;
+        PacketHandler& packets;
+        TeensyPort& teensy;
         const ControlLoop& loop;
         const ControlSettings& control;
         FailsafeMonitor& failsafes;

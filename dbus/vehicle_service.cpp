@@ -6,7 +6,7 @@
 namespace caracara::dbus {
 
 VehicleService::VehicleService(sd_bus* bus, VehicleDaemon& daemon)
-    : bus_(bus), vehicle_(bus, {daemon.vehicle(), daemon.teensy(), daemon.loop(), daemon.config().control, daemon.failsafes()}), teensy_(bus, daemon.teensy()), bus_object_(bus, daemon.bus().monitor()),
+    : bus_(bus), vehicle_(bus, {daemon.vehicle(), daemon.packets(), daemon.teensy(), daemon.loop(), daemon.config().control, daemon.failsafes()}), teensy_(bus, daemon.teensy()), bus_object_(bus, daemon.bus().monitor()),
       clients_(bus, daemon.vehicle()), announcer_(bus, [this](uint32_t changes) { announce(changes); }) {
     for (size_t i = 0; i < daemon.bus().size(); ++i)
         thrusters_.push_back(std::make_unique<ThrusterObject>(bus, daemon.bus(), i));

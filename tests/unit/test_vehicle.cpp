@@ -227,14 +227,14 @@ TEST_CASE("a packet that kills completes after its zeros; one that drives comple
     for (std::size_t i = 0; i < kThrust.size(); ++i)
         packet[i] = kThrust[i];
     std::optional<Result> drove;
-    rig.vehicle().apply_packet(packet, ":1.7", [&](const Result& r) { drove = r; });
+    rig.packets().apply(packet, ":1.7", [&](const Result& r) { drove = r; });
     REQUIRE(drove.has_value()); // at once
     CHECK(drove->ok());
     REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
     rig.wire().clear();
     packet[kPacketKill] = 1;
     std::optional<std::vector<WireEvent>> at_completion;
-    rig.vehicle().apply_packet(packet, ":1.7", [&](const Result&) { at_completion = rig.wire().events(); });
+    rig.packets().apply(packet, ":1.7", [&](const Result&) { at_completion = rig.wire().events(); });
     REQUIRE(rig.run_until([&] { return at_completion.has_value(); }));
     check_kill_output_first(*at_completion); // the completion comes after the zeros
     CHECK(rig.vehicle().safety().kill_source() == KillSource::Packet);

@@ -22,6 +22,7 @@ public:
 
     VehicleDaemon& daemon() { return *daemon_; }
     Vehicle& vehicle() { return daemon_->vehicle(); }
+    PacketHandler& packets() { return daemon_->packets(); }
     ControlLoop& loop() { return daemon_->loop(); }
     const DaemonConfig& config() const { return config_; }
     FakeWire& wire() { return wire_; }
