@@ -16,13 +16,11 @@ uint64_t unix_ms() {
     using namespace std::chrono;
     return static_cast<uint64_t>(duration_cast<milliseconds>(system_clock::now().time_since_epoch()).count());
 }
-
-int16_t clamp16(int32_t v) { return static_cast<int16_t>(std::clamp<int32_t>(v, INT16_MIN + 1, INT16_MAX)); }
 } // namespace
 
 DiveRecorder::DiveRecorder(const DaemonConfig& config, const Vehicle& vehicle, const ThrusterBus& bus,
                            const TeensyPort& teensy, const VehicleEvents& events, DiveWriter& writer)
-    : config_(config), vehicle_(vehicle), bus_(bus), teensy_(teensy), events_(events), writer_(writer) {}
+    : config_(config), vehicle_(vehicle), bus_(bus), events_(events), writer_(writer), sampler_(vehicle, bus, teensy) {}
 
 void DiveRecorder::start() {
     started_ = true;
@@ -67,7 +65,7 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
 }
 
 void DiveRecorder::finish(uint64_t now_ns, const std::string& reason) {
-    dive::encode_sample(records_, sample(now_ns)); // the zeros the dive ends with
+    dive::encode_sample(records_, sampler_.sample(since_start(now_ns))); // the zeros the dive ends with
     dive::encode_end(records_, {since_start(now_ns), reason});
     flush();
     writer_.close();
@@ -166,56 +164,11 @@ void DiveRecorder::bus_restored(uint32_t pulses, double milliseconds) {
 void DiveRecorder::cycle(uint64_t now_ns) {
     if (!recording_)
         return;
-    dive::encode_sample(records_, sample(now_ns));
+    dive::encode_sample(records_, sampler_.sample(since_start(now_ns)));
     if (now_ns - last_flush_ns_ >= kFlushPeriodNs) {
         last_flush_ns_ = now_ns;
         flush();
     }
-}
-
-dive::Sample DiveRecorder::sample(uint64_t now_ns) const {
-    dive::Sample s;
-    s.t_100us = since_start(now_ns);
-    for (std::size_t i = 0; i < dive::kThrusters; ++i) {
-        s.requested[i] = clamp16(vehicle_.requested_values()[i]);
-        s.applied[i] = clamp16(vehicle_.order_value(i));
-    }
-    s.budget_limit = clamp16(vehicle_.budget_limit());
-    const BusTelemetry& bt = bus_.monitor().telemetry();
-    s.flags = static_cast<uint8_t>((vehicle_.saturated() ? dive::kSaturated : 0) |
-                                   (vehicle_.safety().kill_switch_set() ? dive::kKillSwitch : 0) |
-                                   (teensy_.telemetry().online ? dive::kTeensyOnline : 0) |
-                                   (vehicle_.kill_output_asserted() ? dive::kKillOutput : 0) |
-                                   (static_cast<unsigned>(bt.state) << dive::kBusStateShift));
-    for (std::size_t i = 0; i < dive::kThrusters && i < bus_.size(); ++i) {
-        const ThrusterDriver& d = bus_.thruster(i);
-        dive::ThrusterSample& t = s.thrusters[i];
-        t.flags = d.online() ? dive::kOnline : 0;
-        if (const auto& st = d.last_status()) {
-            t.flags |= dive::kStatusKnown;
-            t.faults = st->faults.bits;
-            if (st->current_deciamps) {
-                t.flags |= dive::kCurrentKnown;
-                t.current_da = *st->current_deciamps;
-            }
-            if (st->variant == Variant::SeaBotix) {
-                t.temperature_c = st->seabotix.temperature_c;
-                if (st->seabotix.speed_motor)
-                    t.speed = clamp16(*st->seabotix.speed_motor);
-            }
-        }
-        const ThrusterCounters& c = d.counters();
-        t.nacks = static_cast<uint32_t>(c.nacks);
-        t.bad_replies = static_cast<uint32_t>(c.bad_replies);
-        t.errors = static_cast<uint32_t>(c.order_failures + c.status_failures);
-    }
-    const TeensyTelemetry& tt = teensy_.telemetry();
-    for (std::size_t k = 0; k < 3; ++k)
-        s.orientation[k] = static_cast<float>(tt.orientation[k]);
-    s.distances.assign(tt.distances.begin(), tt.distances.begin() + std::min(tt.distances.size(), dive::kMaxDistances));
-    s.bus_errors = static_cast<uint32_t>(bt.errors);
-    s.bus_recoveries = static_cast<uint32_t>(bt.recoveries);
-    return s;
 }
 
 } // namespace caracara

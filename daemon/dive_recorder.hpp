@@ -2,12 +2,14 @@
 // vehicle arms, takes a sample of the whole vehicle every control-loop cycle and an event for
 // every state change (with its kill source, reason and calling client), fault change, bus loss
 // and recovery and profile switch, and closes the dive at the next kill or power-off. Samples
-// are encoded into memory on the loop (a few hundred bytes, no system call) and handed to the
-// DiveWriter's thread once a second, so a crash loses at most the last second.
+// (its DiveSampler's) are encoded into memory on the loop (a few hundred bytes, no system
+// call) and handed to the DiveWriter's thread once a second, so a crash loses at most the
+// last second.
 #pragma once
 
 #include "core/config.hpp"
 #include "core/dive_format.hpp"
+#include "daemon/dive_sampler.hpp"
 #include "daemon/dive_writer.hpp"
 #include "daemon/teensy_port.hpp"
 #include "daemon/thruster_bus.hpp"
@@ -46,14 +48,13 @@ private:
     void flush();
     uint32_t since_start(uint64_t now_ns) const;
     void add_event(dive::Event e, uint64_t now_ns);
-    dive::Sample sample(uint64_t now_ns) const;
 
     const DaemonConfig& config_;
     const Vehicle& vehicle_;
     const ThrusterBus& bus_;
-    const TeensyPort& teensy_;
     const VehicleEvents& events_;
     DiveWriter& writer_;
+    DiveSampler sampler_;
 
     bool recording_ = false;
     bool started_ = false;
