@@ -19,8 +19,8 @@ BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& 
       bus_(bus),
       steps_(config, io, gpio, bus),
       loop_(loop),
-      vehicle_(vehicle),
       events_(events),
+      loss_(event, config.control, bus, vehicle, events),
       policy_(config.recovery.attempts, config.recovery.backoff_ms) {}
 
 void BusRecovery::bus_locked_up(const std::string& reason) {
@@ -32,7 +32,7 @@ void BusRecovery::bus_locked_up(const std::string& reason) {
         log_error("I2C bus %s lost (%s); recovery is not configured: reopening the adapter once a second",
                   bus_.monitor().device().c_str(), reason.c_str());
         events_.bus_lost(reason);
-        declare_lost(reason);
+        loss_.declare(reason);
         // An adapter that went away (unbound, a restarted simulator) is only found again by
         // opening its node anew; the transfers of each cycle then tell whether it is back.
         phase_ = Phase::Reopening;
@@ -48,25 +48,7 @@ void BusRecovery::bus_locked_up(const std::string& reason) {
     events_.changed(kChangeBus);
     // From the event loop, not from inside the transfer that noticed it.
     schedule(0);
-    // Commands behave as before during a short recovery; one that outlasts the command timeout
-    // has left the thrusters unreachable for longer than any command may stand.
-    const uint64_t at_us = (monotonic_ns() + ms_to_ns(config_.control.command_timeout_ms)) / 1000;
-    if (!lost_timer_) {
-        sd_event_source* s = nullptr;
-        if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, at_us, 1, on_lost_timer, this) < 0)
-            return;
-        lost_timer_.reset(s);
-    }
-    sd_event_source_set_time(lost_timer_.get(), at_us);
-    sd_event_source_set_enabled(lost_timer_.get(), SD_EVENT_ONESHOT);
-}
-
-int BusRecovery::on_lost_timer(sd_event_source*, uint64_t, void* userdata) {
-    auto* self = static_cast<BusRecovery*>(userdata);
-    if (self->bus_.recovering())
-        self->declare_lost("locked up for longer than the command timeout (" +
-                           std::to_string(self->config_.control.command_timeout_ms) + " ms)");
-    return 0;
+    loss_.watch();
 }
 
 void BusRecovery::reopen() {
@@ -80,16 +62,6 @@ void BusRecovery::reopen() {
     }
     steps_.reopen_adapter();
     schedule(kReopenNs);
-}
-
-void BusRecovery::declare_lost(const std::string& why) {
-    BusTelemetry& tm = bus_.monitor().telemetry();
-    if (tm.state == BusState::Lost)
-        return;
-    tm.state = BusState::Lost;
-    tm.last_recovery_error = why;
-    vehicle_.kill(KillSource::Fault, "I2C bus lost: " + why);
-    events_.changed(kChangeState | kChangeBus);
 }
 
 void BusRecovery::schedule(uint64_t delay_ns) {
@@ -175,8 +147,7 @@ void BusRecovery::verify() {
         return;
     }
     bus_.set_recovering(false);
-    if (lost_timer_)
-        sd_event_source_set_enabled(lost_timer_.get(), SD_EVENT_OFF);
+    loss_.recovered();
     BusTelemetry& tm = bus_.monitor().telemetry();
     const bool was_lost = tm.state == BusState::Lost;
     tm.state = BusState::Ok;
@@ -197,7 +168,7 @@ void BusRecovery::failed(const std::string& why) {
     log_error("I2C bus recovery attempt %u failed: %s", policy_.attempt(), why.c_str());
     const RecoveryPolicy::Failure f = policy_.failed();
     if (f.lost)
-        declare_lost("recovery failed: " + why);
+        loss_.declare("recovery failed: " + why);
     events_.changed(kChangeBus);
     schedule(f.retry_in_ns);
 }

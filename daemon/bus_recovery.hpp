@@ -1,12 +1,13 @@
 // Recovering a locked I2C bus: the steps (BusRecoverySteps: close, unbind, bus clear, rebind),
 // then wait for the device node, re-send the current orders (a pending kill first). Bounded
 // attempts with backoff (RecoveryPolicy); when they are used up, or the lockup outlasts the
-// command timeout, the bus is reported lost and the vehicle killed (source bus), and slow
-// retries go on in the background. Owns its timers.
+// command timeout, the bus is reported lost (BusLoss), and slow retries go on in the
+// background. Owns its timer.
 #pragma once
 
 #include "core/config.hpp"
 #include "core/recovery_policy.hpp"
+#include "daemon/bus_loss.hpp"
 #include "daemon/bus_recovery_steps.hpp"
 #include "daemon/control_loop.hpp"
 #include "daemon/thruster_bus.hpp"
@@ -32,7 +33,7 @@ public:
     void set_node_holder(I2cNodeHolder* holder) { steps_.set_node_holder(holder); }
     void stop() {
         timer_.reset();
-        lost_timer_.reset();
+        loss_.stop();
     }
 
 private:
@@ -45,23 +46,19 @@ private:
     void verify(); // once the re-sent orders are done: did any thruster answer?
     void reopen(); // lost without recovery configured: the adapter's node opened anew
     void failed(const std::string& why);
-    // The thrusters cannot be reached: the vehicle is killed (source bus) and stays so.
-    void declare_lost(const std::string& why);
-    static int on_lost_timer(sd_event_source*, uint64_t usec, void* userdata);
 
     sd_event* event_;
     const DaemonConfig& config_;
     ThrusterBus& bus_;
     BusRecoverySteps steps_;
     ControlLoop& loop_; // the orders standing now, re-sent once the bus is back
-    Vehicle& vehicle_;
     VehicleEvents& events_;
+    BusLoss loss_;
     RecoveryPolicy policy_;
     Phase phase_ = Phase::Idle;
     uint64_t node_deadline_ns_ = 0;
     uint32_t last_pulses_ = 0;
     SourcePtr timer_;
-    SourcePtr lost_timer_; // a lockup longer than the command timeout is a lost bus
 };
 
 } // namespace caracara
