@@ -4,8 +4,6 @@
 #include "daemon/log.hpp"
 #include "drivers/platform/io_error.hpp"
 
-#include <sys/epoll.h>
-
 namespace caracara {
 
 namespace {
@@ -31,27 +29,9 @@ std::string SafetyLines::open(bool kill_asserted, Listener* listener) {
             return "gpio.power_off_output: " + err;
     }
     if (settings_.kill_switch) {
-        if (std::string e = open_switch(); !e.empty())
+        if (std::string e = kill_switch_.open(); !e.empty())
             return e;
         poll();
-    }
-    return {};
-}
-
-std::string SafetyLines::open_switch() {
-    std::string err;
-    kill_switch_ = gpio_.request(line_spec(*settings_.kill_switch), GpioMode::InputEdges, 0, err);
-    if (!kill_switch_)
-        return "gpio.kill_switch: " + err;
-    // Above D-Bus and the bus work: the switch is the operator's hand on the vehicle.
-    if (int fd = kill_switch_->event_fd(); fd >= 0) {
-        sd_event_source* s = nullptr;
-        if (int r = sd_event_add_io(event_, &s, fd, EPOLLIN, on_kill_switch, this); r < 0) {
-            kill_switch_.reset();
-            return "gpio.kill_switch: cannot watch edges: " + errno_name(-r);
-        }
-        kill_switch_source_.reset(s);
-        sd_event_source_set_priority(s, SD_EVENT_PRIORITY_IMPORTANT);
     }
     return {};
 }
@@ -59,30 +39,16 @@ std::string SafetyLines::open_switch() {
 void SafetyLines::close() {
     if (kill_output_watcher_)
         kill_output_watcher_->set_kill_output(nullptr);
-    kill_switch_source_.reset();
+    kill_switch_.close();
     reopen_timer_.reset();
-}
-
-int SafetyLines::on_kill_switch(sd_event_source*, int, uint32_t revents, void* userdata) {
-    auto* self = static_cast<SafetyLines*>(userdata);
-    if ((revents & (EPOLLHUP | EPOLLERR)) || self->kill_switch_->drain_events() < 0) {
-        self->switch_lost("the line went away");
-        return 0;
-    }
-    self->poll();
-    return 0;
 }
 
 void SafetyLines::poll() {
     check_outputs();
-    if (!kill_switch_ || !listener_)
+    if (!kill_switch_.is_open() || !listener_)
         return;
-    const int v = kill_switch_->get();
-    if (v < 0) {
-        switch_lost(errno_name(-v));
-        return;
-    }
-    listener_->kill_switch_read(v == 1);
+    if (const std::optional<bool> set = kill_switch_.read())
+        listener_->kill_switch_read(*set);
 }
 
 void SafetyLines::check_outputs() {
@@ -99,11 +65,7 @@ void SafetyLines::check_outputs() {
             output_lost(power_off_, "power-off output", r);
 }
 
-void SafetyLines::switch_lost(const std::string& why) {
-    kill_switch_source_.reset();
-    kill_switch_.reset();
-    log_error("kill switch %s cannot be read (%s): treated as set; asking for it again once a second",
-              line_spec(*settings_.kill_switch).describe().c_str(), why.c_str());
+void SafetyLines::switch_lost() {
     if (listener_)
         listener_->kill_switch_read(true);
     schedule_reopen();
@@ -143,8 +105,8 @@ int SafetyLines::on_reopen(sd_event_source*, uint64_t, void* userdata) {
     };
     reopen_output(self->kill_out_, g.kill_output, self->kill_asserted_ ? 1 : 0, "kill output");
     reopen_output(self->power_off_, g.power_off_output, 0, "power-off output");
-    if (g.kill_switch && !self->kill_switch_) {
-        if (std::string e = self->open_switch(); e.empty()) {
+    if (self->kill_switch_.unreadable()) {
+        if (std::string e = self->kill_switch_.open(); e.empty()) {
             log_notice("kill switch %s is back; its level decides", line_spec(*g.kill_switch).describe().c_str());
             self->poll();
         } else {

@@ -1,10 +1,11 @@
-// The vehicle's safety lines, in the manner of logind's button: the kill switch (an input
-// whose edges wake the loop above D-Bus and the bus work), the kill output and the power-off
-// output. It reads and drives lines; what a switch change means is the Vehicle's business. A
-// switch that cannot be read is a pressed one until it can be again.
+// The vehicle's safety lines: the kill switch (its KillSwitch, whose edges wake the loop above
+// D-Bus and the bus work), the kill output and the power-off output. It reads and drives
+// lines; what a switch change means is the Vehicle's business. A switch that cannot be read is
+// a pressed one until it can be again; a line that went away is asked for again once a second.
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/kill_switch.hpp"
 #include "drivers/devices/kill_output_watcher.hpp"
 #include "drivers/platform/event_loop.hpp"
 #include "drivers/platform/gpio_backend.hpp"
@@ -27,7 +28,8 @@ public:
     };
 
     SafetyLines(sd_event* event, GpioBackend& gpio, const GpioSettings& settings)
-        : event_(event), gpio_(gpio), settings_(settings) {}
+        : event_(event), gpio_(gpio), settings_(settings),
+          kill_switch_(event, gpio, settings.kill_switch, [this] { poll(); }, [this](const std::string&) { switch_lost(); }) {}
 
     // Requests the configured lines (the kill output starting at `kill_asserted`) and watches
     // the switch's edges. "" or what could not be had.
@@ -49,33 +51,29 @@ public:
         kill_output_changed();
     }
     // A configured switch that cannot be read now (it counts as set meanwhile).
-    bool kill_switch_unreadable() const { return settings_.kill_switch && !kill_switch_; }
+    bool kill_switch_unreadable() const { return kill_switch_.unreadable(); }
     // The switch's event fd (for the loop's "is anything waiting" check), or -1.
-    int kill_switch_fd() const { return kill_switch_ ? kill_switch_->event_fd() : -1; }
+    int kill_switch_fd() const { return kill_switch_.fd(); }
 
 private:
-    static int on_kill_switch(sd_event_source*, int fd, uint32_t revents, void* userdata);
     static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
-    // Requests the switch and watches its edges; "" or why not.
-    std::string open_switch();
     // An output (kill, power-off) could not be written: dropped, the vehicle killed, and asked
     // for again with the reopen timer (the kill output then starts asserted).
     void output_lost(std::unique_ptr<GpioLine>& line, const char* what, int err);
     void schedule_reopen();
     // Every kOutputCheckUs: an output that cannot be read back went away (output_lost).
     void check_outputs();
-    // The switch cannot be read (its chip or the simulator went away): its source goes (no busy
-    // loop), it counts as set (a kill), and it is asked for again once a second.
-    void switch_lost(const std::string& why);
+    // The switch cannot be read (its chip or the simulator went away): it counts as set (a
+    // kill), and it is asked for again once a second.
+    void switch_lost();
 
     sd_event* event_;
     GpioBackend& gpio_;
     const GpioSettings& settings_;
     Listener* listener_ = nullptr;
-    std::unique_ptr<GpioLine> kill_switch_;
+    KillSwitch kill_switch_;
     std::unique_ptr<GpioLine> kill_out_;
     std::unique_ptr<GpioLine> power_off_;
-    SourcePtr kill_switch_source_;
     SourcePtr reopen_timer_;
     bool kill_asserted_ = true; // what the kill output should show (for a reopened line)
     uint64_t next_output_check_us_ = 0;
