@@ -175,7 +175,10 @@ int main(int argc, char** argv) {
         log_error("cannot connect to %s: %s", bus_choice.describe().c_str(), errno_name(-r).c_str());
         return 1; // the VehicleDaemon destructor has zeroed the thrusters
     }
-    dbus::VehicleService service(bus.get(), daemon);
+    // Each D-Bus object gets the parts it shows and drives, not the whole daemon.
+    dbus::VehicleService service(bus.get(), {{daemon.vehicle(), daemon.packets(), daemon.teensy(), daemon.loop(),
+                                              daemon.config().control, daemon.failsafes()},
+                                             daemon.bus(), daemon.bus().monitor(), daemon.teensy(), daemon.events()});
     daemon.events().attach(&service);
     if (int r = service.start(); r < 0) {
         log_error("cannot publish %s on %s: %s", dbus::kBusName, bus_choice.describe().c_str(), errno_name(-r).c_str());

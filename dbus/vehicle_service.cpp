@@ -5,22 +5,22 @@
 
 namespace caracara::dbus {
 
-VehicleService::VehicleService(sd_bus* bus, VehicleDaemon& daemon)
-    : bus_(bus), vehicle_(bus, {daemon.vehicle(), daemon.packets(), daemon.teensy(), daemon.loop(), daemon.config().control, daemon.failsafes()}), teensy_(bus, daemon.teensy()), bus_object_(bus, daemon.bus().monitor()),
-      clients_(bus, daemon.vehicle()), announcer_(bus, [this](uint32_t changes) { announce(changes); }) {
-    for (size_t i = 0; i < daemon.bus().size(); ++i)
-        thrusters_.push_back(std::make_unique<ThrusterObject>(bus, daemon.bus(), i));
+VehicleService::VehicleService(sd_bus* bus, const Parts& parts)
+    : bus_(bus), events_(parts.events), vehicle_(bus, parts.vehicle), teensy_(bus, parts.teensy),
+      bus_object_(bus, parts.monitor), clients_(bus, parts.vehicle.vehicle),
+      announcer_(bus, [this](uint32_t changes) { announce(changes); }) {
+    for (size_t i = 0; i < parts.thrusters.size(); ++i)
+        thrusters_.push_back(std::make_unique<ThrusterObject>(bus, parts.thrusters, i));
     // The dive recorder writes who called beside each state change: the sender of the message
     // being dispatched, if any (a timer or the kill switch has none).
-    events_ = &daemon.events();
-    events_->set_caller_source([bus] {
+    events_.set_caller_source([bus] {
         sd_bus_message* m = sd_bus_get_current_message(bus);
         return m ? sender(m) : std::string();
     });
 }
 
 VehicleService::~VehicleService() {
-    events_->set_caller_source(nullptr);
+    events_.set_caller_source(nullptr);
     if (bus_)
         sd_bus_release_name(bus_, kBusName);
 }

@@ -2,7 +2,11 @@
 // in daemon/; the contract is the XML files beside this header.
 #pragma once
 
-#include "daemon/vehicle_daemon.hpp"
+#include "daemon/bus_monitor.hpp"
+#include "daemon/teensy_port.hpp"
+#include "daemon/thruster_bus.hpp"
+#include "daemon/vehicle_events.hpp"
+#include "daemon/vehicle_observer.hpp"
 #include "dbus/announcer.hpp"
 #include "dbus/bus_object.hpp"
 #include "dbus/client_tracker.hpp"
@@ -20,7 +24,16 @@ namespace caracara::dbus {
 
 class VehicleService final : public VehicleObserver {
 public:
-    VehicleService(sd_bus* bus, VehicleDaemon& daemon);
+    // What the objects show and drive, handed by the composition root: the vehicle object's
+    // parts, the thrusters and their bus, the Teensy, and the events whose caller it names.
+    struct Parts {
+        VehicleObject::Parts vehicle;
+        const ThrusterBus& thrusters;
+        BusMonitor& monitor;
+        TeensyPort& teensy;
+        VehicleEvents& events;
+    };
+    VehicleService(sd_bus* bus, const Parts& parts);
     ~VehicleService() override;
     // Registers the objects and the client tracking, then requests the bus name.
     int start();
@@ -38,7 +51,7 @@ private:
     void announce(uint32_t changes);
 
     sd_bus* bus_;
-    VehicleEvents* events_ = nullptr;
+    VehicleEvents& events_;
     SlotPtr object_manager_;
     VehicleObject vehicle_;
     std::vector<std::unique_ptr<ThrusterObject>> thrusters_;
