@@ -13,7 +13,7 @@ import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, X_AXIS, ZERO, poll, simSpeeds, si
 
 const HTTP = process.env.CARACARA_HTTP_URL;
 const ART = process.env.CARACARA_ARTIFACTS;
-const KILL_OUT = 27; // the simulator's kill output line (tests/e2e/test_paths_out.py)
+const KILL_OUT = 27; // the simulator's kill output line (tests/e2e/vehicle_checks.py)
 let chromium;
 let browser;
 

@@ -17,7 +17,7 @@ import dbus
 
 from harness import (DEFAULT_MT, ERR, MOTORS, ROOT, SEED_AXIS_MOTORS, VEHICLE, ZERO, Rig, budget_limit, command,
                      error_name, poll, pump_main_loop, speed_byte)
-from test_paths_out import KILL_OUT
+from vehicle_checks import KILL_OUT
 
 THRUSTER_CONDITIONS = ["water-detect", "ground-fault", "overtemp", "stall", "hall"]
 CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 60000, "status_reads_per_tick": 8}

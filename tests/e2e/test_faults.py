@@ -10,7 +10,7 @@ import unittest
 from bounds import (HUNG_KILL_OUTPUT_MS_MAX, HUNG_TEENSY_DBUS_MS_MAX, VANISHED_CPU_PERCENT_MAX, VANISHED_LOG_LINES_MAX,
                     VANISHED_WINDOW_S)
 from harness import (ERR, MOTORS, ZERO, Rig, error_name, poll, speed_byte)
-from test_paths_out import KILL_OUT, cpu_seconds
+from vehicle_checks import KILL_OUT, cpu_seconds
 
 KILL_SWITCH = 17  # GpioModel::kKillSwitch
 HUNG = 3          # the thruster that hangs

@@ -1,10 +1,22 @@
 """What the e2e tests of org.caracara.Vehicle1 share: checks judged on the simulated wire, a
 watcher of PropertiesChanged, and the seed's packet."""
 
+import os
 import time
 
 import harness
 from harness import (DEFAULT_MT, MOTORS, PROPS, ROOT, VEHICLE, poll, pump_main_loop, speed_byte)
+
+
+KILL_OUT = 27  # the simulator's kill output line (GpioModel::kKillOut)
+POWER_OFF = 22
+
+
+def cpu_seconds(pid):
+    """The CPU time (user + system, s) process pid has used so far."""
+    with open("/proc/%d/stat" % pid) as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def hexes(bs):
