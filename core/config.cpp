@@ -3,6 +3,7 @@
 #include "core/failsafe_config.hpp"
 #include "core/hex.hpp"
 #include "core/toml_checker.hpp"
+#include "core/toml_text.hpp"
 
 #include <algorithm>
 #include <cerrno>

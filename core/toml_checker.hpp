@@ -16,13 +16,6 @@ namespace caracara {
 // What the user wrote, for "got ..." in messages.
 std::string written(const toml::node& n);
 
-// "" when every non-ASCII character of `text` is inside a comment, else "line N, column M: ..."
-// for the first one that is not. Run before toml::parse: toml++ 3.3 (Debian 12) executes
-// __builtin_unreachable when it tests some non-ASCII characters (U+00A1..U+0499 and others)
-// for whitespace, which it does wherever one stands outside a string or comment (found by
-// fuzz_config; upstream marzer/tomlplusplus#190, #295). No key or value of these files needs
-// one; comments may carry any text.
-std::string non_ascii_outside_comments(std::string_view text);
 std::size_t edit_distance(std::string_view a, std::string_view b);
 
 using Keys = std::initializer_list<std::string_view>;

@@ -1,6 +1,7 @@
 #include "sim/sim_config.hpp"
 
 #include "core/toml_checker.hpp"
+#include "core/toml_text.hpp"
 
 #include <fstream>
 #include <sstream>
@@ -39,7 +40,7 @@ bool get_int(const toml::table& t, const char* key, const std::string& where, T 
 } // namespace
 
 bool parse_sim_config(const std::string& text, SimConfig& out, std::string& error) {
-    // The same guard as caracarad's reader of this file (core/toml_checker.hpp says why).
+    // The same guard as caracarad's reader of this file (core/toml_text.hpp says why).
     if (std::string e = non_ascii_outside_comments(text); !e.empty()) {
         error = e;
         return false;
