@@ -146,6 +146,20 @@ TEST_CASE("the kill switch: the kill output first, then the zeros; released, the
     CHECK(kill_output(rig.wire().events(), 0) < 0);
 }
 
+TEST_CASE("started killed with the kill switch set: the kill is the switch's, not the start's") {
+    DaemonRig rig("arm_at_start = false\nloop_rate_hz = 50\n", true);
+    rig.run_for(40);
+    REQUIRE(rig.vehicle().safety().state() == SafetyState::Killed);
+    // What holds the vehicle killed is the switch, which the user must release.
+    CHECK(rig.vehicle().kill_source_name() == "switch");
+    CHECK(rig.vehicle().clear_kill().status == Status::KillSwitchSet);
+    CHECK(kill_output(rig.wire().events(), 0) < 0);
+    rig.gpio().set_kill_switch(false);
+    rig.run_for(40);
+    CHECK(rig.vehicle().kill_source_name() == "switch"); // released, the kill stays until ClearKill
+    CHECK(rig.vehicle().clear_kill().ok());
+}
+
 TEST_CASE("a client that leaves: what it sent reaches the wire, then its zeros; no kill") {
     DaemonRig rig;
     rig.run_until_ready();

@@ -16,8 +16,9 @@ namespace caracara::test {
 
 class DaemonRig {
 public:
-    // `control`: the [control] section's lines (armed at start, no arming delay by default).
-    explicit DaemonRig(const std::string& control = "loop_rate_hz = 50\n");
+    // `control`: the [control] section's lines (armed at start unless they say arm_at_start, no
+    // arming delay by default); `kill_switch_set`: the switch as the daemon finds it at start.
+    explicit DaemonRig(const std::string& control = "loop_rate_hz = 50\n", bool kill_switch_set = false);
     ~DaemonRig();
 
     VehicleDaemon& daemon() { return *daemon_; }
