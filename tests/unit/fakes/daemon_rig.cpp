@@ -9,9 +9,9 @@
 namespace caracara::test {
 
 namespace {
-DaemonConfig parse(const std::string& control) {
+DaemonConfig parse(const std::string& control, const std::string& sections) {
     ConfigResult r = parse_config_string("[control]\narm_at_start = true\narming_delay_ms = 0\n" + control +
-                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n",
+                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n" + sections,
                                          "the test rig");
     if (!r.ok())
         throw std::runtime_error(r.error());
@@ -19,7 +19,8 @@ DaemonConfig parse(const std::string& control) {
 }
 } // namespace
 
-DaemonRig::DaemonRig(const std::string& control) : config_(parse(control)), io_(wire_, config_), gpio_(wire_) {
+DaemonRig::DaemonRig(const std::string& control, const std::string& sections)
+    : config_(parse(control, sections)), io_(wire_, config_), gpio_(wire_) {
     if (sd_event_new(&event_) < 0)
         throw std::runtime_error("sd_event_new");
     daemon_ = std::make_unique<VehicleDaemon>(event_, io_, io_, io_, gpio_, config_);

@@ -16,8 +16,9 @@ namespace caracara::test {
 
 class DaemonRig {
 public:
-    // `control`: the [control] section's lines (armed at start, no arming delay by default).
-    explicit DaemonRig(const std::string& control = "loop_rate_hz = 50\n");
+    // `control`: the [control] section's lines (armed at start, no arming delay by default);
+    // `sections`: more tables, whole (e.g. "[failsafe.pilot-lost]\npersistence_ms = 300\n").
+    explicit DaemonRig(const std::string& control = "loop_rate_hz = 50\n", const std::string& sections = "");
     ~DaemonRig();
 
     VehicleDaemon& daemon() { return *daemon_; }
