@@ -142,9 +142,9 @@ void FailsafeMonitor::keep_surfacing(uint64_t now) {
 
 Result FailsafeMonitor::clear_kill_refusal() const {
     // Bus lost, an unreachable thruster and the kill switch are refused where they arise, by
-    // name (BusLost, ThrusterUnreachable), and at once when they end, not at this object's next
-    // reading; pilot lost ended with its kill (nothing is left to lose). The Teensy link is
-    // refused here, by the failsafe that holds: no other error names it.
+    // name (BusLost, ThrusterUnreachable, KillSwitchSet), and at once when they end, not at
+    // this object's next reading; pilot lost ended with its kill (nothing is left to lose). The
+    // Teensy link is refused here, by the failsafe that holds: no other error names it.
     std::vector<ActiveFailsafe> b = policy_.blocking();
     std::erase_if(b, [this](const ActiveFailsafe& f) {
         return (condition_is_fixed(f.condition) && f.condition != FailsafeCondition::TeensyLinkLost) ||
