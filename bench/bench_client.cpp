@@ -196,14 +196,17 @@ public:
     }
     uint64_t wire_next() { return wire_log(UINT64_MAX, nullptr); }
 
-    // Also arms a daemon that started killed (kill source "start"), as a pilot would.
+    // Also arms a daemon that started killed (kill source "start"), as a pilot would, and one
+    // the pilot-lost failsafe killed after an earlier bench client, the last pilot, left (source
+    // "failsafe": the bench provokes no other failsafe).
     bool wait_ready(uint64_t timeout_ns) {
         const uint64_t end = mono_ns() + timeout_ns;
         while (mono_ns() < end) {
             const std::string s = state();
             if (s == "ready")
                 return true;
-            if (s == "killed" && get_string(kVehicle, kVehiclePath, kVehicle, "KillSource") == "start")
+            const std::string source = s == "killed" ? get_string(kVehicle, kVehiclePath, kVehicle, "KillSource") : "";
+            if (source == "start" || source == "failsafe")
                 vehicle_call("ClearKill");
             sleep_ns(1'000'000);
         }

@@ -111,6 +111,17 @@ class Bench:
             raise RuntimeError(f"busctl {' '.join(args)}: {r.stderr.strip()}")
         return r
 
+    def rearm(self):
+        """Kill and ClearKill (busctl: no pilot), then ready: a bench client that drove and left
+        was the last pilot, and pilot-lost would kill after its persistence (5 s), in the middle
+        of whatever comes next."""
+        for method in ("Kill", "ClearKill"):
+            self.busctl("call", "org.caracara.Vehicle1", "/org/caracara/Vehicle1", "org.caracara.Vehicle1", method)
+        r = subprocess.run([self.exe["client"], "wait-ready", "--bus", self.bus, "--timeout-ms", "20000"],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"caracarad did not become ready again: {r.stderr.strip()}")
+
     def sim_call(self, method, sig="", *args):
         return self.busctl("call", "org.caracara.Simulator1", "/org/caracara/Simulator1", "org.caracara.Simulator1",
                            method, *([sig, *map(str, args)] if sig else []))
@@ -302,6 +313,7 @@ def phase_bridge(b, p, res):
 
     # start_daemon's wait-ready cleared the start kill: the vehicle is ready.
     res["bridge"] = {**run("latency"), **run("motion"), "load": {}}
+    b.rearm()  # the motion run's pilots left: no pilot-lost kill during the load windows
     for k in (1, 4):
         seconds = p["cpu_warm"] + p["cpu_window"]
         n = node("load", k, seconds)
@@ -331,6 +343,7 @@ def phase_bridge(b, p, res):
                       "caracara-bridge (tcp)")
         b.wait_for(lambda: port_listens(port), 10, "the bridge's TCP port")
         env["CARACARA_HTTP_URL"] = f"http://127.0.0.1:{port}/?token={token}"
+        b.rearm()
         res["bridge"].update(run("cockpit"))
         b.stop(tcp)
     else:

@@ -59,6 +59,8 @@ std::array<FailsafeRule, kFailsafeConditionCount> FailsafeSettings::default_rule
     r[static_cast<std::size_t>(FailsafeCondition::Hall)] = {FailsafeAction::Exclude, 1000};
     for (std::size_t i = static_cast<std::size_t>(FailsafeCondition::PilotLost); i < kFailsafeConditionCount; ++i)
         r[i] = {FailsafeAction::Kill, 0};
+    // The only fixed one with a persistence of its own: the lost pilot's thrust is already zero.
+    r[static_cast<std::size_t>(FailsafeCondition::PilotLost)].persistence_ms = kPilotLostPersistenceMs;
     return r;
 }
 

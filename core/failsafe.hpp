@@ -44,6 +44,13 @@ std::optional<FailsafeAction> action_from_name(std::string_view name);
 
 // Fixed at kill; the config checker refuses a weaker action.
 constexpr bool condition_is_fixed(FailsafeCondition c) { return c >= FailsafeCondition::PilotLost; }
+// The fixed ones' timing is the daemon's own, except pilot-lost's: how long a pilot has to come
+// back (a reloaded page, a dropped SSH tunnel) before the vehicle is killed.
+constexpr bool condition_has_persistence(FailsafeCondition c) {
+    return !condition_is_fixed(c) || c == FailsafeCondition::PilotLost;
+}
+inline constexpr uint32_t kPilotLostPersistenceMs = 5000; // why: daemon/caracarad.toml.example
+inline constexpr uint32_t kPilotLostPersistenceMaxMs = 60000;
 // The FAULT bit of a thruster condition (SeaBotix IDS 8.4.2, word 2).
 uint8_t condition_fault_bit(FailsafeCondition c);
 

@@ -10,12 +10,14 @@ namespace {
 void parse_rule(Checker& c, const toml::table& t, FailsafeCondition cond, FailsafeRule& out) {
     const std::string p = "failsafe." + std::string(condition_name(cond)) + ".";
     const bool fixed = condition_is_fixed(cond);
-    // A fixed condition's timing is the daemon's own (command timeout, three failed transfers,
-    // the bus recovery): only its action can be written, and only as "kill".
-    if (fixed)
-        c.only_keys(t, p, {"action"});
-    else
+    // A fixed condition's timing is the daemon's own (three failed transfers, the bus recovery,
+    // a link that went): only its action can be written, and only as "kill". Pilot-lost's
+    // persistence can be written too, within a minute: its kill must still come.
+    const bool timed = condition_has_persistence(cond);
+    if (timed)
         c.only_keys(t, p, {"action", "persistence_ms"});
+    else
+        c.only_keys(t, p, {"action"});
     std::string name;
     if (c.string(t, p, "action", name)) {
         const auto a = action_from_name(name);
@@ -30,8 +32,8 @@ void parse_rule(Checker& c, const toml::table& t, FailsafeCondition cond, Failsa
         else
             out.action = *a;
     }
-    if (!fixed)
-        c.integer(t, p, "persistence_ms", 0, 600000, out.persistence_ms);
+    if (timed)
+        c.integer(t, p, "persistence_ms", 0, fixed ? kPilotLostPersistenceMaxMs : 600000, out.persistence_ms);
 }
 
 void parse_surface(Checker& c, const toml::table& t, SurfaceSettings& out) {

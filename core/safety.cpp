@@ -78,6 +78,7 @@ void SafetyMachine::enter_killed(KillSource source, uint64_t now, std::string_vi
     kill_reason_ = reason.empty() ? std::string(kill_source_name(source)) : std::string(reason);
     killed_at_ = now;
     drop_commands();
+    pilots_.clear(); // nothing left to lose
 }
 
 SafetyAction SafetyMachine::kill(KillSource source, uint64_t now, std::string_view reason) {
@@ -105,6 +106,7 @@ SafetyAction SafetyMachine::clear_kill(uint64_t now) {
     kill_reason_.clear();
     arming_started_ = now;
     drop_commands();
+    pilots_.clear(); // armed again: pilots are those who command from now on
     return zeroing("kill cleared, arming", true);
 }
 
@@ -123,6 +125,7 @@ SafetyAction SafetyMachine::power_off(uint64_t now) {
     (void)now;
     state_ = SafetyState::PoweredOff;
     drop_commands();
+    pilots_.clear();
     return zeroing("powering off", true);
 }
 
@@ -162,11 +165,13 @@ SafetyAction SafetyMachine::accept_command(uint64_t now, std::string_view client
     command_active_ = true;
     last_command_ = now;
     client_ = std::string(client);
+    pilots_.commanded(client);
     return {};
 }
 
 SafetyAction SafetyMachine::client_left(std::string_view client, uint64_t now) {
     (void)now;
+    pilots_.left(client);
     if (!command_active_ || client != client_)
         return {};
     drop_commands();

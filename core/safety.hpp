@@ -10,9 +10,13 @@
 //   any ──power_off──> PoweredOff   (irreversible)
 //
 // A silent command stream (timeout) or a commanding client that left zeroes the output
-// and drops the stored commands, but is NOT a kill: the next command drives again.
+// and drops the stored commands, but is NOT a kill: the next command drives again. Who
+// commanded since the vehicle was armed is its PilotRoster: when the last pilot has left,
+// pilot_lost() holds, and the failsafes kill after its persistence (core/failsafe_policy).
 // An escalated fault (e.g. a failed I2C bus recovery) is a kill with source Fault.
 #pragma once
+
+#include "core/pilot_roster.hpp"
 
 #include <cstdint>
 #include <limits>
@@ -92,8 +96,16 @@ public:
     // Ready (NotReady while arming or killed, PoweredOff after power-off); it (re)starts
     // the watchdog and makes `client` the commanding client.
     SafetyAction accept_command(uint64_t now, std::string_view client = {});
-    // A client left the bus: if it was the commanding client, zero and drop its commands.
+    // A client left the bus: if it was the commanding client, zero and drop its commands; if it
+    // was a pilot, the roster knows (pilot_lost).
     SafetyAction client_left(std::string_view client, uint64_t now);
+    // Armed (arming or ready), a pilot left since, and no pilot remains on the bus: the
+    // pilot-lost failsafe's condition. The failsafe's own ascent counts as a pilot, so a pilot
+    // who leaves during it does not cut it short (it ends in a kill anyway).
+    bool pilot_lost() const {
+        return (state_ == SafetyState::Arming || state_ == SafetyState::Ready) && pilots_.lost();
+    }
+    const PilotRoster& pilots() const { return pilots_; }
 
     SafetyState state() const { return state_; }
     KillSource kill_source() const { return kill_source_; }
@@ -130,6 +142,7 @@ private:
     bool command_active_ = false;
     uint64_t last_command_ = 0;
     std::string client_;
+    PilotRoster pilots_; // since the vehicle was last armed
 };
 
 } // namespace caracara

@@ -22,7 +22,9 @@ FailsafeMonitor::FailsafeMonitor(sd_event* event, const FailsafeSettings& settin
     : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)),
       conditions_(std::move(conditions)), vehicle_(vehicle), events_(events), policy_(settings, thrusters),
       period_us_(std::max<uint64_t>(1000, std::min(kPeriodNs, vehicle.safety().config().command_timeout_ns / 2)) /
-                 1000) {}
+                 1000) {
+    vehicle_.set_failsafe_gate(this);
+}
 
 std::string FailsafeMonitor::start() {
     sd_event_source* s = nullptr;
@@ -30,7 +32,6 @@ std::string FailsafeMonitor::start() {
         return "sd_event_add_time_relative: " + errno_name(-r);
     timer_.reset(s);
     sd_event_source_set_enabled(s, SD_EVENT_ON);
-    vehicle_.set_failsafe_gate(this);
     return {};
 }
 
@@ -48,6 +49,15 @@ void FailsafeMonitor::poll(uint64_t now) {
             FailsafeTransitions t = policy_.observe(i, r->fault_bits, r->temperature_c, now);
             ts.insert(ts.end(), t.begin(), t.end());
         }
+    FailsafeTransitions own = look_at_conditions(now);
+    ts.insert(ts.end(), own.begin(), own.end());
+    tell(ts);
+    carry_out(ts, now);
+    keep_surfacing(now);
+}
+
+FailsafeTransitions FailsafeMonitor::look_at_conditions(uint64_t now) {
+    FailsafeTransitions ts;
     const auto holding = conditions_();
     for (std::size_t c = 0; c < kFailsafeConditionCount; ++c)
         if (condition_is_fixed(static_cast<FailsafeCondition>(c))) {
@@ -56,16 +66,22 @@ void FailsafeMonitor::poll(uint64_t now) {
         }
     FailsafeTransitions due = policy_.tick(now);
     ts.insert(ts.end(), due.begin(), due.end());
+    return ts;
+}
+
+void FailsafeMonitor::conditions_changed() {
+    const uint64_t now = monotonic_ns();
+    const FailsafeTransitions ts = look_at_conditions(now);
     tell(ts);
     carry_out(ts, now);
-    keep_surfacing(now);
 }
 
 void FailsafeMonitor::tell(const FailsafeTransitions& ts) {
     for (const FailsafeTransition& t : ts) {
-        if (t.raised)
-            log_warning("FAILSAFE %s: the condition held for %u ms", describe(t.failsafe).c_str(),
-                        settings_.rule(t.failsafe.condition).persistence_ms);
+        if (const uint32_t ms = settings_.rule(t.failsafe.condition).persistence_ms; t.raised && ms > 0)
+            log_warning("FAILSAFE %s: the condition held for %u ms", describe(t.failsafe).c_str(), ms);
+        else if (t.raised)
+            log_warning("FAILSAFE %s", describe(t.failsafe).c_str());
         else
             log_notice("failsafe %s cleared: the condition is gone%s", describe(t.failsafe).c_str(),
                        condition_clearing(t.failsafe.condition) == FailsafeClearing::PowerCycle
@@ -125,19 +141,27 @@ void FailsafeMonitor::keep_surfacing(uint64_t now) {
 }
 
 Result FailsafeMonitor::clear_kill_refusal() const {
-    // The fixed ones are refused where they arise, by name (BusLost, ThrusterUnreachable), and
-    // at once when they end, not at this object's next reading.
+    // Bus lost, an unreachable thruster and the kill switch are refused where they arise, by
+    // name (BusLost, ThrusterUnreachable, KillSwitchSet), and at once when they end, not at
+    // this object's next reading; pilot lost ended with its kill (nothing is left to lose). The
+    // Teensy link is refused here, by the failsafe that holds: no other error names it.
     std::vector<ActiveFailsafe> b = policy_.blocking();
     std::erase_if(b, [this](const ActiveFailsafe& f) {
-        return condition_is_fixed(f.condition) || (overriding_ && f.condition == *overriding_);
+        return (condition_is_fixed(f.condition) && f.condition != FailsafeCondition::TeensyLinkLost) ||
+               (overriding_ && f.condition == *overriding_);
     });
     if (b.empty())
         return {};
     std::string m = "a failsafe holds: ";
     for (std::size_t i = 0; i < b.size(); ++i)
         m += (i ? ", " : "") + describe(b[i]);
-    m += "; ClearKillOverride(\"" + std::string(condition_name(b.front().condition)) +
-         "\") clears the kill anyway";
+    const auto fixed =
+        std::find_if(b.begin(), b.end(), [](const ActiveFailsafe& f) { return condition_is_fixed(f.condition); });
+    if (fixed != b.end())
+        m += "; " + std::string(condition_name(fixed->condition)) + " is fixed at kill: ClearKill works once it clears";
+    else
+        m += "; ClearKillOverride(\"" + std::string(condition_name(b.front().condition)) +
+             "\") clears the kill anyway";
     return {Status::FailsafeActive, m};
 }
 

@@ -1,7 +1,9 @@
-// The failsafes at work: every thruster's last status reply goes into the FailsafePolicy
-// (core/failsafe_policy) on this object's own timer, and what the policy raises is carried out
-// by the Vehicle (exclude, surface, kill) and told everywhere (VehicleEvents: D-Bus, the dive
-// recorder, STATUS=; the journal here, one line per transition).
+// The failsafes at work: every thruster's last status reply and the vehicle's own conditions go
+// into the FailsafePolicy (core/failsafe_policy) on this object's own timer, and at once when
+// the Vehicle says one changed (the last pilot left, the Teensy link went: FailsafeGate);
+// what the policy raises is carried out by the Vehicle (exclude, surface, kill) and told
+// everywhere (VehicleEvents: D-Bus, the dive recorder, STATUS=; the journal here, one line
+// per transition).
 #pragma once
 
 #include "core/failsafe_policy.hpp"
@@ -27,20 +29,26 @@ struct FailsafeReading {
 class FailsafeMonitor final : public FailsafeGate {
 public:
     using Readings = std::function<std::optional<FailsafeReading>(std::size_t thruster)>;
-    // Which of the vehicle's own (fixed) conditions hold now. The daemon already kills for them
-    // where they arise; here they are told as failsafes, and hold a ClearKill like the others.
+    // Which of the vehicle's own (fixed) conditions hold now. Bus lost, an unreachable thruster
+    // and an unreadable kill switch kill where they arise and are told here; pilot lost and the
+    // Teensy link lost are killed for here.
     using Conditions = std::function<std::array<bool, kFailsafeConditionCount>()>;
     // Readings at 20 Hz: a status reply comes every (thrusters / status reads per tick) cycles,
     // 160 ms for eight at 50 Hz, so a persistence time is kept to within one period. Faster
     // when the command timeout is shorter than two periods: the ascent is re-sent at each one.
     static constexpr uint64_t kPeriodNs = 50'000'000;
 
+    // The vehicle's FailsafeGate from here on, so that no condition it tells is lost.
     FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters, Readings readings,
                     Conditions conditions, Vehicle& vehicle, VehicleEvents& events);
+    ~FailsafeMonitor() override { vehicle_.set_failsafe_gate(nullptr); }
+    FailsafeMonitor(const FailsafeMonitor&) = delete;
+    FailsafeMonitor& operator=(const FailsafeMonitor&) = delete;
     std::string start(); // "" or why the timer could not be made
     void stop() { timer_.reset(); }
 
     Result clear_kill_refusal() const override;
+    void conditions_changed() override;
     // ClearKill for a pilot who means it: the named condition's failsafes warn until it clears.
     Result clear_kill_override(std::string_view condition, std::string_view caller);
 
@@ -53,6 +61,8 @@ public:
 
 private:
     static int on_timer(sd_event_source* s, uint64_t usec, void* userdata);
+    // The vehicle's own conditions into the policy, and what has held for its persistence time.
+    FailsafeTransitions look_at_conditions(uint64_t now);
     void tell(const FailsafeTransitions& ts);
     void carry_out(const FailsafeTransitions& ts, uint64_t now);
     void keep_surfacing(uint64_t now);

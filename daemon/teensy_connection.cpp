@@ -72,21 +72,26 @@ int TeensyConnection::on_reopen(sd_event_source*, uint64_t, void* userdata) {
                              if (self->on_back_)
                                  self->on_back_();
                              self->tm_.online = true;
+                             if (self->lost_) {
+                                 self->lost_ = false;
+                                 self->gate_.link_changed(); // teensy-link-lost clears
+                             }
                          });
     return 0;
 }
 
-void TeensyConnection::link_lost() {
+void TeensyConnection::lose_link() {
     if (!open_)
         return;
-    log_error("Teensy SPI %s went away (%s): vehicle killed; asking for it again once a second",
+    log_error("Teensy SPI %s went away (%s): failsafe teensy-link-lost; asking for it again once a second",
               spi_.path().c_str(), errno_name(ENODEV).c_str());
     open_ = false;
+    lost_ = true;
     worker_.submit([this] { spi_.close(); }, nullptr);
     if (on_lost_)
         on_lost_();
     tm_.online = false;
-    gate_.device_lost("the Teensy's SPI device went away");
+    gate_.link_changed(); // the kill, at once
     schedule_reopen();
 }
 
@@ -128,7 +133,7 @@ void TeensyConnection::poll_done() {
     if (open_)
         tm_.online = poll_.ok;
     if (!poll_.ok && poll_.err == ENODEV)
-        link_lost();
+        lose_link();
 }
 
 void TeensyConnection::command(std::function<teensy::TeensyError()> frame, std::string what, Completion done) {
@@ -142,7 +147,7 @@ void TeensyConnection::command(std::function<teensy::TeensyError()> frame, std::
         [this, e, err, what = std::move(what), done = std::move(done)] {
             const Result r = teensy_result(*e, what);
             if (!r.ok() && *err == ENODEV)
-                link_lost();
+                lose_link();
             if (done)
                 done(r);
         });

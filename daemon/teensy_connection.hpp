@@ -1,8 +1,8 @@
 // The connection to the Teensy over SPI: the node, the link and the TeensyWorker whose thread
 // carries every frame, so a slow or hung Teensy never holds the loop. Polls orientation and
 // distances one frame per cycle; hands a command's frame over and gives its Result back later;
-// a device that goes away (ENODEV) kills the vehicle (its CommandGate) and is asked for again
-// once a second. The commands themselves are TeensyPort's, the Turn handshake TeensyTurn's.
+// a device that goes away (ENODEV) is told to its CommandGate (the failsafes kill, as
+// teensy-link-lost) and is asked for again once a second. The commands themselves are TeensyPort's, the Turn handshake TeensyTurn's.
 #pragma once
 
 #include "core/config.hpp"
@@ -50,6 +50,8 @@ public:
     std::string start(int64_t priority) { return worker_.start(event_, priority); }
     void close(); // after the worker's job on the wire (what was queued still runs)
     bool is_open() const { return open_; }
+    // The link went away (ENODEV) and is not back yet; a Teensy that was never there is not lost.
+    bool link_lost() const { return lost_; }
 
     // One frame: the three orientation axes, then one distance sensor, in turn; handed to the
     // worker unless the last one is still out (a slow Teensy is polled as fast as it answers).
@@ -73,9 +75,9 @@ private:
     };
     static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
     void poll_done();
-    // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, the vehicle
-    // killed (the wheels cannot be stopped), and asked for again once a second.
-    void link_lost();
+    // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, told to the
+    // gate (the wheels cannot be stopped: the failsafes kill), and asked for again once a second.
+    void lose_link();
     void schedule_reopen();
 
     sd_event* event_;
@@ -84,6 +86,7 @@ private:
     TeensyLink link_; // the worker's while it runs
     TeensyWorker worker_;
     bool open_ = false; // loop thread: the SPI node is open (as far as the loop knows)
+    bool lost_ = false; // loop thread: it went away, and is not back
     TeensyTelemetry tm_;
     unsigned poll_index_ = 0;
     bool poll_out_ = false;

@@ -13,6 +13,7 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
                  VehicleEvents& events)
     : config_(config),
       lines_(lines),
+      teensy_(teensy),
       events_(events),
       actuator_(bus, lines, teensy),
       safety_(safety_config(config), false, monotonic_ns()),
@@ -110,11 +111,32 @@ Result Vehicle::power_off(std::string_view confirmation) {
 }
 
 void Vehicle::client_left(std::string_view unique_name) {
-    if (unique_name.empty() || unique_name != safety_.commanding_client())
+    if (unique_name.empty())
         return;
-    log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
-    // Its zeros go behind what it had sent (ZeroOrder::Behind).
-    handle(safety_.client_left(unique_name, monotonic_ns())); // announces Controller with the motors
+    const bool was_lost = safety_.pilot_lost();
+    if (unique_name == safety_.commanding_client()) {
+        log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
+        // Its zeros go behind what it had sent (ZeroOrder::Behind).
+        handle(safety_.client_left(unique_name, monotonic_ns())); // announces Controller with the motors
+    } else {
+        safety_.client_left(unique_name, monotonic_ns()); // a pilot who no longer commands: no zeros
+    }
+    if (safety_.pilot_lost() && !was_lost) {
+        log_warning("the last pilot (%s) left the bus: killed in %u ms (failsafe pilot-lost) unless a pilot commands",
+                    std::string(unique_name).c_str(),
+                    config_.failsafe.rule(FailsafeCondition::PilotLost).persistence_ms);
+        if (failsafes_)
+            failsafes_->conditions_changed();
+    }
+}
+
+void Vehicle::link_changed() {
+    // The kill is the failsafes' (teensy-link-lost, at once); a Vehicle without them (none in
+    // the daemon: the FailsafeMonitor is its gate from its construction) still kills.
+    if (failsafes_)
+        failsafes_->conditions_changed();
+    else if (teensy_.link_lost())
+        kill(KillSource::Device, "the Teensy's SPI device went away");
 }
 
 void Vehicle::kill_switch_read(bool set) {

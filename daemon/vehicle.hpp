@@ -71,8 +71,11 @@ public:
     Result state_error() const override { return condition_.state_error(); }
     bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
     Result accept_command(std::string_view client) override;
-    // A line or device went away under the daemon (SafetyLines, TeensyPort): killed, source fault.
+    // A line or a thruster went away under the daemon (SafetyLines, ThrusterHealth): killed,
+    // source device.
     void device_lost(std::string_view why) override { kill(KillSource::Device, why); }
+    // The Teensy link (TeensyConnection): the failsafes kill, as teensy-link-lost.
+    void link_changed() override;
 
     // What thruster i is to be ordered now: its applied value while the vehicle may drive.
     int32_t order_value(size_t i) const { return motors_.order_value(i); }
@@ -92,7 +95,10 @@ public:
 
     // Failsafes (daemon/failsafe_monitor decides, the Vehicle carries out).
     static constexpr std::string_view kFailsafeClient = MotorCommands::kFailsafeClient;
-    void set_failsafe_gate(const FailsafeGate* gate) { condition_.set_failsafe_gate(gate); }
+    void set_failsafe_gate(FailsafeGate* gate) {
+        failsafes_ = gate;
+        condition_.set_failsafe_gate(gate);
+    }
     void exclude(const std::array<bool, kMotorCount>& excluded) { motors_.exclude(excluded); }
     Result surface(const AxisDemand& ascent) { return motors_.surface(ascent); }
     bool surfacing() const { return motors_.surfacing(); }
@@ -104,6 +110,7 @@ private:
 
     const DaemonConfig& config_;
     SafetyLines& lines_;
+    TeensyPort& teensy_;
     VehicleEvents& events_;
     SafetyActuator actuator_;
     SafetyMachine safety_;
@@ -111,6 +118,7 @@ private:
 
     MotorCommands motors_;
     VehicleCondition condition_;
+    FailsafeGate* failsafes_ = nullptr;
 };
 
 } // namespace caracara

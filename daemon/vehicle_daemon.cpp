@@ -30,6 +30,8 @@ std::array<bool, kFailsafeConditionCount> VehicleDaemon::fixed_conditions() cons
     c[static_cast<std::size_t>(FailsafeCondition::BusLost)] = bus_.monitor().telemetry().state == BusState::Lost;
     c[static_cast<std::size_t>(FailsafeCondition::ThrusterUnreachable)] = bus_.health().first_unreachable().has_value();
     c[static_cast<std::size_t>(FailsafeCondition::KillSwitchUnreadable)] = lines_.kill_switch_unreadable();
+    c[static_cast<std::size_t>(FailsafeCondition::PilotLost)] = vehicle_.safety().pilot_lost();
+    c[static_cast<std::size_t>(FailsafeCondition::TeensyLinkLost)] = teensy_.link_lost();
     return c;
 }
 

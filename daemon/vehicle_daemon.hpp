@@ -65,9 +65,8 @@ public:
 private:
     // Thruster i's last good status reply, for the failsafes; nullopt while it does not answer.
     std::optional<FailsafeReading> reading(std::size_t i) const;
-    // The fixed conditions the daemon can tell today: bus lost, a thruster unreachable, the kill
-    // switch unreadable. (Pilot lost zeroes without a kill; a Teensy link that goes away kills
-    // as "device" but is not told as a failsafe yet.)
+    // The fixed conditions: bus lost, a thruster unreachable, the kill switch unreadable (each
+    // kills where it arises), pilot lost and the Teensy link lost (the failsafes kill).
     std::array<bool, kFailsafeConditionCount> fixed_conditions() const;
 
     sd_event* event_;

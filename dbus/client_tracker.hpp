@@ -1,5 +1,6 @@
 // Tells the Vehicle when a client leaves the bus (NameOwnerChanged for a unique name), so a
-// controlling client that vanishes stops commanding the thrusters.
+// controlling client that vanishes stops commanding the thrusters, and the last pilot gone is
+// the pilot-lost failsafe's.
 #pragma once
 
 #include "daemon/vehicle.hpp"

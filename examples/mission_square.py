@@ -26,7 +26,8 @@ docs/topside.md):
 libdbus runs ssh itself, and ssh runs systemd-stdio-bridge on the vehicle, which connects to the
 vehicle's system bus as the SSH user. That is the address systemctl -H, busctl -H and
 caracaractl -H use (sd_bus_open_system_remote), so the bus policy judges the SSH user, and when
-the link drops, the bridge leaves the bus and caracarad zeroes the thrusters. (A Unix socket
+the link drops, the bridge leaves the bus and caracarad zeroes the thrusters (and, no other
+pilot being connected, the pilot-lost failsafe kills the vehicle after 5 s). (A Unix socket
 forwarded with ssh -L does not work for python3-dbus: the bus authenticates the topside's uid,
 sent by libdbus, against the vehicle user sshd runs as, and refuses them when they differ.)
 

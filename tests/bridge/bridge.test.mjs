@@ -7,8 +7,8 @@ import assert from "node:assert/strict";
 import net from "node:net";
 import WebSocket from "ws";
 import {
-  DEFAULT_MT, ERR, MOTORS, MOTOR_MAX, X_AXIS, ZERO, connect, hold, poll, simSpeeds, simThruster, sleep, speedByte,
-  URL, vget, wireLog, wireNext,
+  DEFAULT_MT, ERR, MOTORS, MOTOR_MAX, PILOT_LOST_MS, X_AXIS, ZERO, connect, hold, killEdges, poll, rearm, simSpeeds,
+  simThruster, sleep, speedByte, URL, vget, wireLog, wireNext,
 } from "./lib.mjs";
 
 const TOPICS = ["/vehicle/state", "/vehicle/motors", ...[...Array(MOTORS).keys()].map((i) => `/thruster/${i}`),
@@ -58,6 +58,7 @@ test("serverInfo, the subprotocol, and every channel advertised with a JSON Sche
 });
 
 test("a thrust set over D-Bus shows on /vehicle/motors; thruster telemetry equals the simulator's", async () => {
+  await rearm();
   const c = await client();
   const values = [1000, -1000, 0, 0, 0, 0, 0, 500];
   const p = hold("thrust", ...values, "--for", 20);
@@ -80,7 +81,8 @@ test("a thrust set over D-Bus shows on /vehicle/motors; thruster telemetry equal
   await poll(() => simSpeeds().every((s) => s === ZERO), 10000, "zero after the holder left");
 });
 
-test("a published motion reaches the wire as the mixing says; a closed client zeroes it within the client-loss bound", async () => {
+test("a published motion reaches the wire as the mixing says; a closed client zeroes it within the client-loss bound, and the last pilot's kill follows after pilot-lost's persistence", async () => {
+  await rearm();
   const c = await client();
   const id = c.publisher("/command/motion");
   const stop = keepPublishing(c, id, { x: 0.2 });
@@ -106,9 +108,24 @@ test("a published motion reaches the wire as the mixing says; a closed client ze
   const worstMs = Number(zeroTimes.reduce((a, b) => (a > b ? a : b)) - closedAt) / 1e6;
   console.log(`# close to the last zero order: ${worstMs.toFixed(1)} ms`);
   assert.ok(worstMs <= 250, `zeroed ${worstMs} ms after the close (bound 250 ms, docs/topside.md)`);
+  // It was the last pilot: the kill output after pilot-lost's persistence, never before it (a
+  // reader's client sees it as a failsafe), then a plain clear-kill re-arms.
+  const watcher = await client();
+  const [edge] = await poll(() => { const k = killEdges(since); return k.length ? k : null; }, PILOT_LOST_MS + 5000,
+                            "the pilot-lost kill");
+  const killMs = Number(edge.time_ns - closedAt) / 1e6;
+  console.log(`# close to the kill output: ${killMs.toFixed(0)} ms (pilot-lost persistence ${PILOT_LOST_MS} ms)`);
+  assert.ok(killMs >= PILOT_LOST_MS, `killed ${killMs} ms after the close, before the persistence`);
+  assert.ok(Number(edge.time_ns) > Number(zeroTimes.reduce((a, b) => (a > b ? a : b))), "the kill before the zeros");
+  await watcher.waitFor("/vehicle/state", (s) => s.state === "killed" && s.kill_source === "failsafe");
+  await poll(() => watcher.events.some((l) => l.name === "failsafe" && l.message.includes("pilot-lost -> kill")), 5000,
+             "the pilot-lost failsafe on /events");
+  watcher.publish(watcher.publisher("/command/clear_kill"), {});
+  await watcher.waitFor("/vehicle/state", (s) => s.state === "ready", 20000);
 });
 
 test("kill from a client, a refused command as a status with the daemon's error name, events as foxglove.Log", async () => {
+  await rearm();
   const c = await client();
   const kill = c.publisher("/command/kill");
   const clear = c.publisher("/command/clear_kill");
@@ -132,7 +149,8 @@ test("kill from a client, a refused command as a status with the daemon's error 
   await c.waitStatus((s) => s.message.includes(ERR + "UnknownProfile"));
 });
 
-test("a second client keeps its own pilot rules", async () => {
+test("a second client keeps its own pilot rules; while it is connected, another leaving kills nothing", async () => {
+  await rearm();
   const a = await client();
   const b = await client();
   const stopA = keepPublishing(a, a.publisher("/command/motion"), { x: 0.2 });
@@ -144,10 +162,14 @@ test("a second client keeps its own pilot rules", async () => {
     await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(-0.2)), 10000, "B's motion");
     const controllerB = (await b.waitFor("/vehicle/state", (s) => s.controller !== "" && s.controller !== controllerA)).controller;
     assert.notEqual(controllerA, controllerB, "each client has its own connection to caracarad");
-    // A leaves: it no longer commands, so B's thrust stays.
+    // A leaves: it no longer commands, so B's thrust stays; B is a pilot still, so no kill.
+    const since = wireNext();
     await a.close();
-    await sleep(700); // past CommandTimeoutMs: B's re-sends keep it alive
+    await sleep(Math.max(700, PILOT_LOST_MS + 300)); // past CommandTimeoutMs and pilot-lost's persistence
+    // The speeds first: busctl runs synchronously, and a long wire log read would hold B's re-sends
+    // past CommandTimeoutMs.
     assert.deepEqual(simSpeeds(), xMotion(-0.2));
+    assert.deepEqual(killEdges(since), [], "killed while a pilot was still connected");
   } finally {
     stopB();
   }

@@ -8,8 +8,8 @@ import net from "node:net";
 import path from "node:path";
 import { launch, openCockpit, surge } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
-import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, X_AXIS, ZERO, poll, simSpeeds, simThruster, sleep, speedByte, vget, wireLog,
-  wireNext } from "./lib.mjs";
+import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, X_AXIS, ZERO, killEdges, poll, rearm, simSpeeds, simThruster,
+  sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
 
 const HTTP = process.env.CARACARA_HTTP_URL;
 const ART = process.env.CARACARA_ARTIFACTS;
@@ -92,6 +92,7 @@ const xMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in X_AXIS ? speed
 const allZero = () => simSpeeds().every((s) => s === ZERO);
 
 test("a scripted gamepad drives motion to the wire as the mixing says only while the deadman is held", async () => {
+  await rearm();
   const { page } = await open();
   await setPad(page, () => { window.__pad.axes[1] = -0.6; });
   await sleep(600);
@@ -154,7 +155,8 @@ test("the mapping and the gain (selector and d-pad) are editable and kept in the
   await page.close();
 });
 
-test("closing the page while driving zeroes the thrusters within the client-loss bound", async () => {
+test("closing the page while driving zeroes the thrusters within the client-loss bound; the kill follows after pilot-lost's persistence", async () => {
+  await rearm();
   const { page } = await open();
   await setPad(page, () => { window.__pad.axes[1] = -0.6; window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; });
   await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
@@ -172,6 +174,18 @@ test("closing the page while driving zeroes the thrusters within the client-loss
   const worstMs = Number(zeroTimes.reduce((a, b) => (a > b ? a : b)) - closedAt) / 1e6;
   console.log(`# page closed to the last zero order: ${worstMs.toFixed(1)} ms`);
   assert.ok(worstMs <= 250, `zeroed ${worstMs} ms after the close (bound 250 ms, docs/topside.md)`);
+  // The page was the last pilot: the kill output after pilot-lost's persistence, never before.
+  const [edge] = await poll(() => { const k = killEdges(since); return k.length ? k : null; }, PILOT_LOST_MS + 5000,
+                            "the pilot-lost kill");
+  const killMs = Number(edge.time_ns - closedAt) / 1e6;
+  console.log(`# page closed to the kill output: ${killMs.toFixed(0)} ms (pilot-lost persistence ${PILOT_LOST_MS} ms)`);
+  assert.ok(killMs >= PILOT_LOST_MS, `killed ${killMs} ms after the close, before the persistence`);
+  // Another page shows why, and its plain clear-kill re-arms (nothing is left to lose).
+  const { page: other } = await open();
+  await other.waitForFunction(() => document.getElementById("state").textContent === "killed", { timeout: 10000 });
+  assert.equal(await text(other, "#kill-source"), "failsafe");
+  await clearKill(other);
+  await other.close();
 });
 
 async function killedBy(page, action) {
@@ -190,6 +204,7 @@ async function clearKill(page) {
 }
 
 test("the kill button and the Space (while driving) and Escape keys each kill; clear-kill asks first", async () => {
+  await rearm();
   const { page } = await open();
   await page.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 20000 });
   await killedBy(page, () => page.click("#kill"));

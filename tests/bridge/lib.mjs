@@ -48,6 +48,21 @@ export function wireLog(since) {
   return entries.map((e) => ({ index: e[0], time_ns: BigInt(e[1]), bus: e[3], addr: e[4], read: e[5], data: e[6] }));
 }
 
+// The simulator's kill output line (tests/e2e/vehicle_checks.py KILL_OUT): its asserted edges.
+export const KILL_OUT = 27;
+export const killEdges = (since) =>
+  wireLog(since).filter((e) => e.bus === "gpio" && e.addr === KILL_OUT && e.data.length === 1 && e.data[0] === 1);
+// [failsafe.pilot-lost] persistence_ms of the rig (test_bridge.py's BridgeRig).
+export const PILOT_LOST_MS = Number(process.env.CARACARA_PILOT_LOST_MS);
+
+// Kill and ClearKill through busctl (no pilot), then ready: a test that drives starts with no
+// pilot-lost pending from an earlier test's pilot that left.
+export async function rearm() {
+  if (vget("State") !== "killed") busctl("call", VEHICLE, ROOT, VEHICLE, "Kill");
+  busctl("call", VEHICLE, ROOT, VEHICLE, "ClearKill");
+  await poll(() => vget("State") === "ready", 20000, "ready again");
+}
+
 export async function poll(fn, timeoutMs = 10000, message = "condition") {
   const end = Date.now() + timeoutMs;
   let last;
@@ -68,13 +83,14 @@ const ajv = new Ajv2020({ strict: false });
 const decoder = new TextDecoder();
 
 // A connected reference client: channels by topic, every message validated against its
-// channel's schema (failures collected), the latest message per topic, status messages.
+// channel's schema (failures collected), the latest message per topic, every /events message,
+// status messages.
 export async function connect(url = URL) {
   const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
   const client = new FoxgloveClient({ ws });
   const c = {
     ws, client, serverInfo: null, channels: new Map(), byId: new Map(), validators: new Map(),
-    subs: new Map(), latest: new Map(), counts: new Map(), statuses: [], invalid: [], closed: false,
+    subs: new Map(), latest: new Map(), counts: new Map(), events: [], statuses: [], invalid: [], closed: false,
   };
   client.on("status", (s) => c.statuses.push(s));
   client.on("close", () => { c.closed = true; });
@@ -86,6 +102,7 @@ export async function connect(url = URL) {
     const validate = c.validators.get(ch.id);
     if (!validate(msg)) c.invalid.push(`${ch.topic}: ${ajv.errorsText(validate.errors)} in ${text}`);
     c.latest.set(ch.topic, { msg, timestamp });
+    if (ch.topic === "/events") c.events.push(msg); // several may come at once (a failsafe, then its kill)
     c.counts.set(ch.topic, (c.counts.get(ch.topic) ?? 0) + 1);
   });
   await new Promise((resolve, reject) => {

@@ -25,6 +25,9 @@ from harness import BUILD_DIR, Rig, poll  # noqa: E402
 from ssh_bridge import free_port, port_listens, private_sshd  # noqa: E402
 
 NPM_CACHE = "/var/cache/caracara-npm"
+# [failsafe.pilot-lost] persistence_ms of the rig: a closed tab, the last pilot, kills this long
+# after (5 s by default; shorter here, the tests wait for it).
+PILOT_LOST_MS = 1000
 CI = os.environ.get("CI") == "true"
 
 
@@ -101,7 +104,8 @@ class BridgeRig:
             raise AssertionError("caracara-bridge is not built in %s" % BUILD_DIR)
         if not shutil.which("ssh") or not shutil.which("ssh-keygen"):
             missing("the OpenSSH client is needed")
-        cls.rig = Rig(control={"arming_delay_ms": 300})
+        cls.rig = Rig(control={"arming_delay_ms": 300}, extra_config={
+            "failsafe": {"pilot-lost": {"action": "kill", "persistence_ms": PILOT_LOST_MS}}})
         cls.procs = []
         cls.sshd = None
         try:
@@ -163,7 +167,8 @@ class BridgeRig:
     def node(self, script, **env):
         r = subprocess.run(["node", "--test", "--test-reporter=spec", script], cwd=HERE, capture_output=True, text=True,
                            timeout=300, env={**os.environ, "CARACARA_BUILD_DIR": BUILD_DIR,
-                                             "CARACARA_BUS_ADDRESS": self.rig.address, **env})
+                                             "CARACARA_BUS_ADDRESS": self.rig.address,
+                                             "CARACARA_PILOT_LOST_MS": str(PILOT_LOST_MS), **env})
         print(r.stdout, r.stderr, sep="\n", file=sys.stderr)
         self.assertEqual(r.returncode, 0, "node --test %s failed" % script)
         return r.stdout

@@ -33,3 +33,12 @@ COMMAND_TIMEOUT_LATENESS_MS_MAX = 3.0
 # second (docs/dive-format.md). The 0.2 s on top is the test's own uncertainty: the dive's start
 # is known only to within the ClearKill call, and the last block's write takes its time.
 DIVE_CRASH_LOSS_S_MAX = 1.0 + 0.2
+
+# A failsafe's action after its persistence time: the FailsafeMonitor reads its conditions
+# every 50 ms (kPeriodNs), so the kill output's edge comes at most one period after the
+# persistence; 500 ms leaves a loaded CI machine ten periods.
+FAILSAFE_LATENESS_MS_MAX = 500.0
+
+# A pilot's leaving to the last of its zero orders on the wire (docs/topside.md: the
+# client-loss bound, the same for a Foxglove tab that closes).
+CLIENT_LOSS_ZERO_MS_MAX = 250.0

@@ -5,7 +5,7 @@
 set(CARACARA_E2E_DIR ${CMAKE_CURRENT_LIST_DIR})
 # org.caracara.Vehicle1, one file per interface or behaviour (test_<name>.py).
 foreach(name properties announcements thrusters bus_recovery budget motion packet kill_and_arming power_off
-             command_timeout client_loss start_and_sigterm invalid_input teensy
+             command_timeout client_loss pilot_lost start_and_sigterm invalid_input teensy
              introspection caracaractl mission faults gpio_lines dive_crash failsafes
              packet_kill fault_reports wheels bus_lost vanished_lines adapter_limits start_killed
              command_timeout_timer thrust_profiles zero_thrusters_step)

@@ -634,7 +634,8 @@ class Rig:
     # -- test conveniences --
 
     def reset(self, timeout=20.0):
-        """Back to ready with zero thrust, whatever an earlier test left."""
+        """Back to ready with zero thrust, whatever an earlier test left. The zeros make this
+        connection a pilot: a test client that leaves the bus is then not the last pilot."""
         st = self.state()
         if st == "killed":
             if self.sim_get("KillSwitch"):
@@ -644,6 +645,19 @@ class Rig:
         if self.state() != "ready":
             self.wait_state("ready", timeout)
         self.thrust([0] * MOTORS)
+        self.wait_sim_zero(timeout)
+
+
+    def rearm(self, timeout=20.0):
+        """Back to ready with no pilot (killed if need be, then ClearKill): an earlier test's
+        pilot that left cannot kill during the next (pilot-lost), and this connection, which
+        only kills and clears, is no pilot."""
+        if self.state() != "killed":
+            self.vcall("Kill")
+        if self.sim_get("KillSwitch"):
+            self.sim_call("SetKillSwitch", False, signature="b")
+        poll(lambda: error_name(self.vcall, "ClearKill") is None, timeout, message="cannot clear the kill")
+        self.wait_state("ready", timeout)
         self.wait_sim_zero(timeout)
 
 

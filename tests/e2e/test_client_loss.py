@@ -1,5 +1,7 @@
 """A topside client is a pilot: when the commanding client leaves the bus, its thrust goes (and
-what it had sent reached the wire first); another client leaving changes nothing.
+what it had sent reached the wire first); another client leaving changes nothing. When it was
+the last pilot, the vehicle is killed after pilot-lost's persistence (test_pilot_lost has the
+rest of that failsafe).
 """
 
 import time
@@ -11,13 +13,18 @@ import dbus.lowlevel
 
 import harness
 from harness import (DEFAULT_MT, MOTORS, ROOT, VEHICLE, ZERO, VehicleTestCase, poll, speed_byte)
+from test_failsafes import kill_edges
+
+PILOT_LOST_MS = 1000
 
 
 class ClientLossTest(VehicleTestCase):
-    """The command timeout is 60 s here: only the client leaving can zero the thrusters."""
+    """The command timeout is 60 s here: only the client leaving can zero the thrusters. The
+    test's own connection is no pilot unless a test commands through it."""
+    EXTRA_CONFIG = {"failsafe": {"pilot-lost": {"action": "kill", "persistence_ms": PILOT_LOST_MS}}}
 
     def setUp(self):
-        self.rig.reset()
+        self.rig.rearm()
 
     def test_commanding_process_exits(self):
         rig = self.rig
@@ -29,7 +36,9 @@ class ClientLossTest(VehicleTestCase):
             # Still driving while the client is connected.
             time.sleep(0.3)
             self.assertEqual(rig.sim_speeds(), [speed_byte(v) for v in values])
+            since = rig.wire_next()
         finally:
+            left_at = time.monotonic_ns()
             proc.stdin.close()
             proc.wait(10)
             proc.stdout.close()
@@ -37,7 +46,14 @@ class ClientLossTest(VehicleTestCase):
         rig.wait_sim_zero(10)
         self.assertEqual(rig.motor_values(), [0] * MOTORS)
         self.assertEqual(rig.vget("Controller"), "")
-        self.assertEqual(rig.state(), "ready", "a client leaving is not a kill")
+        self.assertEqual(rig.state(), "ready", "the zeros come at once, the kill after the persistence")
+        # It was the last pilot: the kill output, after pilot-lost's persistence.
+        rig.wait_state("killed")
+        self.assertEqual(rig.vget("KillSource"), "failsafe")
+        edge = poll(lambda: kill_edges(rig.wire_log(since)[1]), 5, message="no kill output edge")[0]
+        self.assertGreaterEqual((edge.time_ns - left_at) / 1e6, PILOT_LOST_MS)
+        zeros = [e for e in rig.wire_log(since)[1] if e.bus == "i2c" and not e.read and e.data[:1] == bytes([ZERO])]
+        self.assertTrue(zeros and zeros[0].index < edge.index, "the zeros did not come before the kill")
 
     def test_other_client_leaving_changes_nothing(self):
         rig = self.rig
@@ -73,6 +89,7 @@ class ClientLossTest(VehicleTestCase):
         # The call and the disconnect arrive together, so the daemon learns that the client
         # left before its loop had a chance to send the orders: they still go out first.
         rig = self.rig
+        rig.thrust([0] * MOTORS)  # a pilot stays: the rounds are about the orders, not pilot-lost
         for round_ in range(5):
             with self.subTest(round=round_):
                 wire_from = rig.wire_next()

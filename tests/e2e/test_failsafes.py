@@ -5,7 +5,8 @@ warn leaves the orders as they were, exclude zeroes that thruster and holds the 
 budget of one motor fewer, surface orders the mixing of the heave axis for the set time and then
 kills, kill asserts the kill output and zeroes. A condition shorter than its persistence time
 does nothing. After a failsafe kill ClearKill is refused while the condition holds, and
-ClearKillOverride names it, in the journal with the caller."""
+ClearKillOverride names it, in the journal with the caller. The fixed conditions are told the
+same way; a lost Teensy link kills through the failsafe (pilot lost: test_pilot_lost)."""
 import os
 import socket
 import subprocess
@@ -468,6 +469,37 @@ class FixedConditionTest(FailsafeCase):
         poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10)
         rig.wait_state("ready")
 
+
+    def test_a_lost_teensy_link_is_a_failsafe_kill_until_it_is_back(self):
+        rig = self.rig
+        rig.reset()
+        self.drive([1500] * MOTORS)
+        since = rig.wire_next()
+        rig.sim_call("Vanish", "spi", 3000, signature="su")  # the Teensy's SPI device, for 3 s
+        self.signals.wait(("teensy-link-lost", "kill", -1))
+        self.assertEqual(rig.state(), "killed")
+        self.assertEqual(rig.vget("KillSource"), "failsafe")
+        rig.wait_sim_zero()
+        edge = poll(lambda: kill_edges(rig.wire_log(since)[1]), 5, message="no kill output edge")[0]
+        log = rig.wire_log(since)[1]
+        self.assertFalse([e for e, i, s in orders(log) if e.index > edge.index and s != ZERO],
+                         "a non-zero order after the kill output")
+        # Refused while the link is down, by the failsafe that holds; fixed, so not overridable.
+        self.assertIn(("teensy-link-lost", "kill", -1), self.failsafes())
+        r = rig.ctl("clear-kill")
+        self.assertEqual(r.returncode, 1)
+        self.assertIn(ERR + "FailsafeActive", r.stderr)
+        self.assertIn("teensy-link-lost is fixed at kill", r.stderr)
+        self.assertEqual(error_name(rig.vcall, "ClearKillOverride", "teensy-link-lost", signature="s"),
+                         ERR + "FailsafeActive")
+        self.assertEqual(rig.state(), "killed")
+        self.assertEqual(rig.log().count("FAILSAFE teensy-link-lost kill"), 1)
+        # Back: the failsafe clears, and a plain ClearKill re-arms.
+        poll(lambda: ("teensy-link-lost", "kill", -1) not in self.failsafes(), 15,
+             message="the Teensy back did not clear the failsafe")
+        self.assertTrue(rig.vget("Online", path="/org/caracara/Vehicle1/teensy", iface="org.caracara.Vehicle1.Teensy"))
+        poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10)
+        rig.wait_state("ready")
 
     def test_an_unreadable_kill_switch_is_told_as_a_failsafe(self):
         rig = self.rig

@@ -335,8 +335,9 @@ class VanishTest(unittest.TestCase):
         rig.sim_call("Vanish", "spi", 1500, signature="su")
         poll(lambda: rig.state() == "killed", 5, message="a vanished Teensy did not kill")
         killed = time.monotonic() - t0
-        self.assertEqual(rig.vget("KillSource"), "device")
+        self.assertEqual(rig.vget("KillSource"), "failsafe")  # teensy-link-lost (test_failsafes)
         self.assertFalse(rig.vget("Online", path="/org/caracara/Vehicle1/teensy", iface="org.caracara.Vehicle1.Teensy"))
+        self.assertEqual(error_name(rig.vcall, "ClearKill"), ERR + "FailsafeActive")
         poll(lambda: rig.vget("Online", path="/org/caracara/Vehicle1/teensy", iface="org.caracara.Vehicle1.Teensy"),
              10, interval=0.05, message="the Teensy never came back")
         back = time.monotonic() - t0

@@ -641,7 +641,8 @@ def bind_driver(driver, bound):
 def sc_spi_refused(rig):
     """SPI messages the module refuses (EIO): the Teensy reads offline as long as they are
     refused, no kill, and online again after. Then the SPI controller's driver unbound under the open spidev (spidev
-    answers ESHUTDOWN): the Teensy is gone, the vehicle killed with source "device"; bound again,
+    answers ESHUTDOWN): the Teensy is gone, the vehicle killed by the teensy-link-lost failsafe (source
+    "failsafe") and ClearKill refused until it is back; bound again,
     the first reopen is refused (the controller refuses the mode: SPI_IOC_WR_MODE), the next
     one brings the Teensy back."""
     poll(lambda: bool(tget(rig, "Online")), 15, message="Teensy not online")
@@ -663,7 +664,8 @@ def sc_spi_refused(rig):
         bind_driver("caracara-spi", False)
         bound = False
         rig.wait_state("killed", 15)
-        check(rig.vget("KillSource") == "device", "KillSource %r" % rig.vget("KillSource"))
+        check(rig.vget("KillSource") == "failsafe", "KillSource %r" % rig.vget("KillSource"))
+        check(error_name(rig.vcall, "ClearKill") == ERR + "FailsafeActive", "ClearKill not refused without the Teensy")
         wait_log(rig, mark, r"Teensy SPI /dev/spidev0\.0 went away \(ENODEV")
         check(not os.path.exists("/dev/spidev0.0"), "/dev/spidev0.0 still there with its controller unbound")
         time.sleep(1.5)  # a reopen or two find no node

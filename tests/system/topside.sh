@@ -124,10 +124,21 @@ check "the daemon's commanding client $controller is a connection of skipper's o
 sleep 1
 check "the hold keeps them there over SSH (1 s later, latest orders still SPEED 179)" latest_at "$idx" 179 4
 idx=$(wire_next)
+t_left=$(mono_us)
 stop_ctl
 check "Ctrl-C (SIGINT) ends the remote hold with exit 0" [ "$ctl_rc" = 0 ]
 check "the daemon zeroed all eight thrusters when the bridge left" wait_until 5 all_zero_since "$idx"
 cat "$TOP/hold.log" | sed 's/^/  hold | /'
+# That bridge was the last pilot: the pilot-lost failsafe kills after its persistence, and a
+# plain clear-kill re-arms (the condition ended with the kill).
+rearm() {
+  local rc=0
+  caracaractl -H skipper@vehicle clear-kill || rc=$?
+  [ "$rc" = 0 ] && wait_until 10 state_is ready
+}
+check "the bridge was the last pilot: killed by the failsafe (pilot-lost) after its persistence" \
+  pilot_lost_kill "$idx" "$t_left"
+check "caracaractl -H skipper@vehicle clear-kill re-arms after the pilot-lost kill" rearm
 
 # --- monitor, kill, a refused command, clear-kill -----------------------------------------------------
 caracaractl -H visitor@vehicle monitor >"$TOP/monitor.log" 2>&1 &
@@ -178,6 +189,9 @@ z=$(first_zeros_us "$idx")
 drop_ms=$(((z - t_kill) / 1000))
 echo "BOUND: dropped link (ssh killed on the topside): $drop_ms ms to the last thruster's first zero order"
 check "dropped link: zero on the wire within 250 ms of the kill ($drop_ms ms)" [ "$drop_ms" -le 250 ]
+check "dropped link: the last pilot gone, killed by the failsafe (pilot-lost) after its persistence" \
+  pilot_lost_kill "$idx" "$t_kill"
+check "dropped link: clear-kill re-arms" rearm
 
 # --- a stalled link: the tether cut without closing ----------------------------------------------------
 timeout_ms=$(prop $V $VP $V CommandTimeoutMs)
@@ -194,15 +208,21 @@ echo "BOUND: stalled link (tether down, TCP open): $stall_ms ms to the last thru
 check "stalled link: the command timeout zeroes all eight thrusters within ${timeout_ms} + 150 ms ($stall_ms ms)" \
   bash -c '[ -n "$1" ] && [ "$2" -le $(($3 + 150)) ]' _ "$z" "$stall_ms" "$timeout_ms"
 sleep 1
+idx_stop=$(wire_next)
 if kill -0 "$ctl_pid" 2>/dev/null; then
   resumed=$(latest_at "$idx" $spd 8 && echo "resumed at SPEED $spd" || echo "not resumed")
   info "after the tether came back (1.5 s cut): caracaractl still holds; thrusters $resumed"
+  t_left=$(mono_us)
 else
   info "after the tether came back (1.5 s cut): caracaractl had ended"
+  t_left= # its bridge left when it ended: the kill is checked, not its time
 fi
+idx=$idx_stop
 stop_ctl
-idx=$(wire_next)
 check "after the stall the hold is released and the thrusters are zero" wait_until 5 all_zero_since "$idx"
+check "after the stall: the last pilot gone, killed by the failsafe (pilot-lost) after its persistence" \
+  pilot_lost_kill "$idx" "$t_left"
+check "after the stall: clear-kill re-arms" rearm
 
 # --- the python3-dbus mission example over SSH ------------------------------------------------------------
 t=$(now_ms)

@@ -151,6 +151,26 @@ TEST_CASE("failsafe: the vehicle's own conditions have thruster -1") {
     CHECK(p.set_condition(FailsafeCondition::BusLost, false, ms(2)).size() == 1);
 }
 
+TEST_CASE("failsafe: pilot lost kills after its persistence; a pilot back within it ends it") {
+    FailsafePolicy p(FailsafeSettings{}, 8); // 5000 ms by default
+    CHECK(p.set_condition(FailsafeCondition::PilotLost, true, ms(100)).empty());
+    CHECK(p.next_deadline() == ms(5100));
+    CHECK(p.tick(ms(5099)).empty());
+    CHECK(p.set_condition(FailsafeCondition::PilotLost, false, ms(5099)).empty()); // a pilot commands
+    CHECK(p.tick(ms(9000)).empty());
+    CHECK(p.set_condition(FailsafeCondition::PilotLost, true, ms(10000)).empty()); // from the new loss
+    CHECK(p.set_condition(FailsafeCondition::PilotLost, true, ms(14999)).empty());
+    const FailsafeTransitions up = p.set_condition(FailsafeCondition::PilotLost, true, ms(15000));
+    REQUIRE(up.size() == 1);
+    CHECK(up[0].failsafe == fs(FailsafeCondition::PilotLost, FailsafeAction::Kill, -1));
+    CHECK(p.blocking().size() == 1);
+    // The kill ends the condition: cleared, nothing holds a ClearKill.
+    const FailsafeTransitions down = p.set_condition(FailsafeCondition::PilotLost, false, ms(15050));
+    REQUIRE(down.size() == 1);
+    CHECK_FALSE(down[0].raised);
+    CHECK(p.blocking().empty());
+}
+
 TEST_CASE("failsafe: names on the wire") {
     for (std::size_t i = 0; i < kFailsafeConditionCount; ++i) {
         const auto c = static_cast<FailsafeCondition>(i);
@@ -167,6 +187,8 @@ TEST_CASE("[failsafe]: defaults, a full table, and the fixed conditions") {
     REQUIRE(d.ok());
     CHECK(d.config->failsafe.rule(FailsafeCondition::WaterDetect).action == FailsafeAction::Surface);
     CHECK(d.config->failsafe.rule(FailsafeCondition::PilotLost).action == FailsafeAction::Kill);
+    CHECK(d.config->failsafe.rule(FailsafeCondition::PilotLost).persistence_ms == 5000);
+    CHECK(d.config->failsafe.rule(FailsafeCondition::TeensyLinkLost).persistence_ms == 0);
 
     ConfigResult r = parse_config_string("[failsafe.water-detect]\naction = \"warn\"\npersistence_ms = 100\n"
                                          "[failsafe.hall]\naction = \"kill\"\n"
@@ -181,6 +203,14 @@ TEST_CASE("[failsafe]: defaults, a full table, and the fixed conditions") {
     CHECK(f.rule(FailsafeCondition::Hall).persistence_ms == FailsafeSettings{}.rule(FailsafeCondition::Hall).persistence_ms);
     CHECK(f.surface.heave == Approx(-0.3));
     CHECK(f.surface.duration_ms == 4000);
+}
+
+TEST_CASE("[failsafe]: pilot-lost's persistence is the one a fixed condition may set") {
+    const ConfigResult r = parse_config_string("[failsafe.pilot-lost]\naction = \"kill\"\npersistence_ms = 1500\n");
+    INFO(r.error());
+    REQUIRE(r.ok());
+    CHECK(r.config->failsafe.rule(FailsafeCondition::PilotLost).persistence_ms == 1500);
+    CHECK(r.config->failsafe.rule(FailsafeCondition::PilotLost).action == FailsafeAction::Kill);
 }
 
 TEST_CASE("[failsafe]: the checker refuses weakening a fixed condition, by name") {
@@ -206,6 +236,10 @@ TEST_CASE("[failsafe]: bad tables get named errors") {
     CHECK(err("[failsafe.stall]\npersistance_ms = 1\n").find("did you mean 'failsafe.stall.persistence_ms'") !=
           std::string::npos);
     CHECK(err("[failsafe.bus-lost]\npersistence_ms = 1\n").find("unknown key 'failsafe.bus-lost.persistence_ms'") !=
+          std::string::npos);
+    CHECK(err("[failsafe.teensy-link-lost]\npersistence_ms = 1\n")
+              .find("unknown key 'failsafe.teensy-link-lost.persistence_ms'") != std::string::npos);
+    CHECK(err("[failsafe.pilot-lost]\npersistence_ms = 60001\n").find("failsafe.pilot-lost.persistence_ms") !=
           std::string::npos);
     CHECK(err("[failsafe.surface]\nheave = 0.5\n").find("failsafe.surface.heave: must be") != std::string::npos);
     CHECK(err("[failsafe.surface]\nduration_ms = 0\n").find("failsafe.surface.duration_ms") != std::string::npos);

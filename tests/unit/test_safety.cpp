@@ -289,6 +289,60 @@ TEST_CASE("the commanding client leaving zeroes the output without killing") {
     CHECK(s.client_left(":1.8", now + 6).zero_outputs);
 }
 
+TEST_CASE("pilot lost: a pilot left and none remains, while armed; readers are no pilots") {
+    uint64_t now = 0;
+    SafetyMachine s = ready_machine(now);
+    s.client_left(":1.3", now); // a reader (status, ClearKill) that never commanded
+    CHECK_FALSE(s.pilot_lost());
+
+    REQUIRE(s.accept_command(now, ":1.7").ok());
+    REQUIRE(s.accept_command(now, ":1.8").ok()); // a second tab, commanding now
+    s.client_left(":1.8", now + 1);              // the commanding one leaves: zeros...
+    CHECK_FALSE(s.pilot_lost());                 // ... but :1.7 is a pilot still
+    CHECK(s.pilots().connected() == 1);
+    s.client_left(":1.7", now + 2); // no longer commanding, still a pilot: the last one
+    CHECK(s.pilot_lost());
+    CHECK(s.state() == SafetyState::Ready); // the kill is the failsafe's, after its persistence
+
+    REQUIRE(s.accept_command(now + 3, ":1.9").ok()); // a new pilot ends it
+    CHECK_FALSE(s.pilot_lost());
+    s.client_left(":1.9", now + 4);
+    CHECK(s.pilot_lost());
+
+    // The kill ends it (nothing left to lose), and ClearKill arms with nobody piloting.
+    s.kill(KillSource::Failsafe, now + 5, "pilot-lost kill");
+    CHECK_FALSE(s.pilot_lost());
+    REQUIRE(s.clear_kill(now + 6).ok());
+    CHECK_FALSE(s.pilot_lost());
+    CHECK(s.pilots().connected() == 0);
+}
+
+TEST_CASE("pilot lost: a pilot the command timeout zeroed is a pilot still") {
+    uint64_t now = 0;
+    SafetyMachine s = ready_machine(now);
+    REQUIRE(s.accept_command(now, ":1.7").ok());
+    const SafetyAction stale = s.tick(now + s.config().command_timeout_ns);
+    CHECK(stale.command_stale);
+    CHECK(s.state() == SafetyState::Ready); // a zero, not a kill
+    CHECK_FALSE(s.pilot_lost());
+    CHECK_FALSE(s.client_left(":1.7", now + s.config().command_timeout_ns + 1).zero_outputs); // already zero
+    CHECK(s.pilot_lost());
+}
+
+TEST_CASE("pilot lost: a refused command makes no pilot; power-off forgets them") {
+    SafetyMachine s(SafetyConfig{}, false, kT0);
+    CHECK_FALSE(s.accept_command(kT0, ":1.7").ok()); // arming: refused
+    s.client_left(":1.7", kT0 + 1);
+    CHECK_FALSE(s.pilot_lost());
+    uint64_t now = 0;
+    SafetyMachine r = ready_machine(now);
+    REQUIRE(r.accept_command(now, ":1.7").ok());
+    r.client_left(":1.7", now + 1);
+    REQUIRE(r.pilot_lost());
+    r.power_off(now + 2);
+    CHECK_FALSE(r.pilot_lost());
+}
+
 TEST_CASE("state names") {
     CHECK(state_name(SafetyState::Arming) == "arming");
     CHECK(state_name(SafetyState::Ready) == "ready");

@@ -27,6 +27,7 @@ public:
     bool powered_off() const override { return false; }
     Result accept_command(std::string_view) override { return {}; }
     void device_lost(std::string_view why) override { lost.emplace_back(why); }
+    void link_changed() override {}
     std::vector<std::string> lost;
 };
 

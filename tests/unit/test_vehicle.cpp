@@ -2,6 +2,7 @@
 // fake wire (orders with their motor values, the kill and power-off outputs), in order.
 #include "tests/unit/fakes/daemon_rig.hpp"
 
+#include "core/clock.hpp"
 #include "core/packet.hpp"
 #include "tests/catch.hpp"
 
@@ -147,7 +148,7 @@ TEST_CASE("the kill switch: the kill output first, then the zeros; released, the
 }
 
 TEST_CASE("started killed with the kill switch set: the kill is the switch's, not the start's") {
-    DaemonRig rig("arm_at_start = false\nloop_rate_hz = 50\n", true);
+    DaemonRig rig("arm_at_start = false\nloop_rate_hz = 50\n", "", true);
     rig.run_for(40);
     REQUIRE(rig.vehicle().safety().state() == SafetyState::Killed);
     // What holds the vehicle killed is the switch, which the user must release.
@@ -160,11 +161,12 @@ TEST_CASE("started killed with the kill switch set: the kill is the switch's, no
     CHECK(rig.vehicle().clear_kill().ok());
 }
 
-TEST_CASE("a client that leaves: what it sent reaches the wire, then its zeros; no kill") {
-    DaemonRig rig;
+TEST_CASE("a client that leaves: what it sent reaches the wire, then its zeros; the kill only after pilot-lost's persistence") {
+    DaemonRig rig("loop_rate_hz = 50\n", "[failsafe.pilot-lost]\npersistence_ms = 300\n");
     rig.run_until_ready();
     rig.wire().clear();
     REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    const uint64_t left_at = monotonic_ns();
     rig.vehicle().client_left(":1.7"); // before the loop ran: the orders are still due
     // Each thruster gets what the client sent, then its zero.
     const auto sent_then_zero = [&] {
@@ -180,6 +182,26 @@ TEST_CASE("a client that leaves: what it sent reaches the wire, then its zeros; 
     CHECK(kill_output(rig.wire().events(), 1) < 0);
     CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
     CHECK(rig.vehicle().controller_client().empty());
+    // It was the last pilot: the pilot-lost failsafe kills once its persistence has passed.
+    REQUIRE(rig.run_until([&] { return kill_output(rig.wire().events(), 1) >= 0; }, 2000));
+    CHECK(monotonic_ns() - left_at >= ms_to_ns(300));
+    REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events(), kill_output(rig.wire().events(), 1)); }));
+    CHECK(rig.vehicle().kill_source_name() == "failsafe");
+    CHECK(rig.daemon().failsafes().active().size() == 1);
+    check_kill_output_first(rig.wire().events());
+    // The kill ended it: a plain ClearKill arms again.
+    rig.run_for(100);
+    CHECK(rig.daemon().failsafes().active().empty());
+    CHECK(rig.vehicle().clear_kill().ok());
+}
+
+TEST_CASE("a client that never commanded leaving is no pilot lost") {
+    DaemonRig rig("loop_rate_hz = 50\n", "[failsafe.pilot-lost]\npersistence_ms = 100\n");
+    rig.run_until_ready();
+    rig.vehicle().client_left(":1.5");
+    rig.run_for(300);
+    CHECK(kill_output(rig.wire().events(), 1) < 0);
+    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
 }
 
 TEST_CASE("another client leaving changes nothing") {

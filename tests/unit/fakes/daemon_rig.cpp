@@ -9,10 +9,10 @@
 namespace caracara::test {
 
 namespace {
-DaemonConfig parse(const std::string& control) {
+DaemonConfig parse(const std::string& control, const std::string& sections) {
     const std::string arm = control.find("arm_at_start") == std::string::npos ? "arm_at_start = true\n" : "";
     ConfigResult r = parse_config_string("[control]\n" + arm + "arming_delay_ms = 0\n" + control +
-                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n",
+                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n" + sections,
                                          "the test rig");
     if (!r.ok())
         throw std::runtime_error(r.error());
@@ -20,8 +20,8 @@ DaemonConfig parse(const std::string& control) {
 }
 } // namespace
 
-DaemonRig::DaemonRig(const std::string& control, bool kill_switch_set)
-    : config_(parse(control)), io_(wire_, config_), gpio_(wire_) {
+DaemonRig::DaemonRig(const std::string& control, const std::string& sections, bool kill_switch_set)
+    : config_(parse(control, sections)), io_(wire_, config_), gpio_(wire_) {
     gpio_.set_kill_switch(kill_switch_set); // before the daemon reads it
     if (sd_event_new(&event_) < 0)
         throw std::runtime_error("sd_event_new");
