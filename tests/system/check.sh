@@ -364,14 +364,13 @@ check "pilot (group caracara): SetLeds 10 20 30 accepted" allowed pilot $V $VP $
 leds_are() { [ "$(prop $S $SP/teensy $STE Leds)" = "10 20 30" ]; }
 check "the simulated Teensy shows the LEDs 10 20 30" wait_until 3 leds_are
 check "pilot: GetDistance 0 answered" allowed pilot $V $VP/teensy $VT GetDistance y 0
-idx=$(wire_next)
 t_pilot=$(mono_us)
 check "pilot: SetThrust accepted" allowed pilot $V $VP $V SetThrust ai 8 500 0 0 0 0 0 0 0
 # That busctl was the vehicle's only pilot, and it left: its thrust went at once, and the
 # pilot-lost failsafe kills after its persistence (5 s by default); nothing is left to lose, so
 # a plain ClearKill re-arms.
 check "pilot's busctl left, the last pilot: killed by the failsafe (pilot-lost) after its persistence" \
-  pilot_lost_kill "$idx" "$t_pilot"
+  pilot_lost_kill "$t_pilot"
 rearm() { busctl call $V $VP $V ClearKill && wait_until 10 state_is ready; }
 check "root: ClearKill re-arms after the pilot-lost kill, ready after the arming delay" rearm
 check "pilot: Simulator1.ClearWireLog accepted (the simulator's policy)" allowed pilot $S $SP $S ClearWireLog

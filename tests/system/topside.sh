@@ -137,7 +137,7 @@ rearm() {
   [ "$rc" = 0 ] && wait_until 10 state_is ready
 }
 check "the bridge was the last pilot: killed by the failsafe (pilot-lost) after its persistence" \
-  pilot_lost_kill "$idx" "$t_left"
+  pilot_lost_kill "$t_left"
 check "caracaractl -H skipper@vehicle clear-kill re-arms after the pilot-lost kill" rearm
 
 # --- monitor, kill, a refused command, clear-kill -----------------------------------------------------
@@ -190,7 +190,7 @@ drop_ms=$(((z - t_kill) / 1000))
 echo "BOUND: dropped link (ssh killed on the topside): $drop_ms ms to the last thruster's first zero order"
 check "dropped link: zero on the wire within 250 ms of the kill ($drop_ms ms)" [ "$drop_ms" -le 250 ]
 check "dropped link: the last pilot gone, killed by the failsafe (pilot-lost) after its persistence" \
-  pilot_lost_kill "$idx" "$t_kill"
+  pilot_lost_kill "$t_kill"
 check "dropped link: clear-kill re-arms" rearm
 
 # --- a stalled link: the tether cut without closing ----------------------------------------------------
@@ -221,7 +221,7 @@ idx=$idx_stop
 stop_ctl
 check "after the stall the hold is released and the thrusters are zero" wait_until 5 all_zero_since "$idx"
 check "after the stall: the last pilot gone, killed by the failsafe (pilot-lost) after its persistence" \
-  pilot_lost_kill "$idx" "$t_left"
+  pilot_lost_kill "$t_left"
 check "after the stall: clear-kill re-arms" rearm
 
 # --- the python3-dbus mission example over SSH ------------------------------------------------------------
