@@ -4,7 +4,7 @@
 #   scripts/fuzz.sh                      every harness, 10 minutes each
 #   scripts/fuzz.sh seabotix 3600        one harness for an hour
 #   scripts/fuzz.sh config -runs=10000000
-# Harnesses: packet seabotix teensy config sim_request (or "all").
+# Harnesses: those fuzz/CMakeLists.txt declares (caracara_fuzzer), or "all".
 # The grown corpus and any crash-*/leak-*/timeout-* input stay in
 # ${CARACARA_FUZZ_DIR:-/var/tmp/caracara-fuzz}/<harness>/; a crash input belongs in
 # fuzz/regressions/<harness>/ once its cause is fixed. Builds build-fuzz/ with clang-14 first.
@@ -13,7 +13,8 @@
 # some harnesses replaces only their entries.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
-harnesses=(packet seabotix teensy config sim_request dive)
+# The list is fuzz/CMakeLists.txt's, so that a new harness is fuzzed here too.
+mapfile -t harnesses < <(sed -nE 's/^caracara_fuzzer\(([a-z_]+) .*/\1/p' "$top/fuzz/CMakeLists.txt")
 which=${1:-all}
 limit=${2:-600}
 store=${CARACARA_FUZZ_DIR:-/var/tmp/caracara-fuzz}
