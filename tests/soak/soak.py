@@ -106,6 +106,7 @@ class Soak:
         self.wire_gaps = 0
         self.calls = 0
         self.refused = 0
+        self.refused_by = {}   # error name (last part) -> refused SetThrust calls
         self.churn = 0
         self.kill_level = None
         self.killed = False    # between an asserting and a releasing kill output edge
@@ -365,6 +366,8 @@ class Soak:
                 except dbus.DBusException as e:
                     self.refused += 1
                     name = e.get_dbus_name() or ""
+                    why = name.rsplit(".", 1)[-1]
+                    self.refused_by[why] = self.refused_by.get(why, 0) + 1
                     if name.endswith(".Killed"):
                         try:
                             client.call_blocking(VEHICLE, PATH, VEHICLE, "ClearKill", "", ())
@@ -376,7 +379,8 @@ class Soak:
                     next_cmd = now + PERIOD  # after a stall the stream goes on at its rate, no burst
             if now - last_report > 30:
                 print("soak: %.0f s, %d transactions, %d calls, %d wire log entries read, %.1f s behind" %
-                      (now - t_start, tx, self.calls, self.entries_read, now - self.read_to_ns / 1e9), flush=True)
+                      (now - t_start, tx, self.calls, self.entries_read,
+                       now - self.read_to_ns / 1e9 if self.read_to_ns else 0), flush=True)
                 last_report = now
             time.sleep(0.002)
         time.sleep(0.3)
@@ -393,6 +397,7 @@ class Soak:
         print("soak: %.0f s, %d bus transactions, %d SetThrust calls (%d refused), %d client changes, "
               "%d simulator restarts, %d recoveries" % (elapsed, tx, self.calls, self.refused, self.churn,
                                                          self.sim_restarts, recov))
+        print("soak: SetThrust refused with: " + ", ".join("%s %d" % kv for kv in sorted(self.refused_by.items())))
         print("soak: faults injected: " + ", ".join("%s %d" % kv for kv in sorted(self.faults.items())))
         print("soak: commands reached the wire %d, superseded by a newer one %d, by a kill %d, excused by a "
               "fault %d, LOST %d" % (b["reached"], b["superseded"], b["superseded_by_kill"], b["excused"], b["lost"]))
@@ -418,7 +423,8 @@ class Soak:
         for f in failures:
             print("soak: FAIL: %s" % f)
         self.results = dict(seconds=round(elapsed, 1), transactions=tx, setthrust_calls=self.calls,
-                            refused=self.refused, client_changes=self.churn, simulator_restarts=self.sim_restarts,
+                            refused=self.refused, refused_by=dict(self.refused_by), client_changes=self.churn,
+                            simulator_restarts=self.sim_restarts,
                             recoveries=recov, faults=dict(self.faults), books=dict(b), wire_gaps=self.wire_gaps,
                             wire_entries_read=self.entries_read, reader_lag_max_s=round(self.max_lag, 2),
                             fds=[fd0, fd1], rss_kib=[rss0, rss1], rss_judged=not emulated, seed=a.seed,
@@ -448,8 +454,10 @@ def main():
         soak.rig.stop()
         raise
     if args.results:
+        top = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))) + os.sep
         with open(args.results, "w") as f:
-            json.dump(dict(soak.results, command="tests/soak/soak.py " + " ".join(sys.argv[1:]),
+            json.dump(dict(soak.results, command="tests/soak/soak.py " + " ".join(a.replace(top, "") for a in sys.argv[1:]),
+                           cpus=os.cpu_count(),
                            finished=time.strftime("%Y-%m-%dT%H:%M:%S%z")), f, indent=1, sort_keys=True)
             f.write("\n")
         print("soak: counts written to %s" % args.results)
