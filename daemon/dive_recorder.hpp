@@ -3,7 +3,8 @@
 // every state change (with its kill source, reason and calling client), fault change, bus loss
 // and recovery and profile switch, and closes the dive at the next kill or power-off. Samples
 // are encoded into memory on the loop (a few hundred bytes, no system call) and handed to the
-// DiveWriter's thread once a second, so a crash loses at most the last second.
+// DiveWriter's thread once a second, so a crash loses at most the last second, and at 64 KiB
+// (a loop running flat out fills megabytes a second).
 #pragma once
 
 #include "core/config.hpp"
