@@ -5,11 +5,17 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
 
 namespace caracara {
 
 namespace {
 constexpr uint64_t kFlushPeriodNs = 1'000'000'000; // a crash loses at most this much
+// A block is also handed over once this much is buffered: the loop's rate sets how much a
+// second holds (loop_rate_hz = 0: thousands of samples, megabytes a second), and the buffer,
+// its sealed copy and the writer's queue would grow with it, past the format's 4 MiB block
+// on a fast machine. At 50 Hz a second holds about 11 KB, so only the period applies.
+constexpr std::size_t kFlushBytes = 64 * 1024;
 constexpr uint64_t kNsPer100us = 100'000;
 
 uint64_t unix_ms() {
@@ -165,7 +171,7 @@ void DiveRecorder::cycle(uint64_t now_ns) {
     if (!recording_)
         return;
     dive::encode_sample(records_, sampler_.sample(since_start(now_ns)));
-    if (now_ns - last_flush_ns_ >= kFlushPeriodNs) {
+    if (now_ns - last_flush_ns_ >= kFlushPeriodNs || records_.size() >= kFlushBytes) {
         last_flush_ns_ = now_ns;
         flush();
     }

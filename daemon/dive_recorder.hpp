@@ -4,7 +4,7 @@
 // and recovery and profile switch, and closes the dive at the next kill or power-off. Samples
 // (its DiveSampler's) are encoded into memory on the loop (a few hundred bytes, no system
 // call) and handed to the DiveWriter's thread once a second, so a crash loses at most the
-// last second.
+// last second, and at 64 KiB (a loop running flat out fills megabytes a second).
 #pragma once
 
 #include "core/config.hpp"

@@ -78,6 +78,9 @@ fi
 [ -f "$work/caracarad-$version/debian/rules" ] || { echo "package: no debian/ in the copy" >&2; exit 1; }
 
 # --- build ------------------------------------------------------------------------------------
+# Through ccache when present: the copy is made at the same path each time, so the next run's
+# package build (same sources, same dpkg-buildflags) compiles only what changed.
+. "$top/scripts/ccache.sh" "$work/caracarad-$version"
 log=$out/build-$arch.log
 say "dpkg-buildpackage -b ${cross[*]} ${profiles[*]} (DEB_BUILD_OPTIONS='$opts'), log in $log"
 t1=$(date +%s)

@@ -3,7 +3,8 @@
 # warnings as errors, and an AddressSanitizer + UndefinedBehaviorSanitizer build; the arm64
 # cross build with its tests under qemu-user, and the arm64 Debian packages (the normal
 # build's ctest builds the amd64 ones for the system test); then the libFuzzer harnesses
-# (clang, fuzz/) for CARACARA_FUZZ_SECONDS (60) each, two at a time.
+# (clang, fuzz/) for CARACARA_FUZZ_SECONDS (20) each, two at a time: a smoke run (they build,
+# run from their seeds and regression inputs, find nothing); scripts/fuzz.sh runs them long.
 #   scripts/test.sh            all of it
 #   scripts/test.sh normal     only the normal build (faster, for development)
 #   scripts/test.sh cross      only arm64 (scripts/cross_test.sh, scripts/package.sh arm64)
@@ -54,9 +55,7 @@ step() {
 }
 fuzz_suite() {
   echo "== build $top/build-fuzz (libFuzzer harnesses)"
-  cmake -S "$top" -B "$top/build-fuzz" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCARACARA_FUZZ=ON -DCARACARA_WERROR=ON \
-    -DCMAKE_CXX_COMPILER="$(command -v clang++-14 || command -v clang++)" >/dev/null || return
-  cmake --build "$top/build-fuzz" -j"$jobs" --target fuzzers || return
+  CARACARA_FUZZ_BUILD="$top/build-fuzz" "$top/scripts/fuzz.sh" build || return
   echo "== fuzz $top/build-fuzz"
   ctest_run fuzz "$top/build-fuzz" -j2 -L fuzz
 }

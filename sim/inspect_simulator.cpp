@@ -5,6 +5,10 @@
 #include "sim/inspect_reply.hpp"
 #include "sim/simulator_parts.hpp"
 
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
 namespace caracara::sim {
 
 namespace {
@@ -87,16 +91,34 @@ int m_release_bus(sd_bus_message* m, void* userdata, sd_bus_error*) {
 // addr = the line offset (KillSwitchLine for the kill switch), data = {new level on the wire},
 // result "edge", time_ns = the moment of the change (for the kill switch, the moment
 // SetKillSwitch changed it, which is when caracarad's edge event can fire).
-int m_wire_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    uint64_t since = 0;
-    if (int r = sd_bus_message_read(m, "t", &since); r < 0)
-        return r;
+// A reply is one page: the entries from `since` up to kMaxReplyBytes of message, `next` the
+// index to ask for next (the log's end once it is all read). The bus drops a sender whose
+// message exceeds its limit (dbus-daemon's max_message_size, 32 MiB unless configured), so an
+// unbounded reply of a large log (the soak's [sim] wire_log_entries = 2000000) took the
+// simulator off the bus. The default log (200000 entries, about 14 MB) fits in one page.
+// GetWireLogPage(t since, u max_entries) is the same with a smaller page of the caller's choice
+// (a reader that must not stall on one large reply).
+constexpr size_t kMaxReplyBytes = 16u << 20;
+
+// What entry `e` takes in the message, with room for the alignment (at least 8 bytes each).
+size_t marshalled_size(const WireEntry& e) {
+    return 64 + e.bus.size() + e.data.size() + e.miso.size() + e.result.size();
+}
+
+int wire_log_page(sd_bus_message* m, void* userdata, uint64_t since, size_t max_entries) {
     return reply_with(m, [&](sd_bus_message* reply) {
-        auto& log = vehicle(userdata).log();
-        int r = sd_bus_message_append(reply, "t", log.next_index());
+        const WireLog& log = vehicle(userdata).log();
+        std::vector<const WireEntry*> page = log.since(since, max_entries);
+        size_t bytes = 0, n = 0;
+        while (n < page.size() && (bytes += marshalled_size(*page[n])) <= kMaxReplyBytes)
+            ++n;
+        page.resize(n);
+        // Indexes are consecutive: after the last entry of the log this is the log's end.
+        const uint64_t next = page.empty() ? log.next_index() : page.back()->index + 1;
+        int r = sd_bus_message_append(reply, "t", next);
         if (r >= 0)
             r = sd_bus_message_open_container(reply, 'a', "(tttsqbayays)");
-        for (const WireEntry* e : log.since(since)) {
+        for (const WireEntry* e : page) {
             if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttsqbayays");
             if (r >= 0) r = sd_bus_message_append(reply, "tttsqb", e->index, e->time_ns, e->transaction, e->bus.c_str(), e->addr, static_cast<int>(e->read));
             if (r >= 0) r = sd_bus_message_append_array(reply, 'y', e->data.data(), e->data.size());
@@ -106,6 +128,23 @@ int m_wire_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
         }
         return r < 0 ? r : sd_bus_message_close_container(reply);
     });
+}
+
+int m_wire_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    uint64_t since = 0;
+    if (int r = sd_bus_message_read(m, "t", &since); r < 0)
+        return r;
+    return wire_log_page(m, userdata, since, SIZE_MAX);
+}
+
+int m_wire_log_page(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    uint64_t since = 0;
+    uint32_t max_entries = 0;
+    if (int r = sd_bus_message_read(m, "tu", &since, &max_entries); r < 0)
+        return r;
+    if (max_entries < 1)
+        return sd_bus_error_setf(err, kInspectInvalid, "a page holds at least 1 entry, got %u", max_entries);
+    return wire_log_page(m, userdata, since, max_entries);
 }
 
 int m_clear_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -145,6 +184,8 @@ constexpr dbus::Member kMembers[] = {
     property<[](I i) { return uint32_t(i.server.clients()); }>("Clients"),
     member(SD_BUS_METHOD_WITH_ARGS("GetWireLog", SD_BUS_ARGS("t", since), SD_BUS_RESULT("t", next, "a(tttsqbayays)", entries),
                                    m_wire_log, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("GetWireLogPage", SD_BUS_ARGS("t", since, "u", max_entries),
+                                   SD_BUS_RESULT("t", next, "a(tttsqbayays)", entries), m_wire_log_page, kUnpriv)),
     member(SD_BUS_METHOD("ClearWireLog", "", "", m_clear_log, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetRealisticTiming", SD_BUS_ARGS("b", enabled), SD_BUS_NO_RESULT, m_set_realistic, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetClock", SD_BUS_ARGS("u", hz), SD_BUS_NO_RESULT, m_set_clock, kUnpriv)),

@@ -5,6 +5,7 @@
 
 #include "core/clock.hpp"
 
+#include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <string>
@@ -39,8 +40,8 @@ public:
     explicit WireLog(size_t capacity = 200000) : capacity_(capacity) {}
     uint64_t append(WireEntry e);
     uint64_t new_transaction() { return ++transaction_; }
-    // Entries with index >= since, oldest first.
-    std::vector<const WireEntry*> since(uint64_t since_index) const;
+    // Entries with index >= since, oldest first, at most max_entries of them.
+    std::vector<const WireEntry*> since(uint64_t since_index, size_t max_entries = SIZE_MAX) const;
     uint64_t next_index() const { return next_; }
     void clear() { entries_.clear(); }
     size_t size() const { return entries_.size(); }

@@ -287,11 +287,28 @@ std::vector<WireEntry> SimFixture::wire_log(uint64_t since) {
                                "org.caracara.Simulator1", "GetWireLog", &e, &reply, "t", since);
     if (r < 0)
         fail("GetWireLog", e, r);
+    return read_wire_log(reply, nullptr);
+}
+
+std::vector<WireEntry> SimFixture::wire_log_page(uint64_t since, uint32_t max_entries, uint64_t* next) {
+    sd_bus_error e = SD_BUS_ERROR_NULL;
+    sd_bus_message* reply = nullptr;
+    int r = sd_bus_call_method(bus_.get(), "org.caracara.Simulator1", "/org/caracara/Simulator1",
+                               "org.caracara.Simulator1", "GetWireLogPage", &e, &reply, "tu", since, max_entries);
+    if (r < 0)
+        fail("GetWireLogPage", e, r);
+    return read_wire_log(reply, next);
+}
+
+// The reply of GetWireLog or GetWireLogPage (which it takes over).
+std::vector<WireEntry> SimFixture::read_wire_log(sd_bus_message* reply, uint64_t* next_out) {
     dbus::MessagePtr guard(reply);
     uint64_t next = 0;
     sd_bus_message_read(reply, "t", &next);
+    if (next_out)
+        *next_out = next;
     std::vector<WireEntry> out;
-    r = sd_bus_message_enter_container(reply, 'a', "(tttsqbayays)");
+    int r = sd_bus_message_enter_container(reply, 'a', "(tttsqbayays)");
     while (r >= 0 && sd_bus_message_enter_container(reply, 'r', "tttsqbayays") > 0) {
         WireEntry w{};
         const char* busname = nullptr;

@@ -64,6 +64,8 @@ public:
     // Calls a method; returns the D-Bus error name, or "" on success.
     std::string call(const std::string& path, const char* iface, const char* method, const char* sig, ...);
     std::vector<WireEntry> wire_log(uint64_t since = 0);
+    // GetWireLogPage(since, max_entries); `next` gets the index to read on from.
+    std::vector<WireEntry> wire_log_page(uint64_t since, uint32_t max_entries, uint64_t* next);
     // Root object (org.caracara.Simulator1) properties.
     bool root_bool(const char* prop);
     uint64_t root_u64(const char* prop);
@@ -74,6 +76,8 @@ public:
     Process dbus_daemon;
 
 private:
+    static std::vector<WireEntry> read_wire_log(sd_bus_message* reply, uint64_t* next);
+
     std::string dir_;
     std::string socket_;
     dbus::BusPtr bus_;

@@ -111,6 +111,50 @@ TEST_CASE("realistic timing really waits the wire time") {
         CHECK(log[i].time_ns - log[i - 1].time_ns >= 380000);
 }
 
+TEST_CASE("the wire log is read in pages, and a large log cannot take the simulator off the bus") {
+    SimFixture f;
+    SimDeviceIo io;
+    REQUIRE(io.connect(f.socket()) == 0);
+    I2cDev bus(io, "/dev/i2c-1");
+    REQUIRE(bus.open() == 0);
+    for (int i = 0; i < 10; ++i)
+        REQUIRE(bus.write(0x29, kOrder) == IoError::None);
+    const uint64_t first = f.wire_log().front().index;
+    uint64_t next = 0;
+    auto page = f.wire_log_page(first, 4, &next);
+    REQUIRE(page.size() == 4);
+    CHECK(next == page.back().index + 1);
+    page = f.wire_log_page(next, 100, &next);
+    CHECK(page.size() == 6);
+    CHECK(page.front().index == first + 4);
+    CHECK(f.wire_log_page(next, 100, &next).empty()); // the end: nothing new, next stays
+    CHECK(next == page.back().index + 1);
+    CHECK(f.call("/org/caracara/Simulator1", "org.caracara.Simulator1", "GetWireLogPage", "tu", uint64_t{0}, 0u) ==
+          "org.caracara.Simulator1.Error.InvalidArgument");
+
+    // 2200 messages of 8000 bytes: about 17.6 MB of log, more than one reply may carry
+    // (16 MiB, half of dbus-daemon's 32 MiB message limit, whose excess ends the sender's
+    // connection). GetWireLog answers with a page and where to go on; the pages hold them all.
+    const std::vector<uint8_t> big(8000, 0x55);
+    const uint64_t start = next;
+    for (int i = 0; i < 2200; ++i)
+        REQUIRE(bus.write(0x29, big) == IoError::None);
+    size_t total = 0, pages = 0;
+    for (uint64_t at = start;; ++pages) {
+        uint64_t nx = 0;
+        const auto got = f.wire_log_page(at, UINT32_MAX, &nx);
+        if (got.empty())
+            break;
+        CHECK(got.front().index == at);
+        for (const auto& e : got)
+            total += e.data.size() == big.size();
+        at = nx;
+    }
+    CHECK(total == 2200);
+    CHECK(pages == 2);
+    CHECK(f.wire_log(start).size() < 2200); // one page
+}
+
 namespace {
 int raw_connect(const std::string& path) {
     int s = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);

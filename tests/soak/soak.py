@@ -19,6 +19,7 @@ The books:
   * the daemon's pid unchanged, its fds and RSS flat (start vs end).
 """
 import argparse
+import bisect
 import json
 import os
 import random
@@ -29,7 +30,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 import dbus  # noqa: E402
 
 import harness  # noqa: E402
-from harness import MOTORS, SIM, SIM_GPIO, Rig, command, poll, speed_byte  # noqa: E402
+from harness import MOTORS, SIM, SIM_GPIO, SIM_ROOT, Rig, command, poll, speed_byte  # noqa: E402
 
 KILL_OUT = 27
 TIMEOUT_MS = 300
@@ -44,6 +45,11 @@ GPIO = dict(SIM_GPIO, scl={"chip": "gpiochip0", "line": "GPIO3"}, sda={"chip": "
 FD_GROWTH_MAX = 0
 RSS_GROWTH_KIB_MAX = 2048
 RECOVERY = {"enabled": True, "driver_id": "fe804000.i2c", "attempts": 3, "backoff_ms": 50}
+# The wire log is read in pages of this many entries (GetWireLogPage), one page per turn of the
+# main loop, so that the 50 Hz command stream never waits long behind a read: at loop rate 0
+# the bus carries tens of thousands of messages a second, and one unbounded read of them all
+# took seconds, grew with each turn and at last exceeded the bus's message limit.
+PAGE = 2000
 VEHICLE = "org.caracara.Vehicle1"
 PATH = "/org/caracara/Vehicle1"
 
@@ -91,33 +97,78 @@ class Soak:
         self.pauses = []     # (t_pause, t_resume)
         self.wire = []       # (time_ns, index, kind, addr, data0, result) of orders and kill output edges
         self.since = 0
+        self.caught_up = True  # the last page read reached the log's end
+        self.read_to_ns = 0    # the wire time of the last entry read
+        self.entries_read = 0
+        self.max_lag = 0.0     # the longest the reader fell behind the wire (s)
         self.faults = {}
         self.sim_restarts = 0
         self.wire_gaps = 0
         self.calls = 0
         self.refused = 0
+        self.refused_by = {}   # error name (last part) -> refused SetThrust calls
         self.churn = 0
+        self.kill_level = None
+        self.killed = False    # between an asserting and a releasing kill output edge
+        self.zeroed = set()
+        self.first_after_kill = False
 
     # --- the vehicle's side -------------------------------------------------------------------
-    def drain_wire(self):
-        nxt, entries = self.rig.sim_call("GetWireLog", dbus.UInt64(self.since), signature="t")
+    def read_page(self):
+        """Reads the next page of the wire log into the books; True once it reached the log's end."""
+        nxt, entries = self.rig.conn.call_blocking(SIM, SIM_ROOT, SIM, "GetWireLogPage", "tu",
+                                                   (dbus.UInt64(self.since), dbus.UInt32(PAGE)), byte_arrays=True)
         if entries and self.since and int(entries[0][0]) > self.since:
             # The ring dropped entries before this drain read them: what happened then is unknown,
             # so no command of that stretch is judged (counted, and excused).
             self.wire_gaps += 1
-            last = self.wire[-1][0] / 1e9 if self.wire else 0
-            self.excused.append((last, int(entries[0][1]) / 1e9, None))
-        for e in entries:
-            idx, t, _txn, bus, addr, read, data, _miso, result = e
-            if bus == "i2c" and not read and len(data) == 3:
-                self.wire.append((int(t), int(idx), "order", int(addr), int(data[0]), str(result)))
-            elif bus == "i2c":
-                # Status reads and the rest: only to know which transfer was on the wire at a kill.
-                self.wire.append((int(t), int(idx), "i2c", int(addr), -1, str(result)))
-            elif bus == "gpio" and int(addr) == KILL_OUT and len(data) == 1:
-                self.wire.append((int(t), int(idx), "kill", 0, int(data[0]), "edge"))
-        if int(nxt) > self.since:
-            self.since = int(nxt)
+            self.excused.append((self.read_to_ns / 1e9, int(entries[0][1]) / 1e9, None))
+        for idx, t, _txn, bus, addr, read, data, _miso, result in entries:
+            if bus == "i2c":
+                self.judge_killed(int(t), int(idx), int(addr), int(data[0]) if not read and len(data) == 3 else -1)
+            elif bus == "gpio" and addr == KILL_OUT and len(data) == 1:
+                self.wire.append((int(t), int(idx), "kill", 0, data[0], "edge"))
+                self.killed = data[0] == self.kill_level
+                self.zeroed, self.first_after_kill = set(), self.killed
+        self.caught_up = len(entries) < PAGE
+        if entries:
+            self.read_to_ns = max(self.read_to_ns, int(entries[-1][1]))
+            if not self.caught_up:  # a full page: the reader is behind by at least this
+                self.max_lag = max(self.max_lag, time.monotonic() - self.read_to_ns / 1e9)
+        self.entries_read += len(entries)
+        self.since = max(self.since, int(nxt))
+        return self.caught_up
+
+    def drain_wire(self):
+        """Reads the log up to its end as it is now (the wire goes on meanwhile)."""
+        end = int(self.rig.conn.call_blocking(SIM, SIM_ROOT, SIM, "GetWireLogPage", "tu",
+                                              (dbus.UInt64(2 ** 63), dbus.UInt32(1)))[0])
+        while self.since < end and not self.read_page():
+            pass
+
+    def judge_killed(self, t, idx, addr, speed):
+        """One I2C message, in the order of the log. Between a kill output's asserting edge and
+        its release: the simulator logs a transfer when it ends and serves the kill output's GPIO
+        write while an I2C transfer is on the wire (as the kernel does), so the first I2C transfer
+        logged after the kill edge is the one that was on the wire then, which nothing can take
+        back (the zeros follow it). Any later non-zero order before that thruster's zero reached
+        the wire after the kill: in_flight_at_kill, a failure."""
+        if speed >= 0:
+            self.wire.append((t, idx, "order", addr, speed, "ack"))
+        if not self.killed:
+            return
+        on_the_wire_at_kill, self.first_after_kill = self.first_after_kill, False
+        if speed < 0:
+            return
+        b = self.books
+        if speed == 0x80:
+            self.zeroed.add(addr)
+        elif addr in self.zeroed:
+            b["killed_orders"] += 1
+        elif on_the_wire_at_kill:
+            b["on_wire_at_kill"] += 1
+        else:
+            b["in_flight_at_kill"] += 1
 
     # --- faults -------------------------------------------------------------------------------
     def inject(self, now):
@@ -168,6 +219,7 @@ class Soak:
             self.drain_wire()
             self.check_books()
             self.wire, self.commands, self.excused, self.pauses, self.since = [], [], [], [], 0
+            self.read_to_ns, self.killed = 0, False
             sim = self.rig.procs.pop("caracara-sim")
             sim.kill()
             sim.wait(10)
@@ -178,66 +230,44 @@ class Soak:
 
     # --- the books ----------------------------------------------------------------------------
     def check_books(self, cutoff=None):
+        """Judges the commands sent and the pauses ended before `cutoff` (all of them when None),
+        and forgets them. (Orders after a kill are judged as they are read: judge_killed.)"""
         b = self.books
-        orders = [w for w in self.wire if w[2] == "order"]
-        addr_of = self.addrs
-        # Killed: between an asserting and a releasing kill output edge.
-        # The simulator logs a transfer when it ends and serves the kill output's GPIO write while
-        # an I2C transfer is on the wire (as the kernel does): the first I2C transfer logged after
-        # the kill edge is the one that was on the wire then, which nothing can take back (the
-        # zeros follow it). Any later non-zero order before that thruster's zero reached the wire
-        # after the kill: in_flight_at_kill, a failure.
-        killed_from = None
-        zeroed = set()
-        first_after_kill = False
-        for t, idx, kind, addr, d0, res in self.wire:
-            if kind == "kill":
-                if d0 == self.kill_level:
-                    killed_from, zeroed, first_after_kill = idx, set(), True
-                else:
-                    killed_from = None
-                continue
-            if killed_from is None:
-                continue
-            on_the_wire_at_kill, first_after_kill = first_after_kill, False
-            if kind != "order":
-                continue
-            if d0 == 0x80:
-                zeroed.add(addr)
-            elif addr in zeroed:
-                b["killed_orders"] += 1
-            elif on_the_wire_at_kill:
-                b["on_wire_at_kill"] += 1
-            else:
-                b["in_flight_at_kill"] += 1
+        by_addr = {}
+        for w in sorted(w for w in self.wire if w[2] == "order"):
+            times, speeds = by_addr.setdefault(w[3], ([], []))
+            times.append(w[0])
+            speeds.append(w[4])
+        self.by_addr = by_addr
         # Timed out: the stream paused.
         for t0, t1 in self.pauses:
             if cutoff is not None and t1 >= cutoff:
                 continue
             lo, hi = int((t0 + TIMEOUT_MS / 1000 + GRACE) * 1e9), int(t1 * 1e9)
-            b["timed_out_orders"] += sum(1 for w in orders if lo < w[0] < hi and w[4] != 0x80)
+            for times, speeds in by_addr.values():
+                b["timed_out_orders"] += sum(1 for sp in speeds[bisect.bisect_right(times, lo):bisect.bisect_left(times, hi)]
+                                             if sp != 0x80)
+        self.pauses = [p for p in self.pauses if cutoff is not None and p[1] >= cutoff]
         # Lost: each accepted command's eight orders reach the wire before the next (+ grace).
         kills = [w[0] for w in self.wire if w[2] == "kill"]
-        by_addr = {}
-        for w in orders:
-            by_addr.setdefault(w[3], []).append(w[0])
+        judged = 0
         for k, (t, speeds) in enumerate(self.commands):
             if cutoff is not None and t >= cutoff:
                 break
+            judged = k + 1
             end = self.commands[k + 1][0] if k + 1 < len(self.commands) else t + 0.2
             lo, hi = int(t * 1e9), int((end + GRACE) * 1e9)
             if any(lo <= kt <= hi for kt in kills):
                 b["superseded_by_kill"] += 1
                 continue
-            missing = [i for i in range(MOTORS) if not self.reached(i, speeds[i], lo, hi, orders)]
+            missing = [i for i in range(MOTORS) if not self.reached(i, speeds[i], lo, hi)]
             if not missing:
                 b["reached"] += 1
                 continue
             # Superseded: the thruster got a newer command's value instead (the stream moved on
             # before this one's turn on the bus came).
             later = self.commands[k + 1:k + 6]
-            if all(any(lo < wt <= hi and any(sp == c[1][i] for c in later) for wt, sp in self.orders_of(i, orders))
-                   for i in missing):
+            if all(any(sp in {c[1][i] for c in later} for sp in self.window(i, lo, hi, lo_open=True)) for i in missing):
                 b["superseded"] += 1
                 continue
             if all(any(a - 0.05 <= t <= c + 0.05 and (th is None or th == i) for a, c, th in self.excused)
@@ -249,29 +279,28 @@ class Soak:
                     print("soak: LOST command at %.3f..%.3f (thrusters %s, wanted %s)" %
                           (t, end, missing, [hex(speeds[i]) for i in missing]), flush=True)
                     for i in missing:
-                        near = [(round(wt / 1e9 - t, 4), hex(sp)) for wt, sp in self.orders_of(i, orders)
+                        times, sps = by_addr.get(self.addrs[i], ([], []))
+                        near = [(round(wt / 1e9 - t, 4), hex(sp)) for wt, sp in zip(times, sps)
                                 if t - 0.1 <= wt / 1e9 <= end + 0.3]
                         print("soak:   thruster %d orders around it (s from the call, speed): %s" % (i, near))
                     print("soak:   faults around it: %s" % [(round(a0 - t, 3), round(c - t, 3), th)
                                                            for a0, c, th in self.excused if a0 - 1 < t < c + 1])
+        del self.commands[:judged]
 
-    def reached(self, i, want, lo, hi, orders):
+    def window(self, i, lo, hi, lo_open=False):
+        """The speeds ordered to thruster i in [lo, hi] ((lo, hi] with lo_open)."""
+        times, speeds = self.by_addr.get(self.addrs[i], ([], []))
+        start = (bisect.bisect_right if lo_open else bisect.bisect_left)(times, lo)
+        return speeds[start:bisect.bisect_right(times, hi)]
+
+    def reached(self, i, want, lo, hi):
         """The thruster stood at `want` at some moment of [lo, hi]: an order of it in the window,
         or the order standing when the window opened (an unchanged value is not sent again at once)."""
-        standing = None
-        for wt, sp in self.orders_of(i, orders):
-            if wt < lo:
-                standing = sp
-            elif wt <= hi:
-                if sp == want:
-                    return True
-            else:
-                break
-        return standing == want
-
-    def orders_of(self, i, orders):
-        a = self.addrs[i]
-        return [(w[0], w[4]) for w in orders if w[3] == a]
+        if want in self.window(i, lo, hi):
+            return True
+        times, speeds = self.by_addr.get(self.addrs[i], ([], []))
+        before = bisect.bisect_left(times, lo)
+        return before > 0 and speeds[before - 1] == want
 
     # --- the run ------------------------------------------------------------------------------
     def run(self):
@@ -291,10 +320,10 @@ class Soak:
         self.kill_level = next(w[4] for w in reversed(self.wire) if w[2] == "kill")
         rig.vcall("ClearKill")
         rig.wait_state("ready")
-        self.wire = []
+        self.wire, self.entries_read, self.max_lag = [], 0, 0.0
         client = dbus.bus.BusConnection(rig.address)
         t_start = time.monotonic()
-        next_cmd = next_fault = next_drain = next_churn = t_start
+        next_cmd = next_fault = next_drain = next_churn = next_check = t_start
         paused_until = 0
         tx0 = int(rig.vget("Transactions", path=PATH + "/bus", iface=VEHICLE + ".Bus"))
         last_report = t_start
@@ -306,16 +335,17 @@ class Soak:
                 next_tx = now + 1
             if now - t_start >= a.seconds or (a.transactions and tx >= a.transactions):
                 break
-            if now >= next_drain:
-                self.drain_wire()
+            if now >= next_drain or not self.caught_up:
+                # A page a turn until the reader has caught up with the wire, then every 0.2 s.
+                self.read_page()
                 next_drain = now + 0.2
-                if len(self.wire) > 200000:
-                    # Close the books up to a second ago; keep the rest for the next check.
-                    cutoff = now - 1.0
-                    self.check_books(cutoff)
-                    self.commands = [c for c in self.commands if c[0] >= cutoff]
-                    self.wire = [w for w in self.wire if w[0] >= int((cutoff - 2) * 1e9)]
-                    self.pauses = [p for p in self.pauses if p[1] >= cutoff - 2]
+            if now >= next_check:
+                # Close the books up to a second before the last entry read; keep the orders of a
+                # second before that (the order standing when a later command's window opens).
+                cutoff = min(now, self.read_to_ns / 1e9) - 1.0
+                self.check_books(cutoff)
+                self.wire = [w for w in self.wire if w[0] >= int((cutoff - 1) * 1e9)]
+                next_check = now + 1
             if now >= next_fault:
                 self.inject(now)
                 next_fault = time.monotonic() + rng.uniform(0.3, 1.5)
@@ -336,6 +366,8 @@ class Soak:
                 except dbus.DBusException as e:
                     self.refused += 1
                     name = e.get_dbus_name() or ""
+                    why = name.rsplit(".", 1)[-1]
+                    self.refused_by[why] = self.refused_by.get(why, 0) + 1
                     if name.endswith(".Killed"):
                         try:
                             client.call_blocking(VEHICLE, PATH, VEHICLE, "ClearKill", "", ())
@@ -346,7 +378,9 @@ class Soak:
                 if next_cmd < now:
                     next_cmd = now + PERIOD  # after a stall the stream goes on at its rate, no burst
             if now - last_report > 30:
-                print("soak: %.0f s, %d transactions, %d calls" % (now - t_start, tx, self.calls), flush=True)
+                print("soak: %.0f s, %d transactions, %d calls, %d wire log entries read, %.1f s behind" %
+                      (now - t_start, tx, self.calls, self.entries_read,
+                       now - self.read_to_ns / 1e9 if self.read_to_ns else 0), flush=True)
                 last_report = now
             time.sleep(0.002)
         time.sleep(0.3)
@@ -363,13 +397,15 @@ class Soak:
         print("soak: %.0f s, %d bus transactions, %d SetThrust calls (%d refused), %d client changes, "
               "%d simulator restarts, %d recoveries" % (elapsed, tx, self.calls, self.refused, self.churn,
                                                          self.sim_restarts, recov))
+        print("soak: SetThrust refused with: " + ", ".join("%s %d" % kv for kv in sorted(self.refused_by.items())))
         print("soak: faults injected: " + ", ".join("%s %d" % kv for kv in sorted(self.faults.items())))
         print("soak: commands reached the wire %d, superseded by a newer one %d, by a kill %d, excused by a "
               "fault %d, LOST %d" % (b["reached"], b["superseded"], b["superseded_by_kill"], b["excused"], b["lost"]))
         print("soak: non-zero orders after a kill's zero %d, reaching the wire after the kill %d (on the wire "
               "at the kill, not judged: %d), after a timeout %d" %
               (b["killed_orders"], b["in_flight_at_kill"], b["on_wire_at_kill"], b["timed_out_orders"]))
-        print("soak: wire log stretches dropped before they were read: %d" % self.wire_gaps)
+        print("soak: wire log entries read %d (the reader at most %.1f s behind the wire); stretches dropped "
+              "before they were read: %d" % (self.entries_read, self.max_lag, self.wire_gaps))
         # Under an emulator (the arm64 tests under qemu-user) the RSS is qemu's, whose translation
         # cache grows with every code path first run: shown, judged only natively.
         emulated = bool(harness.EMULATOR)
@@ -387,8 +423,10 @@ class Soak:
         for f in failures:
             print("soak: FAIL: %s" % f)
         self.results = dict(seconds=round(elapsed, 1), transactions=tx, setthrust_calls=self.calls,
-                            refused=self.refused, client_changes=self.churn, simulator_restarts=self.sim_restarts,
+                            refused=self.refused, refused_by=dict(self.refused_by), client_changes=self.churn,
+                            simulator_restarts=self.sim_restarts,
                             recoveries=recov, faults=dict(self.faults), books=dict(b), wire_gaps=self.wire_gaps,
+                            wire_entries_read=self.entries_read, reader_lag_max_s=round(self.max_lag, 2),
                             fds=[fd0, fd1], rss_kib=[rss0, rss1], rss_judged=not emulated, seed=a.seed,
                             loop_rate_hz=a.loop_rate, failures=failures, passed=not failures)
         rig.stop_checked()
@@ -416,8 +454,10 @@ def main():
         soak.rig.stop()
         raise
     if args.results:
+        top = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))) + os.sep
         with open(args.results, "w") as f:
-            json.dump(dict(soak.results, command="tests/soak/soak.py " + " ".join(sys.argv[1:]),
+            json.dump(dict(soak.results, command="tests/soak/soak.py " + " ".join(a.replace(top, "") for a in sys.argv[1:]),
+                           cpus=os.cpu_count(),
                            finished=time.strftime("%Y-%m-%dT%H:%M:%S%z")), f, indent=1, sort_keys=True)
             f.write("\n")
         print("soak: counts written to %s" % args.results)
