@@ -37,7 +37,7 @@ build_timeout_s=${CARACARA_DEBIAN13_BUILD_TIMEOUT:-1500}
 # tools, and what the kernel test's guest runs in this root: insmod, i2c-tools.
 packages=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev libcatch2-dev
           libtomlplusplus-dev libboost-dev nlohmann-json3-dev dbus python3 python3-dbus python3-gi python3-matplotlib
-          systemd dpkg-dev debhelper lintian kmod i2c-tools openssh-client)
+          systemd dpkg-dev debhelper lintian kmod i2c-tools openssh-client ccache)
 # Bump when the way the cached root is made changes.
 recipe=2
 
@@ -170,12 +170,16 @@ chmod 0755 "$root/usr/local/bin/caracara-build-and-test"
 
 debs=$build-debs
 mkdir -p "$debs"
+# The root's own ccache (GCC 14, not the host's compiler), kept between runs: CI builds mostly
+# the same sources each time, from a clone at a new path (scripts/ccache.sh sets the base dir).
+ccache_dir=$cache_dir/ccache-$suite-$arch
+mkdir -p "$ccache_dir"
 say "building, testing and packaging $src in the Debian 13 root (at most ${build_timeout_s} s)"
 t1=$(date +%s)
 rc=0
 timeout --kill-after=20 "$build_timeout_s" \
   systemd-nspawn --quiet --keep-unit --register=no --directory="$root" --private-network \
-    --bind-ro="$src" --bind="$build" --bind="$debs" --setenv=HOME=/root --setenv=CI="${CI:-}" --setenv=SRC="$src" \
+    --bind-ro="$src" --bind="$build" --bind="$debs" --bind="$ccache_dir:/var/cache/ccache" --setenv=HOME=/root --setenv=CI="${CI:-}" --setenv=SRC="$src" \
     --setenv=BUILD="$build" --setenv=DEBS="$debs" \
     /usr/local/bin/caracara-build-and-test >"$work/build.log" 2>&1 || rc=$?
 grep -E '^== |^   |^package: |tests passed|tests failed|Total Test time|\*\*\*|Failed|error:|warning:' "$work/build.log" | head -n 60
@@ -224,8 +228,8 @@ if [ "$kernel_rc" = skipped ] && [ "${CARACARA_DEBIAN13_KERNEL:-1}" != 0 ]; then
   mkdir -p "$kcov"
   timeout --kill-after=20 "$build_timeout_s" \
     systemd-nspawn --quiet --keep-unit --register=no --directory="$root" --private-network \
-      --bind-ro="$src" --bind="$kwork" --setenv=HOME=/root \
-      sh -c "cmake -S '$src' -B '$kcov' -DCMAKE_BUILD_TYPE=Debug -DCARACARA_WERROR=ON -DCMAKE_CXX_FLAGS=--coverage >/dev/null &&
+      --bind-ro="$src" --bind="$kwork" --bind="$ccache_dir:/var/cache/ccache" --setenv=HOME=/root \
+      sh -c ". '$src/scripts/ccache.sh' '$src' && cmake -S '$src' -B '$kcov' -DCMAKE_BUILD_TYPE=Debug -DCARACARA_WERROR=ON -DCMAKE_CXX_FLAGS=--coverage >/dev/null &&
              cmake --build '$kcov' -j2 --target caracarad caracara-sim >/dev/null" >"$work/kcov.log" 2>&1 || kernel_rc=$?
   if [ "$kernel_rc" -ne 0 ]; then
     tail -n 40 "$work/kcov.log"
