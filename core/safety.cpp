@@ -2,61 +2,10 @@
 
 namespace caracara {
 
-std::string_view state_name(SafetyState s) {
-    switch (s) {
-    case SafetyState::Arming: return "arming";
-    case SafetyState::Ready: return "ready";
-    case SafetyState::Killed: return "killed";
-    case SafetyState::PoweredOff: return "powered-off";
-    }
-    return "?";
-}
-
-std::string_view kill_source_name(KillSource s) {
-    switch (s) {
-    case KillSource::None: return "none";
-    case KillSource::DBus: return "dbus";
-    case KillSource::Switch: return "switch";
-    case KillSource::Packet: return "packet";
-    case KillSource::Fault: return "bus"; // the escalated fault is the I2C bus that could not be recovered
-    case KillSource::Start: return "start";
-    case KillSource::Device: return "device";
-    case KillSource::Failsafe: return "failsafe";
-    }
-    return "?";
-}
-
-std::string_view error_name(SafetyError e) {
-    switch (e) {
-    case SafetyError::None: return "None";
-    case SafetyError::NotKilled: return "NotKilled";
-    case SafetyError::KillSwitchSet: return "KillSwitchSet";
-    case SafetyError::PoweredOff: return "PoweredOff";
-    case SafetyError::NotReady: return "NotReady";
-    }
-    return "?";
-}
-
 namespace {
 // A monotonic clock never goes back, but a caller's stale timestamp must not wrap around
 // into a huge elapsed time (which would end arming or expire the watchdog early).
 uint64_t elapsed(uint64_t since, uint64_t now) { return now > since ? now - since : 0; }
-
-SafetyAction refuse(SafetyError e, std::string message) {
-    SafetyAction a;
-    a.error = e;
-    a.message = std::move(message);
-    return a;
-}
-
-SafetyAction zeroing(std::string message, bool state_changed) {
-    SafetyAction a;
-    a.message = std::move(message);
-    a.state_changed = state_changed;
-    a.zero_outputs = true;
-    a.clear_commands = true;
-    return a;
-}
 } // namespace
 
 SafetyMachine::SafetyMachine(SafetyConfig config, bool kill_switch_set, uint64_t now)
@@ -85,29 +34,29 @@ SafetyAction SafetyMachine::kill(KillSource source, uint64_t now, std::string_vi
     if (source == KillSource::None)
         source = KillSource::Fault;  // a kill without a named source is still a kill
     if (state_ == SafetyState::PoweredOff)
-        return zeroing("powered off", false);
+        return SafetyAction::zeroing("powered off", false);
     if (state_ == SafetyState::Killed && kill_source_ != KillSource::Start)
-        return zeroing("already killed (" + std::string(kill_source_name(kill_source_)) + ")", false);
+        return SafetyAction::zeroing("already killed (" + std::string(kill_source_name(kill_source_)) + ")", false);
     // A start kill is the weakest source: any real kill names itself in its place (a switch
     // set at start reads "switch", and ClearKill then asks for it to be released).
     enter_killed(source, now, reason);
-    return zeroing("killed (" + std::string(kill_source_name(source)) + "): " + kill_reason_, true);
+    return SafetyAction::zeroing("killed (" + std::string(kill_source_name(source)) + "): " + kill_reason_, true);
 }
 
 SafetyAction SafetyMachine::clear_kill(uint64_t now) {
     if (state_ == SafetyState::PoweredOff)
-        return refuse(SafetyError::PoweredOff, "powered off: a kill cannot be cleared");
+        return SafetyAction::refused(SafetyError::PoweredOff, "powered off: a kill cannot be cleared");
     if (state_ != SafetyState::Killed)
-        return refuse(SafetyError::NotKilled, "not killed (" + std::string(state_name(state_)) + ")");
+        return SafetyAction::refused(SafetyError::NotKilled, "not killed (" + std::string(state_name(state_)) + ")");
     if (switch_set_)
-        return refuse(SafetyError::KillSwitchSet, "the kill switch is set: release it first");
+        return SafetyAction::refused(SafetyError::KillSwitchSet, "the kill switch is set: release it first");
     state_ = SafetyState::Arming;
     kill_source_ = KillSource::None;
     kill_reason_.clear();
     arming_started_ = now;
     drop_commands();
     pilots_.clear(); // armed again: pilots are those who command from now on
-    return zeroing("kill cleared, arming", true);
+    return SafetyAction::zeroing("kill cleared, arming", true);
 }
 
 SafetyAction SafetyMachine::switch_changed(bool set, uint64_t now) {
@@ -121,12 +70,12 @@ SafetyAction SafetyMachine::switch_changed(bool set, uint64_t now) {
 
 SafetyAction SafetyMachine::power_off(uint64_t now) {
     if (state_ == SafetyState::PoweredOff)
-        return refuse(SafetyError::PoweredOff, "already powered off");
+        return SafetyAction::refused(SafetyError::PoweredOff, "already powered off");
     (void)now;
     state_ = SafetyState::PoweredOff;
     drop_commands();
     pilots_.clear();
-    return zeroing("powering off", true);
+    return SafetyAction::zeroing("powering off", true);
 }
 
 SafetyAction SafetyMachine::tick(uint64_t now) {
@@ -140,9 +89,9 @@ SafetyAction SafetyMachine::tick(uint64_t now) {
     }
     if (state_ == SafetyState::Ready && command_active_ &&
         elapsed(last_command_, now) >= config_.command_timeout_ns) {
-        a = zeroing("no command for " + std::to_string(elapsed(last_command_, now) / 1'000'000) +
-                        " ms (timeout " + std::to_string(config_.command_timeout_ns / 1'000'000) + " ms)",
-                    false);
+        a = SafetyAction::zeroing("no command for " + std::to_string(elapsed(last_command_, now) / 1'000'000) +
+                                      " ms (timeout " + std::to_string(config_.command_timeout_ns / 1'000'000) + " ms)",
+                                  false);
         a.command_stale = true;
         drop_commands();
     }
@@ -152,13 +101,14 @@ SafetyAction SafetyMachine::tick(uint64_t now) {
 SafetyAction SafetyMachine::accept_command(uint64_t now, std::string_view client) {
     switch (state_) {
     case SafetyState::PoweredOff:
-        return refuse(SafetyError::PoweredOff, "powered off");
+        return SafetyAction::refused(SafetyError::PoweredOff, "powered off");
     case SafetyState::Killed:
-        return refuse(SafetyError::NotReady, "killed (" + std::string(kill_source_name(kill_source_)) +
-                                                 "): clear the kill first");
+        return SafetyAction::refused(SafetyError::NotReady, "killed (" +
+                                                                std::string(kill_source_name(kill_source_)) +
+                                                                "): clear the kill first");
     case SafetyState::Arming:
-        return refuse(SafetyError::NotReady,
-                      "arming: ready in " + std::to_string(arming_remaining_ns(now) / 1'000'000) + " ms");
+        return SafetyAction::refused(SafetyError::NotReady,
+                                     "arming: ready in " + std::to_string(arming_remaining_ns(now) / 1'000'000) + " ms");
     case SafetyState::Ready:
         break;
     }
@@ -175,7 +125,7 @@ SafetyAction SafetyMachine::client_left(std::string_view client, uint64_t now) {
     if (!command_active_ || client != client_)
         return {};
     drop_commands();
-    return zeroing("commanding client " + std::string(client) + " left", false);
+    return SafetyAction::zeroing("commanding client " + std::string(client) + " left", false);
 }
 
 uint64_t SafetyMachine::arming_remaining_ns(uint64_t now) const {

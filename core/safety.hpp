@@ -17,6 +17,9 @@
 #pragma once
 
 #include "core/pilot_roster.hpp"
+#include "core/safety_action.hpp"
+#include "core/safety_config.hpp"
+#include "core/safety_state.hpp"
 
 #include <cstdint>
 #include <limits>
@@ -24,53 +27,6 @@
 #include <string_view>
 
 namespace caracara {
-
-constexpr uint64_t ms_to_ns(uint64_t ms) { return ms * 1'000'000; }
-
-enum class SafetyState { Arming, Ready, Killed, PoweredOff };
-std::string_view state_name(SafetyState s);  // "arming", "ready", "killed", "powered-off"
-
-enum class KillSource {
-    None,    // not killed
-    DBus,    // the Kill method
-    Switch,  // the kill switch GPIO
-    Packet,  // a legacy packet with killState != 0
-    Fault,   // an escalated fault, e.g. the I2C bus could not be recovered
-    Start,   // every start of the daemon, until someone decides to arm it (ClearKill)
-    Device,  // a line or device the daemon drives went away (kill/power-off output, the Teensy's SPI)
-    Failsafe, // a failsafe's kill, or the end of its ascent (core/failsafe_policy)
-};
-// "none", "dbus", "switch", "packet", "bus", "start", "device", "failsafe"
-std::string_view kill_source_name(KillSource s);
-
-enum class SafetyError {
-    None,
-    NotKilled,      // clear_kill while not killed
-    KillSwitchSet,  // clear_kill while the kill switch is still set
-    PoweredOff,     // anything that needs power after power-off
-    NotReady,       // a thrust command while arming or killed
-};
-std::string_view error_name(SafetyError e);  // "NotKilled", "KillSwitchSet", ... (for logs and tests)
-
-struct SafetyConfig {
-    uint64_t arming_delay_ns = ms_to_ns(3000);     // as the board firmware did
-    uint64_t command_timeout_ns = ms_to_ns(500);
-    // Come up killed (source Start): a restart after a crash, an upgrade or a reboot must not
-    // drive again by itself. The daemon sets it unless control.arm_at_start is true.
-    bool start_killed = false;
-};
-
-// What the owner must do after an event. The flags are idempotent: acting on them twice
-// is harmless, missing one is not.
-struct SafetyAction {
-    SafetyError error = SafetyError::None;
-    std::string message;          // the reason, for logs and the caller
-    bool state_changed = false;
-    bool zero_outputs = false;    // order zero to every thruster now, not at the next tick
-    bool clear_commands = false;  // drop stored commands so nothing resumes by itself
-    bool command_stale = false;   // the watchdog expired on this call (not a kill)
-    bool ok() const { return error == SafetyError::None; }
-};
 
 class SafetyMachine {
 public:

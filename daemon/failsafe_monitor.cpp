@@ -8,19 +8,11 @@
 
 namespace caracara {
 
-namespace {
-std::string describe(const ActiveFailsafe& f) {
-    std::string s = std::string(condition_name(f.condition)) + " " + std::string(action_name(f.effective()));
-    if (f.thruster >= 0)
-        s += " thruster " + std::to_string(f.thruster);
-    return s;
-}
-} // namespace
-
 FailsafeMonitor::FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters,
                                  Readings readings, Conditions conditions, Vehicle& vehicle, VehicleEvents& events)
-    : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)),
+    : event_(event), thrusters_(thrusters), readings_(std::move(readings)),
       conditions_(std::move(conditions)), vehicle_(vehicle), events_(events), policy_(settings, thrusters),
+      report_(settings, events), ascent_(settings.surface, vehicle, events),
       period_us_(std::max<uint64_t>(1000, std::min(kPeriodNs, vehicle.safety().config().command_timeout_ns / 2)) /
                  1000) {
     vehicle_.set_failsafe_gate(this);
@@ -51,9 +43,9 @@ void FailsafeMonitor::poll(uint64_t now) {
         }
     FailsafeTransitions own = look_at_conditions(now);
     ts.insert(ts.end(), own.begin(), own.end());
-    tell(ts);
+    report_.tell(ts);
     carry_out(ts, now);
-    keep_surfacing(now);
+    ascent_.keep(now);
 }
 
 FailsafeTransitions FailsafeMonitor::look_at_conditions(uint64_t now) {
@@ -72,25 +64,8 @@ FailsafeTransitions FailsafeMonitor::look_at_conditions(uint64_t now) {
 void FailsafeMonitor::conditions_changed() {
     const uint64_t now = monotonic_ns();
     const FailsafeTransitions ts = look_at_conditions(now);
-    tell(ts);
+    report_.tell(ts);
     carry_out(ts, now);
-}
-
-void FailsafeMonitor::tell(const FailsafeTransitions& ts) {
-    for (const FailsafeTransition& t : ts) {
-        if (const uint32_t ms = settings_.rule(t.failsafe.condition).persistence_ms; t.raised && ms > 0)
-            log_warning("FAILSAFE %s: the condition held for %u ms", describe(t.failsafe).c_str(), ms);
-        else if (t.raised)
-            log_warning("FAILSAFE %s", describe(t.failsafe).c_str());
-        else
-            log_notice("failsafe %s cleared: the condition is gone%s", describe(t.failsafe).c_str(),
-                       condition_clearing(t.failsafe.condition) == FailsafeClearing::PowerCycle
-                           ? " (the controller's power was cycled)"
-                           : "");
-        events_.failsafe(t.failsafe, t.raised);
-    }
-    if (!ts.empty())
-        events_.changed(kChangeFailsafes);
 }
 
 void FailsafeMonitor::carry_out(const FailsafeTransitions& ts, uint64_t now) {
@@ -106,38 +81,11 @@ void FailsafeMonitor::carry_out(const FailsafeTransitions& ts, uint64_t now) {
             continue;
         const FailsafeAction a = t.failsafe.effective();
         if (a == FailsafeAction::Kill) {
-            vehicle_.kill(KillSource::Failsafe, describe(t.failsafe));
-        } else if (a == FailsafeAction::Surface && surface_until_ == 0) {
-            // Nothing to drive while arming or killed: a surface then ends as it would, killed.
-            surface_reason_ = describe(t.failsafe);
-            if (!vehicle_.may_drive() || !vehicle_.surface(AxisDemand{0, 0, settings_.surface.heave, 0, 0, 0}).ok()) {
-                vehicle_.kill(KillSource::Failsafe, surface_reason_ + ": the vehicle could not drive the ascent");
-                continue;
-            }
-            surface_until_ = now + uint64_t(settings_.surface.duration_ms) * 1'000'000ull;
-            log_warning("SURFACING (%s): heave %g for %u ms, then kill", surface_reason_.c_str(),
-                        settings_.surface.heave, settings_.surface.duration_ms);
-            events_.changed(kChangeState);
+            vehicle_.kill(KillSource::Failsafe, FailsafeReport::describe(t.failsafe));
+        } else if (a == FailsafeAction::Surface && !ascent_.active()) {
+            ascent_.begin(FailsafeReport::describe(t.failsafe), now);
         }
     }
-}
-
-void FailsafeMonitor::keep_surfacing(uint64_t now) {
-    if (surface_until_ == 0)
-        return;
-    if (!vehicle_.surfacing()) { // a Kill, the kill switch or another fault ended it
-        log_notice("surfacing ended by a kill (%s)", std::string(vehicle_.kill_source_name()).c_str());
-        surface_until_ = 0;
-        events_.changed(kChangeState);
-        return;
-    }
-    if (now >= surface_until_) {
-        surface_until_ = 0;
-        vehicle_.kill(KillSource::Failsafe, surface_reason_ + ": ascent done");
-        return;
-    }
-    // Again, or the command timeout would stop the ascent.
-    vehicle_.surface(AxisDemand{0, 0, settings_.surface.heave, 0, 0, 0});
 }
 
 Result FailsafeMonitor::clear_kill_refusal() const {
@@ -154,7 +102,7 @@ Result FailsafeMonitor::clear_kill_refusal() const {
         return {};
     std::string m = "a failsafe holds: ";
     for (std::size_t i = 0; i < b.size(); ++i)
-        m += (i ? ", " : "") + describe(b[i]);
+        m += (i ? ", " : "") + FailsafeReport::describe(b[i]);
     const auto fixed =
         std::find_if(b.begin(), b.end(), [](const ActiveFailsafe& f) { return condition_is_fixed(f.condition); });
     if (fixed != b.end())
@@ -189,7 +137,7 @@ Result FailsafeMonitor::clear_kill_override(std::string_view condition, std::str
 std::string FailsafeMonitor::summary() const {
     std::string s;
     for (const ActiveFailsafe& f : policy_.active())
-        s += (s.empty() ? "" : ", ") + describe(f);
+        s += (s.empty() ? "" : ", ") + FailsafeReport::describe(f);
     return s;
 }
 

@@ -1,13 +1,16 @@
 // The failsafes at work: every thruster's last status reply and the vehicle's own conditions go
 // into the FailsafePolicy (core/failsafe_policy) on this object's own timer, and at once when
 // the Vehicle says one changed (the last pilot left, the Teensy link went: FailsafeGate);
-// what the policy raises is carried out by the Vehicle (exclude, surface, kill) and told
-// everywhere (VehicleEvents: D-Bus, the dive recorder, STATUS=; the journal here, one line
-// per transition).
+// what the policy raises is carried out by the Vehicle (exclude, kill; a surface by the
+// FailsafeAscent) and told everywhere by the FailsafeReport (VehicleEvents: D-Bus, the dive
+// recorder, STATUS=; the journal, one line per transition).
 #pragma once
 
 #include "core/failsafe_policy.hpp"
+#include "daemon/failsafe_ascent.hpp"
 #include "daemon/failsafe_gate.hpp"
+#include "daemon/failsafe_reading.hpp"
+#include "daemon/failsafe_report.hpp"
 #include "daemon/vehicle.hpp"
 #include "daemon/vehicle_events.hpp"
 #include "drivers/platform/event_loop.hpp"
@@ -19,12 +22,6 @@
 #include <string_view>
 
 namespace caracara {
-
-// A thruster's last good status reply, as the policy reads it.
-struct FailsafeReading {
-    uint8_t fault_bits = 0;                // SeaBotix IDS 8.4.2 FAULT bit order
-    std::optional<uint8_t> temperature_c;  // SeaBotix controllers only
-};
 
 class FailsafeMonitor final : public FailsafeGate {
 public:
@@ -63,24 +60,21 @@ private:
     static int on_timer(sd_event_source* s, uint64_t usec, void* userdata);
     // The vehicle's own conditions into the policy, and what has held for its persistence time.
     FailsafeTransitions look_at_conditions(uint64_t now);
-    void tell(const FailsafeTransitions& ts);
     void carry_out(const FailsafeTransitions& ts, uint64_t now);
-    void keep_surfacing(uint64_t now);
 
     sd_event* event_;
-    const FailsafeSettings& settings_;
     std::size_t thrusters_;
     Readings readings_;
     Conditions conditions_;
     Vehicle& vehicle_;
     VehicleEvents& events_;
     FailsafePolicy policy_;
+    FailsafeReport report_;
+    FailsafeAscent ascent_;
     SourcePtr timer_;
     uint64_t period_us_;
     std::array<bool, kMotorCount> excluded_{};
     std::optional<FailsafeCondition> overriding_; // set aside during ClearKillOverride's ClearKill
-    uint64_t surface_until_ = 0;                  // 0: not surfacing
-    std::string surface_reason_;
 };
 
 } // namespace caracara

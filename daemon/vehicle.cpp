@@ -2,7 +2,6 @@
 
 #include "core/clock.hpp"
 #include "core/status_of.hpp"
-
 #include "daemon/log.hpp"
 
 namespace caracara {
@@ -19,7 +18,8 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       safety_(safety_config(config), false, monotonic_ns()),
       deadline_([this] { tick(monotonic_ns()); }),
       motors_(config, safety_, *this, deadline_, actuator_, events),
-      condition_(safety_, bus, lines) {}
+      condition_(safety_, bus, lines),
+      pilots_(config.failsafe, safety_, motors_, condition_, deadline_, events, [this](const SafetyAction& a) { handle(a); }) {}
 
 void Vehicle::handle(const SafetyAction& a) {
     uint32_t changes = 0;
@@ -45,20 +45,6 @@ std::string Vehicle::start(sd_event* event) {
     return error;
 }
 
-Result Vehicle::accept_command(std::string_view client) {
-    if (motors_.surfacing())
-        return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
-    if (Result r = state_error(); !r.ok())
-        return r;
-    const std::string previous = safety_.commanding_client();
-    if (!safety_.accept_command(monotonic_ns(), client).ok())
-        return state_error();
-    arm_deadline();
-    if (previous != safety_.commanding_client())
-        events_.changed(kChangeController);
-    return {};
-}
-
 Result Vehicle::kill(KillSource source, std::string_view reason) {
     const bool was_killed = safety_.state() == SafetyState::Killed;
     handle(safety_.kill(source, monotonic_ns(), reason));
@@ -68,14 +54,6 @@ Result Vehicle::kill(KillSource source, std::string_view reason) {
     actuator_.stop_wheels();
     actuator_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
     return {};
-}
-
-void Vehicle::kill(KillSource source, std::string_view reason, Completion done) {
-    actuator_.after_zeros(std::move(done), kill(source, reason));
-}
-
-void Vehicle::power_off(std::string_view confirmation, Completion done) {
-    actuator_.after_zeros(std::move(done), power_off(confirmation));
 }
 
 Result Vehicle::clear_kill() {
@@ -108,26 +86,6 @@ Result Vehicle::power_off(std::string_view confirmation) {
     actuator_.stop_wheels();
     actuator_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
-}
-
-void Vehicle::client_left(std::string_view unique_name) {
-    if (unique_name.empty())
-        return;
-    const bool was_lost = safety_.pilot_lost();
-    if (unique_name == safety_.commanding_client()) {
-        log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
-        // Its zeros go behind what it had sent (ZeroOrder::Behind).
-        handle(safety_.client_left(unique_name, monotonic_ns())); // announces Controller with the motors
-    } else {
-        safety_.client_left(unique_name, monotonic_ns()); // a pilot who no longer commands: no zeros
-    }
-    if (safety_.pilot_lost() && !was_lost) {
-        log_warning("the last pilot (%s) left the bus: killed in %u ms (failsafe pilot-lost) unless a pilot commands",
-                    std::string(unique_name).c_str(),
-                    config_.failsafe.rule(FailsafeCondition::PilotLost).persistence_ms);
-        if (failsafes_)
-            failsafes_->conditions_changed();
-    }
 }
 
 void Vehicle::link_changed() {

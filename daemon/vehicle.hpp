@@ -3,7 +3,8 @@
 // PacketHandler, which asks the Vehicle for each of these. The motor commands and their
 // values (requested, applied, the budget) are its MotorCommands' job; what the safety machine
 // decides is carried out by its SafetyActuator (on the bus, the safety lines and the Teensy);
-// the end of arming and the command timeout come from its DeadlineTimer.
+// the end of arming and the command timeout come from its DeadlineTimer; who commands and
+// who left, its PilotWatch.
 #pragma once
 
 #include "core/config.hpp"
@@ -17,6 +18,7 @@
 #include "daemon/demand_listener.hpp"
 #include "daemon/failsafe_gate.hpp"
 #include "daemon/motor_commands.hpp"
+#include "daemon/pilot_watch.hpp"
 #include "daemon/safety_actuator.hpp"
 #include "daemon/safety_lines.hpp"
 #include "daemon/teensy_port.hpp"
@@ -58,19 +60,23 @@ public:
     // put on the bus are on the wire (the bus worker's thread): a caller that gets it knows
     // the thrusters were told zero. The loop does not wait for them; the kill output was
     // asserted before any of them.
-    void kill(KillSource source, std::string_view reason, Completion done);
-    void power_off(std::string_view confirmation, Completion done);
+    void kill(KillSource source, std::string_view reason, Completion done) {
+        actuator_.after_zeros(std::move(done), kill(source, reason));
+    }
+    void power_off(std::string_view confirmation, Completion done) {
+        actuator_.after_zeros(std::move(done), power_off(confirmation));
+    }
     // `done(r)` once the zeros handed to the bus so far are on the wire.
     void after_zeros(Completion done, Result r) { actuator_.after_zeros(std::move(done), std::move(r)); }
     Result set_profile(std::string_view name) { return motors_.set_profile(name); }
-    void client_left(std::string_view unique_name);
+    void client_left(std::string_view unique_name) { pilots_.client_left(unique_name); }
     // Once per cycle: arming and the command timeout.
     void tick(uint64_t now_ns) { handle(safety_.tick(now_ns)); }
 
     void kill_switch_read(bool set) override;
     Result state_error() const override { return condition_.state_error(); }
     bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
-    Result accept_command(std::string_view client) override;
+    Result accept_command(std::string_view client) override { return pilots_.accept_command(client); }
     // A line or a thruster went away under the daemon (SafetyLines, ThrusterHealth): killed,
     // source device.
     void device_lost(std::string_view why) override { kill(KillSource::Device, why); }
@@ -98,6 +104,7 @@ public:
     void set_failsafe_gate(FailsafeGate* gate) {
         failsafes_ = gate;
         condition_.set_failsafe_gate(gate);
+        pilots_.set_failsafe_gate(gate);
     }
     void exclude(const std::array<bool, kMotorCount>& excluded) { motors_.exclude(excluded); }
     Result surface(const AxisDemand& ascent) { return motors_.surface(ascent); }
@@ -118,6 +125,7 @@ private:
 
     MotorCommands motors_;
     VehicleCondition condition_;
+    PilotWatch pilots_;
     FailsafeGate* failsafes_ = nullptr;
 };
 

@@ -24,11 +24,11 @@ int m_inject(sd_bus_message* m, void* userdata, sd_bus_error* err) {
         return r;
     const std::string k = kind;
     if (k == "busy")
-        teensy(userdata).inject_busy(frames);
+        teensy(userdata).faults().inject_busy(frames);
     else if (k == "garbage-ack")
-        teensy(userdata).inject_garbage_ack(frames);
+        teensy(userdata).faults().inject_garbage_ack(frames);
     else if (k == "no-answer")
-        teensy(userdata).inject_no_answer(frames);
+        teensy(userdata).faults().inject_no_answer(frames);
     else
         return sd_bus_error_setf(err, kInspectInvalid, "fault must be busy, garbage-ack or no-answer, got '%s'", kind);
     return sd_bus_reply_method_return(m, "");
@@ -39,7 +39,7 @@ int m_random_busy(sd_bus_message* m, void* userdata, sd_bus_error* err) {
     uint64_t seed = 0;
     if (int r = sd_bus_message_read(m, "dt", &p, &seed); r < 0)
         return r;
-    if (!teensy(userdata).set_random_busy(p, seed))
+    if (!teensy(userdata).faults().set_random_busy(p, seed))
         return sd_bus_error_setf(err, kInspectInvalid, "probability must be within 0..1");
     return sd_bus_reply_method_return(m, "");
 }
@@ -54,7 +54,7 @@ int m_set_hang(sd_bus_message* m, void* userdata, sd_bus_error*) {
 }
 
 int m_clear(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    teensy(userdata).clear_faults();
+    teensy(userdata).faults().clear();
     static_cast<SimVehicle*>(userdata)->teensy_port().hang_ms = 0;
     return sd_bus_reply_method_return(m, "");
 }
@@ -73,15 +73,15 @@ int m_commands(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint8_t cmd = 0;
     if (int r = sd_bus_message_read(m, "y", &cmd); r < 0)
         return r;
-    return sd_bus_reply_method_return(m, "tt", static_cast<uint64_t>(teensy(userdata).commands_received(cmd)),
-                                      static_cast<uint64_t>(teensy(userdata).commands_executed(cmd)));
+    return sd_bus_reply_method_return(m, "tt", static_cast<uint64_t>(teensy(userdata).frames().commands_received(cmd)),
+                                      static_cast<uint64_t>(teensy(userdata).frames().commands_executed(cmd)));
 }
 
 // GetFrameLog() -> a(tttysayay): seq, start_ns, end_ns, command, outcome, mosi, miso.
 int m_frame_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return reply_with(m, [&](sd_bus_message* reply) {
         int r = sd_bus_message_open_container(reply, 'a', "(tttysayay)");
-        for (const auto& f : teensy(userdata).frame_log()) {
+        for (const auto& f : teensy(userdata).frames().records()) {
             if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttysayay");
             if (r >= 0) r = sd_bus_message_append(reply, "tttys", f.seq, f.start_ns, f.end_ns, f.command, std::string(to_string(f.outcome)).c_str());
             if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.mosi.data(), f.mosi.size());
@@ -108,7 +108,7 @@ constexpr dbus::Member kMembers[] = {
     property<[](V v) { return v.teensy().stop_duty(); }>("StopDuty"),
     property<[](V v) { return to_string(v.teensy().task_state()); }>("Task"),
     property<[](V v) { return v.teensy().acknowledgements(); }>("Acknowledgements"),
-    property<[](V v) { return v.teensy().frames_total(); }>("Frames"),
+    property<[](V v) { return v.teensy().frames().total(); }>("Frames"),
     property<[](V v) { return double(v.teensy().last_turn_rad()); }>("LastTurn"),
     property<[](V v) { return double(v.teensy().last_turn_to_rad()); }>("LastTurnTo"),
     property<[](V v) { return v.teensy().heading_offset(); }>("HeadingOffset"),

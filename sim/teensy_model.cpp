@@ -62,19 +62,6 @@ std::string_view teensy_command_name(uint8_t command) {
     }
 }
 
-std::string_view to_string(TeensyFrameOutcome o) {
-    switch (o) {
-    case TeensyFrameOutcome::Ok: return "ok";
-    case TeensyFrameOutcome::Busy: return "busy";
-    case TeensyFrameOutcome::GarbageAck: return "garbage-ack";
-    case TeensyFrameOutcome::NoAnswer: return "no-answer";
-    case TeensyFrameOutcome::Invalid: return "invalid";
-    case TeensyFrameOutcome::Unknown: return "unknown";
-    case TeensyFrameOutcome::Incomplete: return "incomplete";
-    }
-    return "?";
-}
-
 std::string_view to_string(TeensyTaskState s) {
     switch (s) {
     case TeensyTaskState::Idle: return "idle";
@@ -85,7 +72,7 @@ std::string_view to_string(TeensyTaskState s) {
 }
 
 TeensyModel::TeensyModel(TeensyConfig cfg, AttitudeSource attitude)
-    : cfg_(cfg), attitude_(std::move(attitude)) {
+    : cfg_(cfg), attitude_(std::move(attitude)), frames_(cfg.log_capacity) {
     if (!attitude_)
         throw std::invalid_argument("TeensyModel needs an attitude source");
     if (!std::isfinite(cfg_.wheel_k) || !std::isfinite(cfg_.front_circumference) ||
@@ -169,42 +156,13 @@ void TeensyModel::begin_frame(uint8_t cmd, uint64_t now_ns) {
     f_.start_ns = now_ns;
     f_.mosi.push_back(cmd);
     f_.miso.push_back(0);
-    ++received_[cmd];
+    frames_.received(cmd);
     if (!s.known)
         return;
-    f_.plan = choose_plan();
+    f_.plan = faults_.next();
     // With no data bytes (Confirm) the answer must be loaded right after the command byte.
     if (f_.data_len == 0)
         prepare_answer();
-}
-
-TeensyModel::Plan TeensyModel::choose_plan() {
-    if (no_answer_frames_ > 0) {
-        --no_answer_frames_;
-        return Plan::NoAnswer;
-    }
-    if (garbage_frames_ > 0) {
-        --garbage_frames_;
-        return Plan::Garbage;
-    }
-    if (busy_frames_ > 0) {
-        --busy_frames_;
-        return Plan::Busy;
-    }
-    if (busy_probability_ > 0.0 && next_random_busy())
-        return Plan::Busy;
-    return Plan::Normal;
-}
-
-bool TeensyModel::next_random_busy() {
-    // splitmix64: tiny, and the same sequence on every platform for a given seed (the
-    // standard distributions are not portable).
-    uint64_t z = (rng_state_ += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    z ^= z >> 31;
-    const double u = static_cast<double>(z >> 11) * 0x1.0p-53;
-    return u < busy_probability_;
 }
 
 void TeensyModel::prepare_answer() {
@@ -337,13 +295,11 @@ void TeensyModel::execute() {
     case teensy::kSetLeds: leds_ = {d[0], d[1], d[2]}; break;
     default: break; // the getters' work was done when the answer was loaded
     }
-    ++executed_[f_.cmd];
+    frames_.executed(f_.cmd);
 }
 
 void TeensyModel::log_frame(TeensyFrameOutcome o, uint64_t now_ns) {
-    ++outcomes_[static_cast<std::size_t>(o)];
     TeensyFrameRecord r;
-    r.seq = next_seq_++;
     r.start_ns = f_.start_ns;
     r.end_ns = now_ns;
     r.command = f_.cmd;
@@ -351,9 +307,7 @@ void TeensyModel::log_frame(TeensyFrameOutcome o, uint64_t now_ns) {
     r.outcome = o;
     r.mosi = std::move(f_.mosi);
     r.miso = std::move(f_.miso);
-    if (log_.size() >= cfg_.log_capacity)
-        log_.pop_front();
-    log_.push_back(std::move(r));
+    frames_.add(std::move(r));
 }
 
 void TeensyModel::step(double dt_s, uint64_t now_ns) {
@@ -372,29 +326,12 @@ void TeensyModel::step(double dt_s, uint64_t now_ns) {
     }
 }
 
-bool TeensyModel::set_random_busy(double probability, uint64_t seed) {
-    if (!(probability >= 0.0 && probability <= 1.0))
-        return false;
-    busy_probability_ = probability;
-    rng_state_ = seed;
-    return true;
-}
-
-void TeensyModel::clear_faults() {
-    busy_frames_ = 0;
-    garbage_frames_ = 0;
-    no_answer_frames_ = 0;
-    busy_probability_ = 0.0;
-}
-
 bool TeensyModel::set_distance_mm(std::size_t sensor, uint16_t mm) {
     if (sensor >= distances_.size())
         return false;
     distances_[sensor] = mm;
     return true;
 }
-
-std::vector<TeensyFrameRecord> TeensyModel::frame_log() const { return {log_.begin(), log_.end()}; }
 
 double TeensyModel::heading() const { return VehicleBody::wrap_angle(attitude_().yaw + heading_offset_); }
 

@@ -27,7 +27,7 @@
 // - Stop ends a running turn where it is and marks it finished, so a host polling Confirm
 //   is not left waiting for a turn that will never complete.
 //
-// Fault injection, decided when the command byte arrives (frames of known commands only;
+// Fault injection (its TeensyFaults), decided when the command byte arrives (frames of known commands only;
 // the first matching rule wins):
 //   no answer  (N frames): MISO all 0x00; models a Teensy that is not listening (resetting,
 //                          hung interrupt), so the frame is not executed;
@@ -42,12 +42,16 @@
 
 #include "sim/spi_slave.hpp"
 #include "sim/stepped.hpp"
+#include "sim/teensy_config.hpp"
+#include "sim/teensy_faults.hpp"
+#include "sim/teensy_frame_log.hpp"
+#include "sim/teensy_frame_record.hpp"
+#include "sim/teensy_wheels.hpp"
 #include "sim/vehicle_body.hpp"
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <optional>
 #include <string_view>
@@ -73,52 +77,9 @@ inline constexpr uint8_t kGarbageXor = 0xA5;
 inline constexpr std::size_t kMaxServoDegrees = 180;
 } // namespace teensy
 
-struct TeensyConfig {
-    // Rear-wheel formula v3/4 = k * Df/Db * ((v1 + v2)/2 +- (v2 - v1)).
-    double wheel_k = 0.8;
-    double front_circumference = 1.0; // Df, any unit (only the ratio matters)
-    double back_circumference = 1.0;  // Db
-    double turn_rate_rad_s = 1.0;
-    std::size_t servo_count = 4;
-    std::size_t distance_sensor_count = 4;
-    uint8_t servo_initial_degrees = 90;
-    uint16_t distance_initial_mm = 1000;
-    std::size_t log_capacity = 256;
-};
-
-// Front speeds as commanded (int8), back speeds from the formula (may exceed int8 range).
-struct TeensyWheels {
-    double front_left = 0.0;
-    double front_right = 0.0;
-    double back_left = 0.0;
-    double back_right = 0.0;
-};
-
 enum class TeensyTaskState : uint8_t { Idle, Running, FinishedAwaitingAck };
 
-enum class TeensyFrameOutcome : uint8_t {
-    Ok,         // executed, ack = command
-    Busy,       // ack 0xFF, not executed
-    GarbageAck, // executed, ack corrupted
-    NoAnswer,   // all zeros, not executed
-    Invalid,    // bad argument, ack 0x00, not executed
-    Unknown,    // unknown command id, zeros until chip select release
-    Incomplete, // chip select released before the ack slot, not executed
-};
-
-struct TeensyFrameRecord {
-    uint64_t seq = 0; // running number over the model's lifetime, for incremental readers
-    uint64_t start_ns = 0;
-    uint64_t end_ns = 0;
-    uint8_t command = 0;
-    std::string_view name;
-    TeensyFrameOutcome outcome = TeensyFrameOutcome::Ok;
-    std::vector<uint8_t> mosi;
-    std::vector<uint8_t> miso;
-};
-
 std::string_view teensy_command_name(uint8_t command);
-std::string_view to_string(TeensyFrameOutcome o);
 std::string_view to_string(TeensyTaskState s);
 
 class TeensyModel : public SpiSlave, public Stepped {
@@ -135,27 +96,14 @@ public:
     void step(double dt_s, uint64_t now_ns) override;
 
     // --- fault injection ---
-    void inject_busy(unsigned frames) { busy_frames_ = frames; }
-    // false (and nothing changes) unless 0 <= probability <= 1.
-    bool set_random_busy(double probability, uint64_t seed);
-    void inject_garbage_ack(unsigned frames) { garbage_frames_ = frames; }
-    void inject_no_answer(unsigned frames) { no_answer_frames_ = frames; }
-    void clear_faults();
-    unsigned pending_busy() const { return busy_frames_; }
-    unsigned pending_garbage_ack() const { return garbage_frames_; }
-    unsigned pending_no_answer() const { return no_answer_frames_; }
-    double random_busy_probability() const { return busy_probability_; }
+    TeensyFaults& faults() { return faults_; }
+    const TeensyFaults& faults() const { return faults_; }
 
     // --- settable sensor values ---
     bool set_distance_mm(std::size_t sensor, uint16_t mm);
 
     // --- observation ---
-    std::vector<TeensyFrameRecord> frame_log() const; // oldest first
-    uint64_t frames_total() const { return next_seq_; }
-    // Frames whose command byte was seen / that were executed (Ok or GarbageAck).
-    uint64_t commands_received(uint8_t command) const { return received_[command]; }
-    uint64_t commands_executed(uint8_t command) const { return executed_[command]; }
-    uint64_t outcome_count(TeensyFrameOutcome o) const { return outcomes_[static_cast<std::size_t>(o)]; }
+    const TeensyFrameLog& frames() const { return frames_; }
 
     TeensyWheels wheels() const { return wheels_; }
     uint8_t stop_duty() const { return stop_duty_; }
@@ -176,7 +124,7 @@ public:
     const TeensyConfig& config() const { return cfg_; }
 
 private:
-    enum class Plan : uint8_t { Normal, Busy, Garbage, NoAnswer };
+    using Plan = TeensyFramePlan;
 
     struct Frame {
         bool active = false;
@@ -197,7 +145,6 @@ private:
 
     uint8_t on_byte(uint8_t in, uint64_t now_ns);
     void begin_frame(uint8_t cmd, uint64_t now_ns);
-    Plan choose_plan();
     void prepare_answer();
     uint8_t slot_output() const;
     uint8_t ack_byte() const;
@@ -205,23 +152,12 @@ private:
     void execute();
     void log_frame(TeensyFrameOutcome o, uint64_t now_ns);
     double heading() const;
-    bool next_random_busy();
 
     TeensyConfig cfg_;
     AttitudeSource attitude_;
     Frame f_;
-
-    unsigned busy_frames_ = 0;
-    unsigned garbage_frames_ = 0;
-    unsigned no_answer_frames_ = 0;
-    double busy_probability_ = 0.0;
-    uint64_t rng_state_ = 0;
-
-    std::deque<TeensyFrameRecord> log_;
-    uint64_t next_seq_ = 0;
-    std::array<uint64_t, 256> received_{};
-    std::array<uint64_t, 256> executed_{};
-    std::array<uint64_t, 7> outcomes_{};
+    TeensyFaults faults_;
+    TeensyFrameLog frames_;
 
     TeensyWheels wheels_{};
     uint8_t stop_duty_ = 0;

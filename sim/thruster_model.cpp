@@ -13,30 +13,7 @@ constexpr double kCoolingPerSecond = 0.1;   // fraction of the excess lost per s
 constexpr double kOvertempSetC = 110.0;     // IDS: set at 110C
 constexpr double kOvertempClearC = 100.0;   // IDS: clear at 100C
 constexpr uint8_t kLatching = kGroundFault; // until power cycle, both variants
-
-const std::array<std::pair<uint8_t, const char*>, 5> kFaultNames = {{
-    {kOvertemp, "overtemp"},
-    {kStall, "stall"},
-    {kHall, "hall"},
-    {kGroundFault, "ground-fault"},
-    {kWaterDetect, "water-detect"},
-}};
 } // namespace
-
-std::optional<uint8_t> fault_bit_from_name(const std::string& name) {
-    for (auto& [bit, n] : kFaultNames)
-        if (name == n)
-            return bit;
-    return std::nullopt;
-}
-
-std::vector<std::string> fault_names(uint8_t bits) {
-    std::vector<std::string> out;
-    for (auto& [bit, n] : kFaultNames)
-        if (bits & bit)
-            out.emplace_back(n);
-    return out;
-}
 
 ThrusterModel::ThrusterModel(ThrusterSpec spec) : spec_(spec) {}
 

@@ -4,6 +4,8 @@
 
 #include "sim/i2c_slave.hpp"
 #include "sim/stepped.hpp"
+#include "sim/thruster_fault_bits.hpp"
+#include "sim/thruster_spec.hpp"
 
 #include <array>
 #include <cstdint>
@@ -12,28 +14,6 @@
 #include <vector>
 
 namespace caracara::sim {
-
-enum class ThrusterVariant { SeaBotix, Legacy };
-
-// Fault bits in the SeaBotix FAULT byte order; the legacy STATUS byte uses bits 0-3 the
-// same way and bit 4 for water detect.
-enum FaultBit : uint8_t {
-    kOvertemp = 1 << 0,
-    kStall = 1 << 1,
-    kHall = 1 << 2,
-    kGroundFault = 1 << 3,
-    kWaterDetect = 1 << 4,
-};
-std::optional<uint8_t> fault_bit_from_name(const std::string& name);
-std::vector<std::string> fault_names(uint8_t bits);
-
-struct ThrusterSpec {
-    uint8_t mt = 0x52;                 // 8-bit write address byte
-    ThrusterVariant variant = ThrusterVariant::SeaBotix;
-    std::optional<uint16_t> mux_addr;  // 7-bit address of the PCA9544A in front of it
-    uint8_t mux_channel = 0;
-    bool brushless = true;
-};
 
 class ThrusterModel final : public I2cSlave, public Stepped {
 public:

@@ -5,6 +5,8 @@
 #include "sim/gpio_model.hpp"
 #include "sim/i2c_bus_model.hpp"
 #include "sim/sim_config.hpp"
+#include "sim/spi_message_xfer.hpp"
+#include "sim/spi_port.hpp"
 #include "sim/spi_slave.hpp"
 #include "sim/stepped.hpp"
 #include "sim/teensy_model.hpp"
@@ -21,30 +23,6 @@
 #include <vector>
 
 namespace caracara::sim {
-
-struct SpiMessageXfer {
-    std::vector<uint8_t> tx;  // empty when the transfer had no tx_buf (the master sends zeros)
-    size_t len = 0;
-    bool want_rx = false;
-    SpiTransferParams params;
-    std::vector<uint8_t> rx;  // filled by the vehicle
-};
-
-struct SpiPort {
-    SpiSlave* slave = nullptr;
-    uint8_t mode = 0;
-    uint8_t bits_per_word = 8;
-    uint32_t max_speed_hz = 500000;
-    uint8_t lsb_first = 0;
-    uint64_t messages = 0;
-    uint64_t mode_mismatches = 0;
-    // The shape of the last SPI_IOC_MESSAGE, for tests of the spidev marshalling.
-    uint32_t last_transfers = 0;
-    uint32_t last_speed_hz = 0;
-    uint16_t last_delay_usecs = 0;
-    // A hung slave (caracara-sim's Teensy fault SetHang): every message is answered this late.
-    uint32_t hang_ms = 0;
-};
 
 class SimVehicle {
 public:

@@ -60,8 +60,8 @@ TEST_CASE("Get orientation answers float32 little-endian with the command as ack
     Bytes roll = frame(r.teensy, {0x08, 0x02, 0, 0, 0, 0, 0});
     CHECK(roll[6] == 0x08);
     CHECK(le_f32(roll, 2) == -0.5f);
-    CHECK(r.teensy.commands_executed(0x08) == 3);
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::Ok) == 3);
+    CHECK(r.teensy.frames().commands_executed(0x08) == 3);
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::Ok) == 3);
 }
 
 TEST_CASE("one 1-byte transfer per byte gives the same frame as one transfer") {
@@ -86,15 +86,15 @@ TEST_CASE("chip select released mid-frame discards the frame and resynchronises"
     Rig r;
     CHECK(frame(r.teensy, {0x09, 0x10, 0x20}) == Bytes{0, 0, 0});
     CHECK(r.teensy.leds() == std::array<uint8_t, 3>{0, 0, 0});
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::Incomplete) == 1);
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::Incomplete) == 1);
     // Cut after data but before the ack slot: still no effect (a Turn resend must not double).
     frame(r.teensy, {0x03, 0x00, 0x00, 0x00, 0x3F});
     CHECK(r.teensy.task_state() == TeensyTaskState::Idle);
-    CHECK(r.teensy.commands_executed(0x03) == 0);
+    CHECK(r.teensy.frames().commands_executed(0x03) == 0);
     // The rest of a frame in the next message is not glued on: 0x00 is no command.
     frame(r.teensy, {0x08});
     CHECK(frame(r.teensy, {0x00, 0, 0, 0, 0, 0}) == Bytes{0, 0, 0, 0, 0, 0});
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::Unknown) == 1);
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::Unknown) == 1);
     // And the next whole frame works.
     CHECK(frame(r.teensy, {0x09, 0x10, 0x20, 0x30, 0}) == Bytes{0, 0, 0, 0, 0x09});
     CHECK(r.teensy.leds() == std::array<uint8_t, 3>{0x10, 0x20, 0x30});
@@ -103,9 +103,9 @@ TEST_CASE("chip select released mid-frame discards the frame and resynchronises"
 TEST_CASE("unknown command answers zeros until chip select release") {
     Rig r;
     CHECK(frame(r.teensy, {0x42, 1, 2, 3, 4, 5}) == Bytes{0, 0, 0, 0, 0, 0});
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::Unknown) == 1);
-    CHECK(r.teensy.commands_received(0x42) == 1);
-    auto log = r.teensy.frame_log();
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::Unknown) == 1);
+    CHECK(r.teensy.frames().commands_received(0x42) == 1);
+    auto log = r.teensy.frames().records();
     REQUIRE(log.size() == 1);
     CHECK(log[0].name == "Unknown");
     CHECK(log[0].mosi == Bytes{0x42, 1, 2, 3, 4, 5});
@@ -115,27 +115,27 @@ TEST_CASE("unknown command answers zeros until chip select release") {
 TEST_CASE("injected busy answers 0xFF in the ack slot for N frames without executing them") {
     Rig r;
     r.body.set_attitude({1.0, 0, 0});
-    r.teensy.inject_busy(2);
+    r.teensy.faults().inject_busy(2);
     CHECK(frame(r.teensy, {0x09, 7, 8, 9, 0}) == Bytes{0, 0, 0, 0, 0xFF});
     CHECK(frame(r.teensy, {0x08, 0x00, 0, 0, 0, 0, 0}) == Bytes{0, 0, 0, 0, 0, 0, 0xFF});
     CHECK(r.teensy.leds() == std::array<uint8_t, 3>{0, 0, 0});
-    CHECK(r.teensy.pending_busy() == 0);
+    CHECK(r.teensy.faults().pending_busy() == 0);
     CHECK(frame(r.teensy, {0x09, 7, 8, 9, 0}) == Bytes{0, 0, 0, 0, 0x09});
     CHECK(r.teensy.leds() == std::array<uint8_t, 3>{7, 8, 9});
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::Busy) == 2);
-    CHECK(r.teensy.commands_received(0x09) == 2);
-    CHECK(r.teensy.commands_executed(0x09) == 1);
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::Busy) == 2);
+    CHECK(r.teensy.frames().commands_received(0x09) == 2);
+    CHECK(r.teensy.frames().commands_executed(0x09) == 1);
 }
 
 TEST_CASE("random busy is reproducible from its seed and never executes a busy frame") {
     auto run = [](uint64_t seed) {
         Rig r;
-        REQUIRE(r.teensy.set_random_busy(0.5, seed));
+        REQUIRE(r.teensy.faults().set_random_busy(0.5, seed));
         Bytes acks;
         for (int i = 0; i < 200; ++i)
             acks.push_back(frame(r.teensy, {0x05, 0x00, 0x00})[2]);
-        CHECK(r.teensy.commands_executed(0x05) == r.teensy.outcome_count(TeensyFrameOutcome::Ok));
-        CHECK(r.teensy.outcome_count(TeensyFrameOutcome::Busy) + r.teensy.outcome_count(TeensyFrameOutcome::Ok) == 200);
+        CHECK(r.teensy.frames().commands_executed(0x05) == r.teensy.frames().outcome_count(TeensyFrameOutcome::Ok));
+        CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::Busy) + r.teensy.frames().outcome_count(TeensyFrameOutcome::Ok) == 200);
         return acks;
     };
     Bytes a = run(42);
@@ -147,31 +147,31 @@ TEST_CASE("random busy is reproducible from its seed and never executes a busy f
     CHECK(busy > 60);
     CHECK(ok > 60);
     Rig r;
-    CHECK_FALSE(r.teensy.set_random_busy(1.5, 1));
-    CHECK_FALSE(r.teensy.set_random_busy(std::nan(""), 1));
+    CHECK_FALSE(r.teensy.faults().set_random_busy(1.5, 1));
+    CHECK_FALSE(r.teensy.faults().set_random_busy(std::nan(""), 1));
 }
 
 TEST_CASE("garbage ack corrupts only the ack; no answer is all zeros and not executed") {
     Rig r;
     r.teensy.set_distance_mm(0, 0x0102);
-    r.teensy.inject_garbage_ack(1);
+    r.teensy.faults().inject_garbage_ack(1);
     CHECK(frame(r.teensy, {0x07, 0x00, 0, 0, 0}) == Bytes{0, 0, 0x02, 0x01, uint8_t(0x07 ^ 0xA5)});
     CHECK(frame(r.teensy, {0x07, 0x00, 0, 0, 0}) == Bytes{0, 0, 0x02, 0x01, 0x07});
     // The slave heard a garbage-ack frame (only MISO was corrupted), so it took effect.
-    r.teensy.inject_garbage_ack(1);
+    r.teensy.faults().inject_garbage_ack(1);
     CHECK(frame(r.teensy, {0x09, 1, 1, 1, 0})[4] == (0x09 ^ 0xA5));
     CHECK(r.teensy.leds() == std::array<uint8_t, 3>{1, 1, 1});
 
-    r.teensy.inject_no_answer(2);
+    r.teensy.faults().inject_no_answer(2);
     CHECK(frame(r.teensy, {0x07, 0x00, 0, 0, 0}) == Bytes{0, 0, 0, 0, 0});
     CHECK(frame(r.teensy, {0x09, 2, 2, 2, 0}) == Bytes{0, 0, 0, 0, 0});
     CHECK(r.teensy.leds() == std::array<uint8_t, 3>{1, 1, 1});
     CHECK(frame(r.teensy, {0x09, 2, 2, 2, 0}) == Bytes{0, 0, 0, 0, 0x09});
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::GarbageAck) == 2);
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::NoAnswer) == 2);
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::GarbageAck) == 2);
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::NoAnswer) == 2);
 
-    r.teensy.inject_busy(3);
-    r.teensy.clear_faults();
+    r.teensy.faults().inject_busy(3);
+    r.teensy.faults().clear();
     CHECK(frame(r.teensy, {0x05, 0, 0}) == Bytes{0, 0, 0x05});
 }
 
@@ -214,7 +214,7 @@ TEST_CASE("a busy acknowledgement is not taken; the resend is") {
     Rig r;
     frame(r.teensy, {0x03, 0x00, 0x00, 0x00, 0x3F, 0x00});
     r.teensy.step(1.0, 0);
-    r.teensy.inject_busy(1);
+    r.teensy.faults().inject_busy(1);
     CHECK(frame(r.teensy, {0x01, 0x01, 0x00}) == Bytes{0, 0x00, 0xFF});
     CHECK(r.teensy.task_state() == TeensyTaskState::FinishedAwaitingAck);
     CHECK(frame(r.teensy, {0x01, 0x01, 0x00}) == Bytes{0, 0xFF, 0x01});
@@ -235,7 +235,7 @@ TEST_CASE("Turn to goes the shortest way to an absolute heading") {
     CHECK(r.teensy.orientation().yaw == Approx(-3.0));
     // NaN (0x7FC00000) is refused: ack 0x00.
     CHECK(frame(r.teensy, {0x04, 0x00, 0x00, 0xC0, 0x7F, 0x00}) == Bytes{0, 0, 0, 0, 0, 0x00});
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::Invalid) == 1);
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::Invalid) == 1);
 }
 
 TEST_CASE("Stop zeroes the wheels, keeps the duty and finishes a running turn") {
@@ -290,7 +290,7 @@ TEST_CASE("LEDs, servos and distance sensors") {
     CHECK(frame(r.teensy, {0x07, 0x00, 0x00, 0x00, 0x00}) == Bytes{0, 0, 0xE8, 0x03, 0x07}); // 1000 mm
     CHECK(frame(r.teensy, {0x07, 0x04, 0x00, 0x00, 0x00}) == Bytes{0, 0, 0, 0, 0x00});
     CHECK(frame(r.teensy, {0x08, 0x03, 0, 0, 0, 0, 0}) == Bytes{0, 0, 0, 0, 0, 0, 0x00}); // axis 3
-    CHECK(r.teensy.outcome_count(TeensyFrameOutcome::Invalid) == 4);
+    CHECK(r.teensy.frames().outcome_count(TeensyFrameOutcome::Invalid) == 4);
 }
 
 TEST_CASE("the frame log is a bounded ring of raw bytes and outcomes") {
@@ -299,11 +299,11 @@ TEST_CASE("the frame log is a bounded ring of raw bytes and outcomes") {
     Rig r(cfg);
     for (uint8_t i = 0; i < 9; ++i)
         frame(r.teensy, {0x09, i, 0, 0, 0}, 1000u + i);
-    r.teensy.inject_busy(1);
+    r.teensy.faults().inject_busy(1);
     frame(r.teensy, {0x05, 0x01, 0x00}, 2000);
-    auto log = r.teensy.frame_log();
+    auto log = r.teensy.frames().records();
     REQUIRE(log.size() == 4);
-    CHECK(r.teensy.frames_total() == 10);
+    CHECK(r.teensy.frames().total() == 10);
     CHECK(log[0].seq == 6);
     CHECK(log[2].start_ns == 1008);
     CHECK(log[2].mosi == Bytes{0x09, 8, 0, 0, 0});
