@@ -13,7 +13,7 @@ import dbus
 import harness
 from bounds import CLIENT_LOSS_ZERO_MS_MAX, FAILSAFE_LATENESS_MS_MAX
 from harness import MOTORS, ROOT, VEHICLE, ZERO, Rig, poll, pump_main_loop, speed_byte
-from test_failsafes import FailsafeSignals, kill_edges, orders
+from test_failsafes import FailsafeSignals, kill_edges, nonzero_after_kill, orders
 
 PERSISTENCE_MS = 1000
 CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 60000}
@@ -99,7 +99,7 @@ class PilotCase(unittest.TestCase):
         self.assertGreaterEqual(after_ms, PERSISTENCE_MS, "killed before the persistence time")
         self.assertLessEqual(after_ms, PERSISTENCE_MS + FAILSAFE_LATENESS_MS_MAX)
         log = rig.wire_log(since)[1]
-        self.assertFalse([e for e, i, s in orders(log) if e.index > edge.index and s != ZERO],
+        self.assertFalse(nonzero_after_kill(log, edge),
                          "a non-zero order after the kill output")
         poll(lambda: any(PILOT_LOST in v for v in self.seen.values), 5, pump=pump_main_loop,
              message="Failsafes never named pilot-lost (saw %r)" % self.seen.values)
