@@ -82,11 +82,19 @@ bool BusWorker::run_job(std::unique_lock<std::mutex>& lk) {
     published_[job.index] = *drivers_[job.index];
     done_.push_back(d);
     busy_ = false;
+    owed_ = owed_ || d.error != IoError::None;
     finished_.notify_all();
     // One wake-up of the loop per batch (the queue ran dry), or every kWakeEvery jobs so the
     // books stay fresh when the bus never rests: a wake-up per transfer would cost the loop
     // more than the transfer when the device answers at once.
-    return queue_.empty() || done_.size() >= kWakeEvery;
+    return (queue_.empty() && (eager_ || owed_)) || done_.size() >= kWakeEvery;
+}
+
+void BusWorker::set_eager(bool eager) {
+    std::lock_guard lk(thread_.mutex());
+    eager_ = eager;
+    if (eager && !done_.empty() && queue_.empty() && !busy_)
+        thread_.wake_loop(); // the batch was over before: its results now
 }
 
 BusJobDone BusWorker::transfer(const BusJob& job) {
@@ -107,6 +115,7 @@ void BusWorker::deliver() {
     {
         std::lock_guard lk(thread_.mutex());
         delivering_.swap(done_);
+        owed_ = false;
         for (const BusJobDone& d : delivering_)
             views_[d.job.index] = published_[d.job.index];
     }

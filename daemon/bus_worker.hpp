@@ -56,6 +56,11 @@ public:
     void set_gate(BusGate* gate) { gate_.store(gate); }
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
     bool idle() const { return outstanding_ == 0; }
+    // Eager (the default): the loop is woken as soon as a batch is over. Otherwise it takes the
+    // results itself (collect(), at its next tick: a cycle's routine transfers need no wake-up
+    // of their own), and only a failed transfer or a long batch wakes it.
+    void set_eager(bool eager);
+    void collect() { deliver(); }
     // Blocks until idle, handing the finished jobs to `done`: start-up and shutdown only,
     // where the zero orders must be on the wire before the daemon goes on.
     void wait_idle();
@@ -82,6 +87,8 @@ private:
     std::vector<BusJobDone> done_;     // under the lock
     std::vector<BusJobDone> delivering_; // loop thread; reused
     bool busy_ = false;                // under the lock: a job is on the wire
+    bool eager_ = true;                // under the lock
+    bool owed_ = false;                // under the lock: a failure the loop must hear of now
     DoneFn on_done_;
     WorkerThread thread_{*this}; // last: joined before the rest goes
 };
