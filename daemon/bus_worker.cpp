@@ -97,6 +97,13 @@ void BusWorker::set_eager(bool eager) {
         thread_.wake_loop(); // the batch was over before: its results now
 }
 
+void BusWorker::wake_when_done() {
+    std::lock_guard lk(thread_.mutex());
+    owed_ = true;
+    if (!done_.empty() && queue_.empty() && !busy_)
+        thread_.wake_loop();
+}
+
 BusJobDone BusWorker::transfer(const BusJob& job) {
     // A non-zero order from before the last kill is dropped here, at the last moment.
     if (job.kind == BusJobKind::Order && job.value != 0 && job.epoch != epoch_.load())
@@ -115,7 +122,7 @@ void BusWorker::deliver() {
     {
         std::lock_guard lk(thread_.mutex());
         delivering_.swap(done_);
-        owed_ = false;
+        owed_ = owed_ && (busy_ || !queue_.empty()); // still owed for the rest of the batch
         for (const BusJobDone& d : delivering_)
             views_[d.job.index] = published_[d.job.index];
     }

@@ -60,6 +60,9 @@ public:
     // results itself (collect(), at its next tick: a cycle's routine transfers need no wake-up
     // of their own), and only a failed transfer or a long batch wakes it.
     void set_eager(bool eager);
+    // Eager for the jobs handed over so far (call after the last of them): the loop is woken
+    // once they are done (a command's orders: its properties show what is on the wire).
+    void wake_when_done();
     void collect() { deliver(); }
     // Blocks until idle, handing the finished jobs to `done`: start-up and shutdown only,
     // where the zero orders must be on the wire before the daemon goes on.
@@ -88,7 +91,7 @@ private:
     std::vector<BusJobDone> delivering_; // loop thread; reused
     bool busy_ = false;                // under the lock: a job is on the wire
     bool eager_ = true;                // under the lock
-    bool owed_ = false;                // under the lock: a failure the loop must hear of now
+    bool owed_ = false;                // under the lock: the loop must hear of this batch (a failure)
     DoneFn on_done_;
     WorkerThread thread_{*this}; // last: joined before the rest goes
 };

@@ -59,6 +59,8 @@ public:
         update_eager();
     }
     void collect() { worker_.collect(); }
+    // The transfers handed over so far come back at once, lazy or not (see BusWorker).
+    void wake_when_done() { worker_.wake_when_done(); }
 
     // The adapter closed for a bus recovery (its queued work dropped) and open again.
     void set_recovering(bool r);
