@@ -6,10 +6,6 @@ namespace caracara {
 
 namespace {
 constexpr std::size_t kWakeEvery = 16;
-
-IoError execute(ThrusterDriver& d, const BusJob& job) {
-    return job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
-}
 } // namespace
 
 BusWorker::BusWorker(std::vector<std::unique_ptr<ThrusterDriver>>& drivers) : drivers_(drivers) {
@@ -111,7 +107,8 @@ BusJobDone BusWorker::transfer(const BusJob& job) {
     BusGate* gate = gate_.load();
     if (gate && !gate->enter(::gettid()))
         return {job, IoError::None, true}; // the crash handler has the bus; the process is ending
-    const IoError e = execute(*drivers_[job.index], job);
+    ThrusterDriver& d = *drivers_[job.index];
+    const IoError e = job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
     if (gate)
         gate->leave();
     return {job, e, false};

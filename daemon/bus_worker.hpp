@@ -1,10 +1,9 @@
-// The worker that carries the I2C transfers on its own thread (WorkerThread), so that the event
-// loop never waits on the bus: a hung thruster holds a transfer for up to the adapter's
-// timeout, and a Kill, a kill switch edge, D-Bus and the watchdog must not queue behind it.
-// The loop hands over one job at a time (an order or a status read), kept in order by its
-// BusJobQueue up to the moment its transfer starts. Only the thread touches the drivers, the
-// mux state and the adapter's descriptor while a job is out; the loop reads each driver
-// through the copy made after its last job. Finished jobs come back with one wake-up per batch.
+// Carries the I2C transfers on its own thread (WorkerThread), so that the loop never waits on
+// the bus: a hung thruster holds a transfer up to the adapter's timeout, and a Kill, a kill
+// switch edge, D-Bus and the watchdog must not queue behind it. Each job (an order or a status
+// read) stays in its BusJobQueue's order up to the moment its transfer starts. Only the thread
+// touches the drivers, the mux and the adapter while a job is out; the loop reads each driver
+// through the copy made after its last job.
 #pragma once
 
 #include "daemon/bus_job_queue.hpp"
@@ -67,7 +66,6 @@ public:
     // Blocks until idle, handing the finished jobs to `done`: start-up and shutdown only,
     // where the zero orders must be on the wire before the daemon goes on.
     void wait_idle();
-
     // Thruster i as of its last finished job.
     const ThrusterDriver& view(std::size_t i) const { return views_[i]; }
 
