@@ -2,13 +2,15 @@
 // the status reads, a newer order for a thruster takes the place of one still queued for it
 // (a new command waits at most for the transfer on the wire), and a kill's zero orders
 // replace everything queued. Not thread-safe: the BusWorker holds its lock around each call.
+// A vector read from `head_`: the queue holds a cycle's work (a dozen jobs) and runs dry at
+// every cycle, so it allocates only when it first grows.
 #pragma once
 
 #include "drivers/platform/io_error.hpp"
 
 #include <cstddef>
 #include <cstdint>
-#include <deque>
+#include <vector>
 #include <span>
 
 namespace caracara {
@@ -41,10 +43,11 @@ public:
     // Drops everything queued; returns how many.
     std::size_t clear();
     BusJob pop();
-    bool empty() const { return queue_.empty(); }
+    bool empty() const { return head_ == jobs_.size(); }
 
 private:
-    std::deque<BusJob> queue_;
+    std::vector<BusJob> jobs_; // queued: [head_, end)
+    std::size_t head_ = 0;
 };
 
 } // namespace caracara

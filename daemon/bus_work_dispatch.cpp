@@ -71,6 +71,9 @@ int BusWorkDispatch::on_work(sd_event_source*, void* userdata) {
         if (w == Work::Transfer)
             continue;
         if (w == Work::Waiting) {
+            if (self->command_out_)
+                self->bus_.wake_when_done(); // a command's orders: its properties follow the wire at once
+            self->command_out_ = false;
             sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);
             return 0;
         }
@@ -144,8 +147,10 @@ void BusWorkDispatch::demand_changed(const MotorValues& orders) {
             any_due = true;
         }
     orders_ = orders;
-    if (any_due)
+    if (any_due) {
+        command_out_ = true;
         schedule_work();
+    }
 }
 
 void BusWorkDispatch::zero_all(ZeroOrder where) {
@@ -158,6 +163,7 @@ void BusWorkDispatch::zero_all(ZeroOrder where) {
     orders_.fill(0);
     schedule_.drop_orders();
     bus_.zero_all(where);
+    bus_.wake_when_done();
 }
 
 void BusWorkDispatch::resend_orders() {

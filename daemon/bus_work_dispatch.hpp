@@ -72,6 +72,7 @@ private:
 
     OrderSchedule schedule_;
     MotorValues orders_{}; // what each thruster is to be ordered (Vehicle's last demand_changed)
+    bool command_out_ = false; // changed orders are being handed over: the loop hears of them at once
 
     SourcePtr work_source_;
     SourcePtr resume_source_; // below the announcements: the rest of the work, or the next cycle at rate 0

@@ -1,17 +1,11 @@
 #include "daemon/bus_worker.hpp"
 
-#include <cerrno>
-#include <cstdint>
 #include <unistd.h>
 
 namespace caracara {
 
 namespace {
 constexpr std::size_t kWakeEvery = 16;
-
-IoError execute(ThrusterDriver& d, const BusJob& job) {
-    return job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
-}
 } // namespace
 
 BusWorker::BusWorker(std::vector<std::unique_ptr<ThrusterDriver>>& drivers) : drivers_(drivers) {
@@ -19,37 +13,22 @@ BusWorker::BusWorker(std::vector<std::unique_ptr<ThrusterDriver>>& drivers) : dr
         views_.push_back(*d);
         published_.push_back(*d);
     }
+    done_.reserve(kWakeEvery * 2);
+    delivering_.reserve(kWakeEvery * 2);
 }
 
 std::string BusWorker::start(sd_event* event, int64_t priority, DoneFn done) {
     on_done_ = std::move(done);
-    if (running())
-        return {};
-    if (std::string e = waker_.open(event, priority, [this] { deliver(); }); !e.empty())
-        return e;
-    stopping_ = false;
-    // Signals stay blocked in this thread as in the one that made it (main blocks them before
-    // the daemon starts): the loop's signal sources must see them.
-    thread_ = std::thread([this] { run(); });
-    return {};
+    return thread_.start(event, priority);
 }
 
 void BusWorker::stop() {
-    if (running()) {
-        {
-            std::lock_guard lk(mu_);
-            stopping_ = true;
-        }
-        wake_.notify_all();
-        thread_.join();
-    }
-    std::lock_guard lk(mu_);
+    thread_.stop();
+    std::lock_guard lk(thread_.mutex());
     queue_.clear();
     done_.clear();
     outstanding_ = 0;
-    for (std::size_t i = 0; i < views_.size(); ++i)
-        views_[i] = published_[i];
-    waker_.close();
+    views_ = published_;
 }
 
 void BusWorker::submit(const BusJob& in, bool replace) {
@@ -65,10 +44,10 @@ void BusWorker::submit(const BusJob& in, bool replace) {
     }
     ++outstanding_;
     {
-        std::lock_guard lk(mu_);
+        std::lock_guard lk(thread_.mutex());
         outstanding_ -= queue_.push(job, replace);
     }
-    wake_.notify_one();
+    thread_.notify();
 }
 
 void BusWorker::submit_first(std::span<const BusJob> jobs) {
@@ -78,40 +57,47 @@ void BusWorker::submit_first(std::span<const BusJob> jobs) {
         return;
     }
     {
-        std::lock_guard lk(mu_);
+        std::lock_guard lk(thread_.mutex());
         outstanding_ -= queue_.replace_all(jobs, epoch_.load());
     }
     outstanding_ += jobs.size();
-    wake_.notify_one();
+    thread_.notify();
 }
 
 void BusWorker::drop_queued() {
-    std::lock_guard lk(mu_);
+    std::lock_guard lk(thread_.mutex());
     outstanding_ -= queue_.clear();
 }
 
-void BusWorker::run() {
-    std::unique_lock lk(mu_);
-    for (;;) {
-        wake_.wait(lk, [this] { return stopping_ || !queue_.empty(); });
-        if (stopping_)
-            return;
-        const BusJob job = queue_.pop();
-        busy_ = true;
-        lk.unlock();
-        const BusJobDone d = transfer(job); // nothing held
-        lk.lock();
-        published_[job.index] = *drivers_[job.index];
-        done_.push_back(d);
-        busy_ = false;
-        finished_.notify_all();
-        // One wake-up of the loop per batch (the queue ran dry), or every kWakeEvery jobs so the
-        // books stay fresh when the bus never rests: a wake-up per transfer would cost the loop
-        // more than the transfer when the device answers at once.
-        if (queue_.empty() || done_.size() >= kWakeEvery) {
-            waker_.wake();
-        }
-    }
+bool BusWorker::run_job(std::unique_lock<std::mutex>& lk) {
+    const BusJob job = queue_.pop();
+    busy_ = true;
+    lk.unlock();
+    const BusJobDone d = transfer(job); // nothing held
+    lk.lock();
+    published_[job.index] = *drivers_[job.index];
+    done_.push_back(d);
+    busy_ = false;
+    owed_ = owed_ || d.error != IoError::None;
+    finished_.notify_all();
+    // One wake-up of the loop per batch (the queue ran dry), or every kWakeEvery jobs so the
+    // books stay fresh when the bus never rests: a wake-up per transfer would cost the loop
+    // more than the transfer when the device answers at once.
+    return (queue_.empty() && (eager_ || owed_)) || done_.size() >= kWakeEvery;
+}
+
+void BusWorker::set_eager(bool eager) {
+    std::lock_guard lk(thread_.mutex());
+    eager_ = eager;
+    if (eager && !done_.empty() && queue_.empty() && !busy_)
+        thread_.wake_loop(); // the batch was over before: its results now
+}
+
+void BusWorker::wake_when_done() {
+    std::lock_guard lk(thread_.mutex());
+    owed_ = true;
+    if (!done_.empty() && queue_.empty() && !busy_)
+        thread_.wake_loop();
 }
 
 BusJobDone BusWorker::transfer(const BusJob& job) {
@@ -121,7 +107,8 @@ BusJobDone BusWorker::transfer(const BusJob& job) {
     BusGate* gate = gate_.load();
     if (gate && !gate->enter(::gettid()))
         return {job, IoError::None, true}; // the crash handler has the bus; the process is ending
-    const IoError e = execute(*drivers_[job.index], job);
+    ThrusterDriver& d = *drivers_[job.index];
+    const IoError e = job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
     if (gate)
         gate->leave();
     return {job, e, false};
@@ -130,8 +117,9 @@ BusJobDone BusWorker::transfer(const BusJob& job) {
 void BusWorker::deliver() {
     delivering_.clear();
     {
-        std::lock_guard lk(mu_);
+        std::lock_guard lk(thread_.mutex());
         delivering_.swap(done_);
+        owed_ = owed_ && (busy_ || !queue_.empty()); // still owed for the rest of the batch
         for (const BusJobDone& d : delivering_)
             views_[d.job.index] = published_[d.job.index];
     }
@@ -145,14 +133,14 @@ void BusWorker::deliver() {
 void BusWorker::wait_idle() {
     while (running() && outstanding_ > 0) {
         {
-            std::unique_lock lk(mu_);
+            std::unique_lock lk(thread_.mutex());
             finished_.wait(lk, [this] { return !done_.empty() || (queue_.empty() && !busy_); });
         }
         const std::size_t before = outstanding_;
         deliver();
         if (outstanding_ == before && before > 0) {
             // Nothing was finished and nothing is queued: the count is off; do not hang.
-            std::lock_guard lk(mu_);
+            std::lock_guard lk(thread_.mutex());
             if (queue_.empty() && !busy_ && done_.empty())
                 outstanding_ = 0;
         }

@@ -1,14 +1,13 @@
-// The thread that carries the I2C transfers, so that the event loop never waits on the bus:
-// a hung thruster holds a transfer for up to the adapter's timeout, and a Kill, a kill switch
-// edge, D-Bus and the watchdog must not queue behind it. The loop hands over one job at a
-// time (an order or a status read), kept in order by its BusJobQueue. Only this thread
-// touches the drivers, the mux state and the adapter's descriptor while a job is out; the
-// loop reads each driver through the copy made after its last job.
-// Finished jobs come back through an eventfd that the worker owns as an event source.
+// Carries the I2C transfers on its own thread (WorkerThread), so that the loop never waits on
+// the bus: a hung thruster holds a transfer up to the adapter's timeout, and a Kill, a kill
+// switch edge, D-Bus and the watchdog must not queue behind it. Each job (an order or a status
+// read) stays in its BusJobQueue's order up to the moment its transfer starts. Only the thread
+// touches the drivers, the mux and the adapter while a job is out; the loop reads each driver
+// through the copy made after its last job.
 #pragma once
 
 #include "daemon/bus_job_queue.hpp"
-#include "daemon/loop_waker.hpp"
+#include "daemon/worker_thread.hpp"
 #include "drivers/devices/bus_gate.hpp"
 #include "drivers/devices/thruster_driver.hpp"
 #include "drivers/platform/event_loop.hpp"
@@ -21,12 +20,11 @@
 #include <mutex>
 #include <span>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace caracara {
 
-class BusWorker {
+class BusWorker final : private WorkerThread::Jobs {
 public:
     using DoneFn = std::function<void(const BusJobDone&)>;
 
@@ -39,7 +37,7 @@ public:
     std::string start(sd_event* event, int64_t priority, DoneFn done);
     // Joins the thread once the job on the wire is over; queued jobs are dropped.
     void stop();
-    bool running() const { return thread_.joinable(); }
+    bool running() const { return thread_.running(); }
 
     // An order goes before the queued status reads and, with `replace`, takes the place of one
     // still queued for the same thruster; a status read goes last.
@@ -57,38 +55,43 @@ public:
     void set_gate(BusGate* gate) { gate_.store(gate); }
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
     bool idle() const { return outstanding_ == 0; }
+    // Eager (the default): the loop is woken as soon as a batch is over. Otherwise it takes the
+    // results itself (collect(), at its next tick: a cycle's routine transfers need no wake-up
+    // of their own), and only a failed transfer or a long batch wakes it.
+    void set_eager(bool eager);
+    // Eager for the jobs handed over so far (call after the last of them): the loop is woken
+    // once they are done (a command's orders: its properties show what is on the wire).
+    void wake_when_done();
+    void collect() { deliver(); }
     // Blocks until idle, handing the finished jobs to `done`: start-up and shutdown only,
     // where the zero orders must be on the wire before the daemon goes on.
     void wait_idle();
-
     // Thruster i as of its last finished job.
     const ThrusterDriver& view(std::size_t i) const { return views_[i]; }
 
 private:
-    void run();
-    void deliver();
+    bool has_job() const override { return !queue_.empty(); }
+    bool run_job(std::unique_lock<std::mutex>& lk) override;
+    void deliver() override;
     // The job's transfer, unless a kill overtook it (`skipped`) or the gate is closed.
     BusJobDone transfer(const BusJob& job);
 
     std::vector<std::unique_ptr<ThrusterDriver>>& drivers_;
     std::vector<ThrusterDriver> views_;     // loop thread
-    std::vector<ThrusterDriver> published_; // under mu_: the worker's copy after each job
+    std::vector<ThrusterDriver> published_; // under the lock: the thread's copy after each job
     std::size_t outstanding_ = 0;           // loop thread
     std::atomic<uint64_t> epoch_{0};
     std::atomic<BusGate*> gate_{nullptr};
 
-    mutable std::mutex mu_;
-    std::condition_variable wake_;      // the worker: a job or stop
-    std::condition_variable finished_;  // wait_idle: a job finished
-    BusJobQueue queue_;
-    std::vector<BusJobDone> done_;
+    std::condition_variable finished_; // wait_idle: a job finished
+    BusJobQueue queue_;                // under the lock
+    std::vector<BusJobDone> done_;     // under the lock
     std::vector<BusJobDone> delivering_; // loop thread; reused
-    bool stopping_ = false;
-    bool busy_ = false; // a job is on the wire
-
-    LoopWaker waker_;
+    bool busy_ = false;                // under the lock: a job is on the wire
+    bool eager_ = true;                // under the lock
+    bool owed_ = false;                // under the lock: the loop must hear of this batch (a failure)
     DoneFn on_done_;
-    std::thread thread_;
+    WorkerThread thread_{*this}; // last: joined before the rest goes
 };
 
 } // namespace caracara

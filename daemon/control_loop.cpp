@@ -43,6 +43,7 @@ std::string ControlLoop::start() {
 
 void ControlLoop::stop() {
     started_ = false;
+    bus_.set_lazy(false); // no more ticks to take the results
     tick_source_.reset();
     work_.stop();
 }
@@ -75,10 +76,10 @@ void ControlLoop::end_cycle() {
 void ControlLoop::bus_done(const BusJob& job) {
     if (!started_ || !bus_.idle())
         return; // more of a kill's zeros to come
-    if (job.kind == BusJobKind::Order && !work_.order_due())
-        work_.step_aside(); // the orders are out: announce, then the rest
-    else if (in_cycle_ && work_.nothing_due())
+    if (in_cycle_ && work_.nothing_due())
         end_cycle(); // the cycle's last transfer: closed here, not by another dispatch of the work
+    else if (job.kind == BusJobKind::Order && !work_.order_due())
+        work_.step_aside(); // the orders are out: announce, then the rest
     else
         work_.schedule_work();
 }
@@ -93,6 +94,8 @@ void ControlLoop::resumed() {
 }
 
 void ControlLoop::cycle() {
+    // The last cycle's results, taken here rather than at a wake-up of their own (may close it).
+    bus_.collect();
     const uint64_t t = monotonic_ns();
     lines_.poll(); // a backstop for a lost edge event
     vehicle_.tick(t);
@@ -104,9 +107,12 @@ void ControlLoop::cycle() {
         // it is done, as at loop rate 0. Refreshing the orders now instead would put them in
         // front of that cycle's status reads at every tick, and they would never be read.
         cycle_overrun_ = true;
+        bus_.set_lazy(false); // its end starts the next one: the loop must hear of it at once
         publish_telemetry_if_due(t);
         return;
     }
+    // At a loop rate the next tick takes this cycle's results; flat out, its end starts the next.
+    bus_.set_lazy(settings_.loop_rate_hz != 0);
     ++cycles_;
     in_cycle_ = true;
     work_.start_cycle(settings_.status_reads_per_tick);

@@ -1,27 +1,25 @@
-// The thread that carries the Teensy's SPI frames, so that a slow or hung Teensy holds only
-// itself: a kill, a D-Bus reply and the watchdog never wait for a frame (busy resends sleep
-// too). Jobs run one at a time in the order handed over; each job's `done` runs afterwards on
-// the loop thread, with one wake-up of the loop per batch (the queue ran dry). Only this thread
-// touches the link and the SPI descriptor while a job is out; the loop reads the link's
-// counters through the copy made after the last job.
+// The worker that carries the Teensy's SPI frames on its own thread (WorkerThread), so that a
+// slow or hung Teensy holds only itself: a kill, a D-Bus reply and the watchdog never wait for
+// a frame (busy resends sleep too). Jobs run one at a time in the order handed over; each job's
+// `done` runs afterwards on the loop thread, with one wake-up of the loop per batch (the queue
+// ran dry). Only the thread touches the link and the SPI descriptor while a job is out; the
+// loop reads the link's counters through the copy made after the last job.
 #pragma once
 
-#include "daemon/loop_waker.hpp"
+#include "daemon/worker_thread.hpp"
 #include "drivers/devices/teensy_link.hpp"
 #include "drivers/platform/event_loop.hpp"
 
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace caracara {
 
-class TeensyWorker {
+class TeensyWorker final : private WorkerThread::Jobs {
 public:
     using Work = std::function<void()>; // on the worker's thread
     using Done = std::function<void()>; // then on the loop thread
@@ -31,11 +29,11 @@ public:
     TeensyWorker(const TeensyWorker&) = delete;
     TeensyWorker& operator=(const TeensyWorker&) = delete;
 
-    std::string start(sd_event* event, int64_t priority);
+    std::string start(sd_event* event, int64_t priority) { return thread_.start(event, priority); }
     // Joins the thread once the job on the wire is over; the finished and queued jobs' `done`
     // run here (queued ones after their work, on this thread: the way out still stops the wheels).
     void stop();
-    bool running() const { return thread_.joinable(); }
+    bool running() const { return thread_.running(); }
 
     // Before start and after stop the work runs at once, on the caller's thread. `wake`: the
     // loop is woken for its `done`; without it, `done` waits for the next wake-up or collect()
@@ -53,24 +51,21 @@ private:
         Done done;
         bool wake = true;
     };
-    void run();
-    void deliver();
+    bool has_job() const override { return !queue_.empty(); }
+    bool run_job(std::unique_lock<std::mutex>& lk) override;
+    void deliver() override;
+    void run_here(Job& job);
 
     const TeensyLink& link_;
-    TeensyLinkCounters counters_;   // loop thread
-    TeensyLinkCounters published_{}; // under mu_
-    std::size_t outstanding_ = 0;   // loop thread
+    TeensyLinkCounters counters_;    // loop thread
+    TeensyLinkCounters published_{}; // under the lock
+    std::size_t outstanding_ = 0;    // loop thread
 
-    std::mutex mu_;
-    std::condition_variable wake_;
-    std::deque<Job> queue_;
-    std::vector<Done> done_;
-    bool wake_owed_ = false; // under mu_: a job in done_ wants the loop woken
+    std::deque<Job> queue_;        // under the lock
+    std::vector<Done> done_;       // under the lock
+    bool wake_owed_ = false;       // under the lock: a job in done_ wants the loop woken
     std::vector<Done> delivering_; // loop thread; reused
-    bool stopping_ = false;
-
-    LoopWaker waker_;
-    std::thread thread_;
+    WorkerThread thread_{*this};   // last: joined before the rest goes
 };
 
 } // namespace caracara

@@ -60,6 +60,14 @@ void ThrusterBus::when_idle(std::function<void()> fn) {
         return;
     }
     when_idle_.push_back(std::move(fn));
+    update_eager();
+}
+
+void ThrusterBus::update_eager() {
+    const bool eager = !lazy_ || !when_idle_.empty() || recovering();
+    if (eager != eager_)
+        worker_.set_eager(eager);
+    eager_ = eager;
 }
 
 void ThrusterBus::done(const BusJobDone& d) {
@@ -74,6 +82,7 @@ void ThrusterBus::done(const BusJobDone& d) {
         when_idle_.clear();
         for (auto& fn : fns)
             fn();
+        update_eager();
     }
     if (on_done_)
         on_done_(d.job);
@@ -83,6 +92,7 @@ void ThrusterBus::set_recovering(bool r) {
     monitor_.set_recovering(r);
     if (r)
         worker_.drop_queued(); // the adapter is about to close; what is on the wire finishes
+    update_eager();
 }
 
 bool ThrusterBus::any_online() const {

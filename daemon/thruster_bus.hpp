@@ -51,6 +51,16 @@ public:
     bool idle() const { return worker_.idle(); }
     // Runs `fn` once the transfers handed over so far are done (at once when idle).
     void when_idle(std::function<void()> fn);
+    // Lazy: the loop takes the results of its routine transfers at its tick (collect()) rather
+    // than being woken for them; it is woken anyway while something waits for the bus to be
+    // idle (when_idle, a recovery) and for a failure (see BusWorker::set_eager).
+    void set_lazy(bool lazy) {
+        lazy_ = lazy;
+        update_eager();
+    }
+    void collect() { worker_.collect(); }
+    // The transfers handed over so far come back at once, lazy or not (see BusWorker).
+    void wake_when_done() { worker_.wake_when_done(); }
 
     // The adapter closed for a bus recovery (its queued work dropped) and open again.
     void set_recovering(bool r);
@@ -70,6 +80,7 @@ public:
 
 private:
     void done(const BusJobDone& d);
+    void update_eager();
 
     BusMonitor monitor_;
     ThrusterHealth health_;
@@ -80,6 +91,8 @@ private:
     std::vector<int32_t> ordered_;
     std::function<void(const BusJob&)> on_done_;
     std::vector<std::function<void()>> when_idle_;
+    bool lazy_ = false;
+    bool eager_ = true; // as last told to the worker
 };
 
 } // namespace caracara

@@ -41,7 +41,8 @@ int AnnouncedObject::emit(uint64_t which) {
     if (r < 0)
         return r;
     MessagePtr m(raw);
-    if ((r = sd_bus_message_append(raw, "s", iface_)) < 0 || (r = sd_bus_message_open_container(raw, 'a', "{sv}")) < 0)
+    // The typed calls, not sd_bus_message_append() with a format string to parse at each signal.
+    if ((r = sd_bus_message_append_basic(raw, 's', iface_)) < 0 || (r = sd_bus_message_open_container(raw, 'a', "{sv}")) < 0)
         return r;
     for (size_t i = 0; i < members_.size(); ++i) {
         if (!(which & (uint64_t{1} << i)))
@@ -57,7 +58,7 @@ int AnnouncedObject::emit(uint64_t which) {
         if (r < 0 || (r = sd_bus_message_close_container(raw)) < 0 || (r = sd_bus_message_close_container(raw)) < 0)
             return r;
     }
-    if ((r = sd_bus_message_close_container(raw)) < 0 || (r = sd_bus_message_append(raw, "as", 0)) < 0)
+    if ((r = sd_bus_message_close_container(raw)) < 0 || (r = sd_bus_message_append_strv(raw, nullptr)) < 0)
         return r;
     return sd_bus_send(bus_, raw, nullptr);
 }

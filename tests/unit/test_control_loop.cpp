@@ -34,7 +34,8 @@ TEST_CASE("a changed order goes out at once, not at the next tick") {
     REQUIRE(rig.run_until([&] { return rig.loop().cycles() > cycles; }));
     rig.wire().clear();
     const auto is_read = [](const WireEvent& e) { return e.kind == Kind::StatusRead; };
-    REQUIRE(rig.run_until([&] { return find(rig.wire().events(), is_read) >= 0 && rig.daemon().bus().idle(); }));
+    // The status read is the cycle's last transfer (its results are taken at the next tick).
+    REQUIRE(rig.run_until([&] { return find(rig.wire().events(), is_read) >= 0; }));
     rig.wire().clear();
     m[2] = 3000;
     rig.loop().demand_changed(m);
