@@ -22,6 +22,14 @@ MotorValues values(int32_t base) {
         m[i] = base * static_cast<int32_t>(i + 1);
     return m;
 }
+
+// Every thruster's order with its value of `m` (as the wire carries it) is in `events`.
+bool all_ordered(const std::vector<WireEvent>& events, const MotorValues& m) {
+    for (std::size_t i = 0; i < m.size(); ++i)
+        if (find(events, [&](const WireEvent& e) { return e.is_order(i, on_wire(m[i])); }) < 0)
+            return false;
+    return true;
+}
 } // namespace
 
 TEST_CASE("a changed order goes out at once, not at the next tick") {
@@ -50,14 +58,7 @@ TEST_CASE("the tick refreshes every order with the value it was handed, and read
     rig.run_until_ready();
     const MotorValues m = values(500);
     rig.loop().demand_changed(m);
-    const auto holds_m = [&] {
-        const auto ev = rig.wire().events();
-        for (std::size_t i = 0; i < 8; ++i)
-            if (find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(m[i])); }) < 0)
-                return false;
-        return true;
-    };
-    REQUIRE(rig.run_until(holds_m));
+    REQUIRE(rig.run_until([&] { return all_ordered(rig.wire().events(), m); }));
     rig.wire().clear();
     // About twenty ticks: each thruster refreshed at least five times, each one's status read.
     std::array<int, 8> orders{};
@@ -87,14 +88,7 @@ TEST_CASE("zeros behind: the orders already due reach the wire first") {
     rig.loop().demand_changed(m);
     rig.loop().zero_all(ZeroOrder::Behind); // before the loop ran: all eight still due
     // Waited for on the wire: the bus is idle only between a cycle's results and the next tick.
-    const auto all_zeroed = [&] {
-        const auto ev = rig.wire().events();
-        for (std::size_t i = 0; i < 8; ++i)
-            if (find(ev, [&](const WireEvent& e) { return e.is_order(i, 0); }) < 0)
-                return false;
-        return true;
-    };
-    REQUIRE(rig.run_until(all_zeroed));
+    REQUIRE(rig.run_until([&] { return all_ordered(rig.wire().events(), MotorValues{}); }));
     const auto ev = rig.wire().events();
     for (std::size_t i = 0; i < 8; ++i) {
         const long sent = find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(m[i])); });
@@ -121,13 +115,7 @@ TEST_CASE("a recovered bus gets every standing order again") {
     DaemonRig rig("loop_rate_hz = 2\n");
     rig.run_until_ready();
     const MotorValues m = values(300);
-    const auto all_on_wire = [&] {
-        const auto ev = rig.wire().events();
-        for (std::size_t i = 0; i < 8; ++i)
-            if (find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(m[i])); }) < 0)
-                return false;
-        return true;
-    };
+    const auto all_on_wire = [&] { return all_ordered(rig.wire().events(), m); };
     rig.loop().demand_changed(m);
     REQUIRE(rig.run_until(all_on_wire));
     rig.wire().clear();
