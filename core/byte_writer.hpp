@@ -1,5 +1,5 @@
 // Appends little-endian integers, floats and length-prefixed strings to a byte vector (the
-// dive file's encoding).
+// dive file's encoding), or to a FixedBytes on the stack for a record of bounded size.
 #pragma once
 
 #include <bit>
@@ -10,9 +10,10 @@
 
 namespace caracara {
 
-class ByteWriter {
+template <typename Out>
+class BasicByteWriter {
 public:
-    explicit ByteWriter(std::vector<uint8_t>& out) : out_(out) {}
+    explicit BasicByteWriter(Out& out) : out_(out) {}
     void u8(uint8_t v) { out_.push_back(v); }
     void u16(uint16_t v) { le(v, 2); }
     void u32(uint32_t v) { le(v, 4); }
@@ -36,10 +37,19 @@ public:
 
 private:
     void le(uint64_t v, int n) {
-        for (int i = 0; i < n; ++i)
-            out_.push_back(static_cast<uint8_t>(v >> (8 * i)));
+        if constexpr (requires(const uint8_t* b) { out_.append(b, std::size_t{}); }) {
+            uint8_t b[8];
+            for (int i = 0; i < n; ++i)
+                b[i] = static_cast<uint8_t>(v >> (8 * i));
+            out_.append(b, static_cast<std::size_t>(n));
+        } else {
+            for (int i = 0; i < n; ++i)
+                out_.push_back(static_cast<uint8_t>(v >> (8 * i)));
+        }
     }
-    std::vector<uint8_t>& out_;
+    Out& out_;
 };
+
+using ByteWriter = BasicByteWriter<std::vector<uint8_t>>;
 
 } // namespace caracara

@@ -2,6 +2,7 @@
 #include "core/byte_writer.hpp"
 #include "core/crc32.hpp"
 #include "core/dive_format.hpp"
+#include "core/fixed_bytes.hpp"
 
 #include <algorithm>
 
@@ -9,10 +10,15 @@ namespace caracara::dive {
 
 namespace {
 
+// The largest sample record: kind, length, time, requested and applied values, budget, flags,
+// the thrusters, orientation, bus counters, then the distances.
+constexpr std::size_t kMaxSampleRecord =
+    1 + 2 + 4 + 2 * kThrusters * 2 + 2 + 1 + kThrusters * 18 + 3 * 4 + 2 * 4 + 1 + kMaxDistances * 2;
+
 // u8 kind, u16 length, then the body `fill` writes.
-template <typename Fill>
-void record(std::vector<uint8_t>& out, RecordKind kind, Fill fill) {
-    ByteWriter w(out);
+template <typename Out, typename Fill>
+void record(Out& out, RecordKind kind, Fill fill) {
+    BasicByteWriter<Out> w(out);
     w.u8(static_cast<uint8_t>(kind));
     const std::size_t len_at = w.size();
     w.u16(0);
@@ -54,7 +60,10 @@ std::vector<uint8_t> encode_header(const Header& h) {
 }
 
 void encode_sample(std::vector<uint8_t>& records, const Sample& s) {
-    record(records, RecordKind::Sample, [&](ByteWriter& w) {
+    // Written on the stack and appended at once: a sample is about a hundred fields, at every
+    // control-loop tick.
+    FixedBytes<kMaxSampleRecord> bytes;
+    record(bytes, RecordKind::Sample, [&](auto& w) {
         w.u32(s.t_100us);
         for (int16_t v : s.requested)
             w.i16(v);
@@ -81,6 +90,8 @@ void encode_sample(std::vector<uint8_t>& records, const Sample& s) {
         for (std::size_t i = 0; i < n; ++i)
             w.u16(s.distances[i]);
     });
+    if (!bytes.overflowed()) // cannot happen: kMaxSampleRecord is the record's bound
+        records.insert(records.end(), bytes.begin(), bytes.end());
 }
 
 void encode_event(std::vector<uint8_t>& records, const Event& e) {

@@ -63,6 +63,12 @@ void BusWorkDispatch::pause() {
 
 int BusWorkDispatch::on_work(sd_event_source*, void* userdata) {
     auto* self = static_cast<BusWorkDispatch*>(userdata);
+    // The transfers of this pass wake the bus worker once, at its end (whichever way it ends).
+    self->bus_.hold_wakeups();
+    struct Release {
+        ThrusterBus& bus;
+        ~Release() { bus.release_wakeups(); }
+    } release{self->bus_};
     // The cycle's transfers are handed to the bus worker as one batch (orders first; see
     // BusWorker::submit); the Teensy's slots run here meanwhile. The end of the batch
     // (ControlLoop::bus_done) brings the work back to close the cycle.

@@ -47,7 +47,17 @@ void BusWorker::submit(const BusJob& in, bool replace) {
         std::lock_guard lk(thread_.mutex());
         outstanding_ -= queue_.push(job, replace);
     }
-    thread_.notify();
+    if (holding_wakeups_)
+        wakeup_owed_ = true;
+    else
+        thread_.notify();
+}
+
+void BusWorker::release_wakeups() {
+    holding_wakeups_ = false;
+    if (wakeup_owed_)
+        thread_.notify();
+    wakeup_owed_ = false;
 }
 
 void BusWorker::submit_first(std::span<const BusJob> jobs) {
@@ -105,7 +115,9 @@ BusJobDone BusWorker::transfer(const BusJob& job) {
     if (job.kind == BusJobKind::Order && job.value != 0 && job.epoch != epoch_.load())
         return {job, IoError::None, true};
     BusGate* gate = gate_.load();
-    if (gate && !gate->enter(::gettid()))
+    // The thread's id, taken once: gettid() is a system call, and this runs for every transfer.
+    thread_local const pid_t self = ::gettid();
+    if (gate && !gate->enter(self))
         return {job, IoError::None, true}; // the crash handler has the bus; the process is ending
     ThrusterDriver& d = *drivers_[job.index];
     const IoError e = job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();

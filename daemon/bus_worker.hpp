@@ -42,6 +42,11 @@ public:
     // An order goes before the queued status reads and, with `replace`, takes the place of one
     // still queued for the same thruster; a status read goes last.
     void submit(const BusJob& job, bool replace = true);
+    // The thread is woken once for the jobs submitted between these two (a dispatch of the
+    // cycle's work), not at each: when the device answers at once, a wake-up per job costs
+    // more than the job. submit_first() always wakes it at once.
+    void hold_wakeups() { holding_wakeups_ = true; }
+    void release_wakeups();
     // `jobs` go before everything queued, which is dropped (a kill's zero orders).
     void submit_first(std::span<const BusJob> jobs);
     // Drops what is queued but not yet on the wire (the bus is closed for recovery).
@@ -80,6 +85,8 @@ private:
     std::vector<ThrusterDriver> views_;     // loop thread
     std::vector<ThrusterDriver> published_; // under the lock: the thread's copy after each job
     std::size_t outstanding_ = 0;           // loop thread
+    bool holding_wakeups_ = false;          // loop thread
+    bool wakeup_owed_ = false;              // loop thread: a job was submitted while holding
     std::atomic<uint64_t> epoch_{0};
     std::atomic<BusGate*> gate_{nullptr};
 

@@ -36,11 +36,16 @@ int FailsafeMonitor::on_timer(sd_event_source* s, uint64_t usec, void* userdata)
 
 void FailsafeMonitor::poll(uint64_t now) {
     FailsafeTransitions ts;
-    for (std::size_t i = 0; i < thrusters_; ++i)
-        if (const auto r = readings_(i)) {
-            FailsafeTransitions t = policy_.observe(i, r->fault_bits, r->temperature_c, now);
-            ts.insert(ts.end(), t.begin(), t.end());
-        }
+    for (std::size_t i = 0; i < thrusters_ && i < kMotorCount; ++i) {
+        // A reading seen already changes nothing in the policy (a condition's persistence runs
+        // on in its tick): a status reply comes every few cycles, the poll at 20 Hz.
+        const auto r = readings_(i);
+        if (!r || r == observed_[i])
+            continue;
+        observed_[i] = r;
+        FailsafeTransitions t = policy_.observe(i, r->fault_bits, r->temperature_c, now);
+        ts.insert(ts.end(), t.begin(), t.end());
+    }
     FailsafeTransitions own = look_at_conditions(now);
     ts.insert(ts.end(), own.begin(), own.end());
     report_.tell(ts);

@@ -74,6 +74,7 @@ private:
     SourcePtr timer_;
     uint64_t period_us_;
     std::array<bool, kMotorCount> excluded_{};
+    std::array<std::optional<FailsafeReading>, kMotorCount> observed_{}; // each thruster's reading last observed
     std::optional<FailsafeCondition> overriding_; // set aside during ClearKillOverride's ClearKill
 };
 

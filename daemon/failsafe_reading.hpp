@@ -10,6 +10,8 @@ namespace caracara {
 struct FailsafeReading {
     uint8_t fault_bits = 0;                // SeaBotix IDS 8.4.2 FAULT bit order
     std::optional<uint8_t> temperature_c;  // SeaBotix controllers only
+
+    bool operator==(const FailsafeReading&) const = default;
 };
 
 } // namespace caracara

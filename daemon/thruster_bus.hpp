@@ -38,6 +38,9 @@ public:
     // Each hands one transfer to the worker; its outcome arrives later through done().
     void send_order(std::size_t i, int32_t value);
     void read_status(std::size_t i);
+    // The transfers handed over in between wake the worker once (see BusWorker).
+    void hold_wakeups() { worker_.hold_wakeups(); }
+    void release_wakeups() { worker_.release_wakeups(); }
     // Zero to every thruster, back to back: nothing may come between a kill and its zeros.
     void zero_all(ZeroOrder where = ZeroOrder::First);
     // Before a kill's kill output: no non-zero order handed over earlier goes out after it.

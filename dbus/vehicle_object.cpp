@@ -128,7 +128,7 @@ constexpr Member kMembers[] = {
     property<[](D d) { return control(d).command_timeout_ms; }>("CommandTimeoutMs", kConst),
     property<[](D d) { return control(d).arming_delay_ms; }>("ArmingDelayMs", kConst),
     property<[](D d) { return double(control(d).loop_rate_hz); }>("LoopRateHz", kConst),
-    property<[](D d) { return d.loop.cycles(); }>("Cycles", kChange, kTelemetryTick),
+    property<[](D d) { return d.loop.cycles(); }>("Cycles", kChange, kCounterTick), // every cycle: 1 Hz
 };
 constexpr auto kVtable = vtable(kMembers);
 
