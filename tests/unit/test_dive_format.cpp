@@ -98,6 +98,33 @@ TEST_CASE("a dive reads back as written") {
     CHECK(r.samples[0].bus_state() == 1);
 }
 
+TEST_CASE("the largest sample (every thruster, every distance, extreme values) reads back whole") {
+    // The sample is written on the stack with room for exactly the format's largest record: a
+    // wrong bound would drop it (or cut it), and this dive would not read back.
+    dive::Dive d;
+    d.header = {1, 2, 50, "water", "clear-kill"};
+    dive::Sample s;
+    s.t_100us = UINT32_MAX;
+    s.requested.fill(INT16_MAX);
+    s.applied.fill(INT16_MIN + 1);
+    s.budget_limit = INT16_MAX;
+    s.flags = static_cast<uint8_t>(dive::kSaturated | dive::kKillSwitch | dive::kTeensyOnline | dive::kKillOutput |
+                                   (2u << dive::kBusStateShift)); // bus lost, the last state
+    for (auto& t : s.thrusters)
+        t = {INT16_MIN, 0xFF, 0xFF, 0x1F, 0xFF, UINT32_MAX, UINT32_MAX, UINT32_MAX}; // every FAULT bit
+    s.orientation = {-1e30f, 1e30f, 3.5f};
+    s.distances.assign(dive::kMaxDistances, 0xFFFF);
+    s.bus_errors = UINT32_MAX;
+    s.bus_recoveries = UINT32_MAX;
+    d.samples = {s, s};
+    d.ended = true;
+    d.end = {UINT32_MAX, "killed (dbus)"};
+    const dive::Dive r = dive::decode(encode(d));
+    REQUIRE(r.ok());
+    REQUIRE(r.samples.size() == 2);
+    CHECK(r.samples[1] == s);
+}
+
 TEST_CASE("the documented layout: magic, version, little-endian fields, block header") {
     const auto h = dive::encode_header({0x0102030405060708ull, 0, 50, "", ""});
     CHECK(std::string(h.begin(), h.begin() + 8) == "CARADIVE");
