@@ -20,7 +20,7 @@ ControlLoop::ControlLoop(sd_event* event, const ControlSettings& settings, Vehic
       bus_(bus),
       lines_(lines),
       events_(events),
-      work_(event, bus, teensy, lines, [this] { end_cycle(); }, [this] { resumed(); }) {}
+      work_(event, bus, teensy, lines, [this] { end_cycle(); }, [this] { resumed(); }, [this] { orders_out(true); }) {}
 
 std::string ControlLoop::start() {
     if (std::string e = work_.start(); !e.empty())
@@ -42,6 +42,7 @@ std::string ControlLoop::start() {
 }
 
 void ControlLoop::stop() {
+    orders_out(false);
     started_ = false;
     bus_.set_lazy(false); // no more ticks to take the results
     tick_source_.reset();
@@ -73,9 +74,17 @@ void ControlLoop::end_cycle() {
         work_.pause();
 }
 
+void ControlLoop::orders_out(bool in_flight) {
+    if (in_flight == orders_in_flight_)
+        return;
+    orders_in_flight_ = in_flight;
+    events_.orders_in_flight(in_flight);
+}
+
 void ControlLoop::bus_done(const BusJob& job) {
     if (!started_ || !bus_.idle())
         return; // more of a kill's zeros to come
+    orders_out(false);
     if (in_cycle_ && work_.nothing_due())
         end_cycle(); // the cycle's last transfer: closed here, not by another dispatch of the work
     else if (job.kind == BusJobKind::Order && !work_.order_due())
@@ -96,6 +105,7 @@ void ControlLoop::resumed() {
 void ControlLoop::cycle() {
     // The last cycle's results, taken here rather than at a wake-up of their own (may close it).
     bus_.collect();
+    orders_out(false); // at the latest: a dropped order (a recovery) never comes back as done
     const uint64_t t = monotonic_ns();
     lines_.poll(); // a backstop for a lost edge event
     vehicle_.tick(t);

@@ -49,6 +49,8 @@ private:
     void end_cycle();
     void resumed();
     void publish_telemetry_if_due(uint64_t now_ns);
+    // A command's orders handed to the bus worker / all on the wire (told to the presentation).
+    void orders_out(bool in_flight);
 
     sd_event* event_;
     const ControlSettings& settings_;
@@ -62,6 +64,7 @@ private:
     bool started_ = false;
     bool in_cycle_ = false;
     bool cycle_overrun_ = false; // a tick came while a cycle was still going
+    bool orders_in_flight_ = false;
     uint64_t cycles_ = 0;
     uint64_t last_cycle_ns_ = 0;
     uint64_t last_telemetry_ns_ = 0;

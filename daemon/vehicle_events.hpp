@@ -30,6 +30,10 @@ public:
         if (recorder_)
             recorder_->cycle(now_ns);
     }
+    void orders_in_flight(bool in_flight) {
+        if (observer_)
+            observer_->orders_in_flight(in_flight);
+    }
     void bus_lost(const std::string& reason) {
         for (VehicleObserver* o : {recorder_, observer_})
             if (o)

@@ -34,6 +34,9 @@ public:
     virtual void bus_restored(uint32_t /*pulses*/, double /*milliseconds*/) {}
     // Every control-loop cycle (the dive recorder's samples).
     virtual void cycle(uint64_t /*now_ns*/) {}
+    // A command's orders were handed to the bus worker (true) and are now all on the wire
+    // (false): what announces the command may wait for the wire it describes.
+    virtual void orders_in_flight(bool /*in_flight*/) {}
     // A failsafe was raised or its condition cleared (daemon/failsafe_monitor).
     virtual void failsafe(const ActiveFailsafe& /*f*/, bool /*raised*/) {}
 };

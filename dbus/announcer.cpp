@@ -20,8 +20,17 @@ void Announcer::request(uint32_t changes) {
         on_flush(nullptr, this); // no event loop to defer to: now
 }
 
+void Announcer::hold(bool held) {
+    held_ = held;
+    if (!held && pending_)
+        request(0);
+}
+
 int Announcer::on_flush(sd_event_source*, void* userdata) {
     auto* self = static_cast<Announcer*>(userdata);
+    constexpr uint32_t kWaitForTheWire = kChangeMotors | kChangeController | kTelemetryTick;
+    if (self->held_ && !(self->pending_ & ~kWaitForTheWire))
+        return 0; // hold(false) brings them
     uint32_t changes = self->pending_;
     self->pending_ = 0;
     if ((changes & kTelemetryTick) && ++self->ticks_ % 5 == 0)

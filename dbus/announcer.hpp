@@ -22,6 +22,11 @@ public:
     Announcer(sd_bus* bus, Flush flush) : bus_(bus), flush_(std::move(flush)) {}
     // VehicleChange flags and/or kTelemetryTick.
     void request(uint32_t changes);
+    // While a command's orders are on their way to the wire, what announces the command (its
+    // motor values, its controller) and telemetry wait for them: the signal then says what the
+    // wire carries, and is not built while the command's reply, the bus worker and the devices
+    // want the CPU. Everything else (a kill's state, a fault) goes at once, and takes what waits.
+    void hold(bool held);
 
 private:
     static int on_flush(sd_event_source*, void* userdata);
@@ -29,6 +34,7 @@ private:
     sd_bus* bus_;
     Flush flush_;
     uint32_t pending_ = 0;
+    bool held_ = false;
     uint64_t ticks_ = 0;
     SourcePtr source_;
 };

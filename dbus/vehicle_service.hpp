@@ -40,6 +40,7 @@ public:
 
     void vehicle_changed(uint32_t changes) override { announcer_.request(changes); }
     void telemetry() override { announcer_.request(kTelemetryTick); }
+    void orders_in_flight(bool in_flight) override { announcer_.hold(in_flight); }
     void bus_lost(const std::string& reason) override { bus_object_.emit_lost(reason); }
     void bus_restored(uint32_t pulses, double milliseconds) override { bus_object_.emit_restored(pulses, milliseconds); }
     void failsafe(const ActiveFailsafe& f, bool raised) override {
