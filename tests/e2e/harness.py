@@ -53,6 +53,8 @@ def binary(name):
 # tests with (CARACARA_TEST_EMULATOR, set by tests/CMakeLists.txt), while python3, busctl and
 # dbus-daemon stay native.
 EMULATOR = os.environ.get("CARACARA_TEST_EMULATOR", "").split()
+# ASan+UBSan builds (CARACARA_SANITIZE): correct, but their CPU time is the instrumentation's.
+SANITIZED = os.environ.get("CARACARA_TEST_SANITIZED") == "1"
 
 
 def command(name):

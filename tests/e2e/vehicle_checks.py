@@ -21,10 +21,11 @@ def cpu_seconds(pid):
 
 def assert_idle_cpu(test, cpu_percent):
     """A daemon whose devices vanished idles: at most VANISHED_CPU_PERCENT_MAX of a core. Judged
-    natively: under qemu-user (the arm64 run) the CPU is the emulator's, every instruction
-    translated (2.2-2.6 % seen there for the same idle loop), as soak.py's RSS."""
+    on the plain native build: under qemu-user (the arm64 run) the CPU is the emulator's, every
+    instruction translated, and under ASan+UBSan the instrumentation's (2.2-2.6 % seen in both for
+    the same idle loop, 0.5-0.6 % natively), as soak.py's RSS."""
     from bounds import VANISHED_CPU_PERCENT_MAX
-    if not harness.EMULATOR:
+    if not harness.EMULATOR and not harness.SANITIZED:
         test.assertLessEqual(cpu_percent, VANISHED_CPU_PERCENT_MAX)
 
 
