@@ -6,7 +6,7 @@ set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 build=${CARACARA_BENCH_BUILD:-$top/build-bench}
 cmake -S "$top" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build "$build" -j"${JOBS:-$(nproc)}" --target caracarad caracara-sim caracara-bench caracara-bench-floor >/dev/null
+cmake --build "$build" -j"${JOBS:-$(nproc)}" --target caracarad caracara-sim caracara-bench caracara-bench-floor caracara-bridge >/dev/null
 # /usr/bin/python3 explicitly: only the standard library is used, but a pyenv python on PATH
 # is not guaranteed to be a working interpreter for system tools.
 exec /usr/bin/python3 "$top/bench/run.py" --build "$build" "$@"
