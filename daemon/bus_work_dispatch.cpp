@@ -12,14 +12,14 @@ constexpr int kTransactionsPerDispatch = 32;
 
 BusWorkDispatch::BusWorkDispatch(sd_event* event, ThrusterBus& bus, TeensyPort& teensy, SafetyLines& lines,
                                  std::function<void()> cycle_work_done, std::function<void()> resumed,
-                                 std::function<void()> command_out)
+                                 std::function<void()> command_handed_over)
     : event_(event),
       bus_(bus),
       teensy_(teensy),
       lines_(lines),
       cycle_work_done_(std::move(cycle_work_done)),
       resumed_(std::move(resumed)),
-      command_out_fn_(std::move(command_out)),
+      command_handed_over_(std::move(command_handed_over)),
       schedule_(bus.size()) {}
 
 std::string BusWorkDispatch::start() {
@@ -81,7 +81,7 @@ int BusWorkDispatch::on_work(sd_event_source*, void* userdata) {
         if (w == Work::Waiting) {
             if (self->command_out_) {
                 self->bus_.wake_when_done(); // a command's orders: its properties follow the wire at once
-                self->command_out_fn_();
+                self->command_handed_over_();
             }
             self->command_out_ = false;
             sd_event_source_set_enabled(self->work_source_.get(), SD_EVENT_OFF);

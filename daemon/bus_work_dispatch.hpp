@@ -30,11 +30,11 @@ inline constexpr int64_t kAnnouncePriority = kWorkPriority + 1;
 class BusWorkDispatch final {
 public:
     // `cycle_work_done`: nothing is due and the bus is idle (the cycle can close);
-    // `resumed`: the work stepped aside and what is below it ran; `command_out`: a command's
-    // changed orders are all handed to the bus worker.
+    // `resumed`: the work stepped aside and what is below it ran; `command_handed_over`: a
+    // command's changed orders are all handed to the bus worker.
     BusWorkDispatch(sd_event* event, ThrusterBus& bus, TeensyPort& teensy, SafetyLines& lines,
                     std::function<void()> cycle_work_done, std::function<void()> resumed,
-                    std::function<void()> command_out);
+                    std::function<void()> command_handed_over);
 
     std::string start(); // "" or why the sources could not be made
     void stop();
@@ -70,7 +70,7 @@ private:
     SafetyLines& lines_;
     std::function<void()> cycle_work_done_;
     std::function<void()> resumed_;
-    std::function<void()> command_out_fn_;
+    std::function<void()> command_handed_over_;
     const InputProbe* input_ = nullptr;
 
     OrderSchedule schedule_;

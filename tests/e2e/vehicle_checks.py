@@ -5,6 +5,7 @@ import os
 import time
 
 import harness
+from bounds import VANISHED_CPU_PERCENT_MAX
 from harness import (DEFAULT_MT, MOTORS, PROPS, ROOT, VEHICLE, poll, pump_main_loop, speed_byte)
 
 
@@ -24,7 +25,6 @@ def assert_idle_cpu(test, cpu_percent):
     on the plain native build: under qemu-user (the arm64 run) the CPU is the emulator's, every
     instruction translated, and under ASan+UBSan the instrumentation's (2.2-2.6 % seen in both for
     the same idle loop, 0.5-0.6 % natively), as soak.py's RSS."""
-    from bounds import VANISHED_CPU_PERCENT_MAX
     if not harness.EMULATOR and not harness.SANITIZED:
         test.assertLessEqual(cpu_percent, VANISHED_CPU_PERCENT_MAX)
 
