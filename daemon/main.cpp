@@ -1,14 +1,14 @@
 // caracarad: the Caracara vehicle daemon. One sd-event loop; see docs/architecture.md.
 #include "core/config.hpp"
+#include "daemon/loop/log.hpp"
 #include "daemon/vehicle_daemon.hpp"
-#include "drivers/platform/hardware.hpp"
+#include "dbus/bus_input_probe.hpp"
+#include "dbus/vehicle_service.hpp"
 #include "drivers/devices/emergency_stop.hpp"
 #include "drivers/devices/final_stop.hpp"
+#include "drivers/platform/hardware.hpp"
 #include "drivers/platform/io_error.hpp"
-#include "daemon/log.hpp"
-#include "dbus/bus_input_probe.hpp"
 #include "drivers/sdbus/sdbus.hpp"
-#include "dbus/vehicle_service.hpp"
 
 #include <csignal>
 #include <cstdio>

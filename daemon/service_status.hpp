@@ -2,10 +2,10 @@
 // STOPPING=1, and the watchdog, fed only while the control loop keeps completing cycles.
 #pragma once
 
-#include "daemon/control_loop.hpp"
-#include "daemon/thruster_bus.hpp"
-#include "daemon/vehicle.hpp"
-#include "daemon/vehicle_observer.hpp"
+#include "daemon/bus/thruster_bus.hpp"
+#include "daemon/control/control_loop.hpp"
+#include "daemon/vehicle/vehicle.hpp"
+#include "daemon/interfaces/vehicle_observer.hpp"
 #include "drivers/platform/event_loop.hpp"
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 #include "daemon/vehicle_daemon.hpp"
 
-#include "daemon/log.hpp"
+#include "daemon/loop/log.hpp"
 #include "drivers/platform/io_error.hpp"
 
 namespace caracara {

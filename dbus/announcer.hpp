@@ -3,7 +3,7 @@
 // orders of the change (see kAnnouncePriority). Steady counters go out at every fifth tick.
 #pragma once
 
-#include "daemon/control_loop.hpp" // kAnnouncePriority
+#include "daemon/control/control_loop.hpp" // kAnnouncePriority
 #include "drivers/sdbus/sdbus.hpp"
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 // The control loop's InputProbe over an sd-bus connection.
 #pragma once
 
-#include "daemon/input_probe.hpp"
+#include "daemon/interfaces/input_probe.hpp"
 
 #include <systemd/sd-bus.h>
 

@@ -1,7 +1,7 @@
 // /org/caracara/Vehicle1/bus, org.caracara.Vehicle1.Bus: the I2C bus, its errors and recoveries.
 #pragma once
 
-#include "daemon/bus_monitor.hpp"
+#include "daemon/bus/bus_monitor.hpp"
 #include "dbus/announced_object.hpp"
 
 #include <string>

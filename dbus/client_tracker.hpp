@@ -3,7 +3,7 @@
 // the pilot-lost failsafe's.
 #pragma once
 
-#include "daemon/vehicle.hpp"
+#include "daemon/vehicle/vehicle.hpp"
 #include "drivers/sdbus/sdbus.hpp"
 
 namespace caracara::dbus {

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "core/status.hpp"
-#include "daemon/completion.hpp"
+#include "daemon/loop/completion.hpp"
 
 #include <string>
 #include <systemd/sd-bus.h>

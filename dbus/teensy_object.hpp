@@ -2,7 +2,7 @@
 // behind the Teensy, and its SPI link.
 #pragma once
 
-#include "daemon/teensy_port.hpp"
+#include "daemon/teensy/teensy_port.hpp"
 #include "dbus/announced_object.hpp"
 
 namespace caracara::dbus {

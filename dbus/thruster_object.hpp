@@ -2,7 +2,7 @@
 // status and counters.
 #pragma once
 
-#include "daemon/thruster_bus.hpp"
+#include "daemon/bus/thruster_bus.hpp"
 #include "dbus/announced_object.hpp"
 
 namespace caracara::dbus {

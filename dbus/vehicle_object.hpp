@@ -2,11 +2,11 @@
 #pragma once
 
 #include "core/config.hpp"
-#include "daemon/control_loop.hpp"
-#include "daemon/failsafe_monitor.hpp"
-#include "daemon/packet_handler.hpp"
-#include "daemon/teensy_port.hpp"
-#include "daemon/vehicle.hpp"
+#include "daemon/failsafe/failsafe_monitor.hpp"
+#include "daemon/teensy/teensy_port.hpp"
+#include "daemon/control/control_loop.hpp"
+#include "daemon/vehicle/packet_handler.hpp"
+#include "daemon/vehicle/vehicle.hpp"
 #include "dbus/announced_object.hpp"
 
 namespace caracara::dbus {

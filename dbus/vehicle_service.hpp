@@ -2,19 +2,19 @@
 // in daemon/; the contract is the XML files beside this header.
 #pragma once
 
-#include "daemon/bus_monitor.hpp"
-#include "daemon/teensy_port.hpp"
-#include "daemon/thruster_bus.hpp"
-#include "daemon/vehicle_events.hpp"
-#include "daemon/vehicle_observer.hpp"
+#include "daemon/bus/bus_monitor.hpp"
+#include "daemon/bus/thruster_bus.hpp"
+#include "daemon/teensy/teensy_port.hpp"
+#include "daemon/interfaces/vehicle_events.hpp"
+#include "daemon/interfaces/vehicle_observer.hpp"
 #include "dbus/announcer.hpp"
 #include "dbus/bus_object.hpp"
 #include "dbus/client_tracker.hpp"
-#include "drivers/sdbus/sdbus.hpp"
 #include "dbus/teensy_object.hpp"
 #include "dbus/thruster_object.hpp"
 #include "dbus/vehicle_names.hpp"
 #include "dbus/vehicle_object.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 
 #include <memory>
 #include <string>

@@ -29,7 +29,7 @@ VANISHED_LOG_LINES_MAX = 10
 COMMAND_TIMEOUT_LATENESS_MS_MAX = 3.0
 
 # A SIGKILL in mid-dive: the recorder hands the writer a block once a second (kFlushPeriodNs in
-# daemon/dive_recorder.cpp), which writes and fdatasyncs it, so the file lacks at most the last
+# daemon/dive/dive_recorder.cpp), which writes and fdatasyncs it, so the file lacks at most the last
 # second (docs/dive-format.md). The 0.2 s on top is the test's own uncertainty: the dive's start
 # is known only to within the ClearKill call, and the last block's write takes its time.
 DIVE_CRASH_LOSS_S_MAX = 1.0 + 0.2

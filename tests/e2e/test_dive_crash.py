@@ -14,7 +14,7 @@ import unittest
 from bounds import DIVE_CRASH_LOSS_S_MAX
 from harness import EMULATOR, MOTORS, Rig, command, speed_byte
 
-# daemon/dive_recorder.cpp's kFlushBytes: a block is handed over once this much is buffered, so
+# daemon/dive/dive_recorder.cpp's kFlushBytes: a block is handed over once this much is buffered, so
 # it holds at most this plus the record that passed it (a sample is about 220 bytes).
 BLOCK_BYTES_MAX = 64 * 1024 + 1024
 

@@ -2,7 +2,7 @@
 // the directory passes its bound, the oldest dives go, as many as it takes and no more, never the
 // one being written; a dive that alone passes the bound stops being recorded. Real files in a
 // temporary directory, the writer's own thread.
-#include "daemon/dive_writer.hpp"
+#include "daemon/dive/dive_writer.hpp"
 #include "drivers/platform/dive_files.hpp"
 #include "tests/catch.hpp"
 

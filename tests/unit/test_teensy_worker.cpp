@@ -1,10 +1,10 @@
 // TeensyWorker on an sd-event loop of its own: jobs run in order on its thread, their results
 // come back on the loop's, and a job held on the wire (a hung Teensy) does not hold the loop.
-#include "daemon/teensy_worker.hpp"
+#include "daemon/teensy/teensy_worker.hpp"
 
+#include "core/config.hpp"
 #include "tests/unit/fakes/fake_device_io.hpp"
 #include "tests/unit/fakes/fake_wire.hpp"
-#include "core/config.hpp"
 
 #include "tests/catch.hpp"
 

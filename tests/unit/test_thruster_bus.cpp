@@ -1,7 +1,7 @@
 // ThrusterBus and its BusWorker on the in-process fake of the device seam (FakeDeviceIo):
 // what reaches the wire when a kill's zeros overtake queued orders or queue behind them, a
 // queued order replaced by a newer one, when_idle, and the bus's and each thruster's health.
-#include "daemon/thruster_bus.hpp"
+#include "daemon/bus/thruster_bus.hpp"
 
 #include "core/clock.hpp"
 #include "core/safety.hpp"

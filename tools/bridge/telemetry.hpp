@@ -7,7 +7,7 @@
 #pragma once
 
 #include "tools/bridge/bus_watch.hpp"
-#include "tools/client.hpp"
+#include "tools/client/client.hpp"
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>

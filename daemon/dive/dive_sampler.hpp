@@ -1,0 +1,28 @@
+// One sample of the whole vehicle for the dive recorder (docs/dive-format.md): motor values
+// requested and applied, the budget, the vehicle's flags, each thruster's status and counters,
+// the Teensy's orientation and distances, the bus counters. Read on the loop, no system call.
+#pragma once
+
+#include "core/dive_format.hpp"
+#include "daemon/bus/thruster_bus.hpp"
+#include "daemon/teensy/teensy_port.hpp"
+#include "daemon/vehicle/vehicle.hpp"
+
+#include <cstdint>
+
+namespace caracara {
+
+class DiveSampler {
+public:
+    DiveSampler(const Vehicle& vehicle, const ThrusterBus& bus, const TeensyPort& teensy)
+        : vehicle_(vehicle), bus_(bus), teensy_(teensy) {}
+    // `t_100us`: the time since the dive began, in 100 us.
+    dive::Sample sample(uint32_t t_100us) const;
+
+private:
+    const Vehicle& vehicle_;
+    const ThrusterBus& bus_;
+    const TeensyPort& teensy_;
+};
+
+} // namespace caracara

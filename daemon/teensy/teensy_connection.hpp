@@ -1,0 +1,99 @@
+// The connection to the Teensy over SPI: the node, the link and the TeensyWorker whose thread
+// carries every frame, so a slow or hung Teensy never holds the loop. Polls orientation and
+// distances one frame per cycle; hands a command's frame over and gives its Result back later;
+// a device that goes away (ENODEV) is told to its CommandGate (the failsafes kill, as
+// teensy-link-lost) and is asked for again once a second. The commands themselves are TeensyPort's, the Turn handshake TeensyTurn's.
+#pragma once
+
+#include "core/config.hpp"
+#include "core/status.hpp"
+#include "daemon/loop/completion.hpp"
+#include "daemon/teensy/teensy_worker.hpp"
+#include "daemon/interfaces/command_gate.hpp"
+#include "drivers/devices/teensy_link.hpp"
+#include "drivers/platform/device_io.hpp"
+#include "drivers/platform/event_loop.hpp"
+#include "drivers/platform/spi_dev.hpp"
+#include "drivers/protocol/teensy_codec.hpp"
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace caracara {
+
+struct TeensyTelemetry {
+    bool online = false;
+    std::array<double, 3> orientation{}; // yaw, pitch, roll
+    std::vector<uint16_t> distances;
+    std::vector<uint8_t> servos;
+    bool turning = false;
+};
+
+// The link's error as a Result naming the frame (`what`).
+Result teensy_result(teensy::TeensyError e, std::string_view what);
+
+class TeensyConnection {
+public:
+    TeensyConnection(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate);
+
+    // `lost`: the device went away; `back`: it is open again (the wheels are to be stopped).
+    void set_handlers(std::function<void()> lost, std::function<void()> back) {
+        on_lost_ = std::move(lost);
+        on_back_ = std::move(back);
+    }
+
+    int open(); // 0 or -errno, on the caller's thread (before start); a missing Teensy is not fatal
+    std::string start(int64_t priority) { return worker_.start(event_, priority); }
+    void close(); // after the worker's job on the wire (what was queued still runs)
+    bool is_open() const { return open_; }
+    // The link went away (ENODEV) and is not back yet; a Teensy that was never there is not lost.
+    bool link_lost() const { return lost_; }
+
+    // One frame: the three orientation axes, then one distance sensor, in turn; handed to the
+    // worker unless the last one is still out (a slow Teensy is polled as fast as it answers).
+    void poll();
+    // Hands `frame` (run on the worker, returning the link's error) over; `done` gets its Result.
+    void command(std::function<teensy::TeensyError()> frame, std::string what, Completion done);
+
+    TeensyLink& link() { return link_; } // the worker's while it runs
+    TeensyWorker& worker() { return worker_; }
+    TeensyTelemetry& telemetry() { return tm_; }
+    const TeensyTelemetry& telemetry() const { return tm_; }
+    const TeensyLinkCounters& counters() const { return worker_.counters(); }
+
+private:
+    struct PollResult {
+        unsigned slot = 0;
+        unsigned sensor = 0;
+        bool ok = false;
+        double value = 0;
+        int err = 0;
+    };
+    static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
+    void poll_done();
+    // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, told to the
+    // gate (the wheels cannot be stopped: the failsafes kill), and asked for again once a second.
+    void lose_link();
+    void schedule_reopen();
+
+    sd_event* event_;
+    CommandGate& gate_;
+    SpiDev spi_;      // the worker's while it runs
+    TeensyLink link_; // the worker's while it runs
+    TeensyWorker worker_;
+    bool open_ = false; // loop thread: the SPI node is open (as far as the loop knows)
+    bool lost_ = false; // loop thread: it went away, and is not back
+    TeensyTelemetry tm_;
+    unsigned poll_index_ = 0;
+    bool poll_out_ = false;
+    PollResult poll_; // the worker's while a poll is out
+    SourcePtr reopen_timer_;
+    std::function<void()> on_lost_;
+    std::function<void()> on_back_;
+};
+
+} // namespace caracara

@@ -1,0 +1,47 @@
+// Who pilots the vehicle, as clients come and go: a command's client taken as the commanding
+// client (SetThrust, SetMotion, a packet, a wheel or a turn), and a client that leaves the bus:
+// its zeros when it was commanding, and, when it was the last pilot, the pilot-lost failsafe's
+// condition told to the failsafes at once. The roster itself is the safety machine's
+// (core/pilot_roster); what the safety machine decides is carried out by the Vehicle (`handle`).
+// Owned by the Vehicle.
+#pragma once
+
+#include "core/failsafe.hpp"
+#include "core/safety.hpp"
+#include "core/status.hpp"
+#include "daemon/interfaces/failsafe_gate.hpp"
+#include "daemon/loop/deadline_timer.hpp"
+#include "daemon/vehicle/motor_commands.hpp"
+#include "daemon/vehicle/vehicle_condition.hpp"
+#include "daemon/interfaces/vehicle_events.hpp"
+
+#include <functional>
+#include <string_view>
+
+namespace caracara {
+
+class PilotWatch final {
+public:
+    using Handle = std::function<void(const SafetyAction&)>;
+    PilotWatch(const FailsafeSettings& failsafe, SafetyMachine& safety, const MotorCommands& motors,
+               const VehicleCondition& condition, DeadlineTimer& deadline, VehicleEvents& events, Handle handle)
+        : failsafe_(failsafe), safety_(safety), motors_(motors), condition_(condition), deadline_(deadline),
+          events_(events), handle_(std::move(handle)) {}
+    void set_failsafe_gate(FailsafeGate* gate) { failsafes_ = gate; }
+
+    // CommandGate::accept_command: refused while a failsafe surfaces or the state refuses it.
+    Result accept_command(std::string_view client);
+    void client_left(std::string_view unique_name);
+
+private:
+    const FailsafeSettings& failsafe_;
+    SafetyMachine& safety_;
+    const MotorCommands& motors_;
+    const VehicleCondition& condition_;
+    DeadlineTimer& deadline_;
+    VehicleEvents& events_;
+    Handle handle_;
+    FailsafeGate* failsafes_ = nullptr;
+};
+
+} // namespace caracara

@@ -1,0 +1,115 @@
+#include "daemon/vehicle/vehicle.hpp"
+
+#include "core/clock.hpp"
+#include "core/status_of.hpp"
+#include "daemon/loop/log.hpp"
+
+namespace caracara {
+
+static_assert(DeadlineTimer::kNever == SafetyMachine::kNoDeadline);
+
+Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
+                 VehicleEvents& events)
+    : config_(config),
+      lines_(lines),
+      teensy_(teensy),
+      events_(events),
+      actuator_(bus, lines, teensy),
+      safety_(safety_config(config), false, monotonic_ns()),
+      deadline_([this] { tick(monotonic_ns()); }),
+      motors_(config, safety_, *this, deadline_, actuator_, events),
+      condition_(safety_, bus, lines),
+      pilots_(config.failsafe, safety_, motors_, condition_, deadline_, events, [this](const SafetyAction& a) { handle(a); }) {}
+
+void Vehicle::handle(const SafetyAction& a) {
+    uint32_t changes = 0;
+    if (a.clear_commands) {
+        motors_.clear();
+        changes |= kChangeMotors | kChangeController;
+    }
+    if (safety_.kill_output_asserted())
+        motors_.end_surfacing(); // a kill ends an ascent at once
+    actuator_.carry_out(a, safety_.kill_output_asserted());
+    if (a.state_changed)
+        changes |= kChangeState;
+    if (a.command_stale)
+        log_info("command stream silent for %llu ms: thrusters to zero",
+                 static_cast<unsigned long long>(config_.control.command_timeout_ms));
+    events_.changed(changes);
+    arm_deadline();
+}
+
+std::string Vehicle::start(sd_event* event) {
+    std::string error = deadline_.start(event);
+    arm_deadline();
+    return error;
+}
+
+Result Vehicle::kill(KillSource source, std::string_view reason) {
+    const bool was_killed = safety_.state() == SafetyState::Killed;
+    handle(safety_.kill(source, monotonic_ns(), reason));
+    if (!was_killed && safety_.state() == SafetyState::Killed)
+        log_warning("KILLED by %s%s%s", std::string(kill_source_name()).c_str(), reason.empty() ? "" : ": ",
+                    std::string(reason).c_str());
+    actuator_.stop_wheels();
+    actuator_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
+    return {};
+}
+
+Result Vehicle::clear_kill() {
+    if (Result r = condition_.clear_kill_refusal(); !r.ok())
+        return r;
+    if (Result r = clear(); !r.ok())
+        return r;
+    log_notice("kill cleared; arming for %u ms", config_.control.arming_delay_ms);
+    return {};
+}
+
+Result Vehicle::clear() {
+    SafetyAction a = safety_.clear_kill(monotonic_ns());
+    if (!a.ok())
+        return {status_of(a.error), a.message};
+    handle(a);
+    return {};
+}
+
+Result Vehicle::power_off(std::string_view confirmation) {
+    if (confirmation != kPowerOffConfirmation)
+        return {Status::ConfirmationRequired,
+                std::string("power-off is irreversible: pass the confirmation string \"") + kPowerOffConfirmation + "\""};
+    SafetyAction a = safety_.power_off(monotonic_ns());
+    if (a.error == SafetyError::PoweredOff)
+        return {Status::PoweredOff, a.message};
+    handle(a);
+    actuator_.power_off(); // thrusters first, whatever handle() decided; then the line
+    log_warning("POWER-OFF confirmed: thrusters to zero%s", lines_.has_power_off() ? ", then the power-off line" : "");
+    actuator_.stop_wheels();
+    actuator_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
+    return {};
+}
+
+void Vehicle::link_changed() {
+    // The kill is the failsafes' (teensy-link-lost, at once); a Vehicle without them (none in
+    // the daemon: the FailsafeMonitor is its gate from its construction) still kills.
+    if (failsafes_)
+        failsafes_->conditions_changed();
+    else if (teensy_.link_lost())
+        kill(KillSource::Device, "the Teensy's SPI device went away");
+}
+
+void Vehicle::kill_switch_read(bool set) {
+    if (set == safety_.kill_switch_set())
+        return;
+    const bool was_killed = safety_.state() == SafetyState::Killed;
+    handle(safety_.switch_changed(set, monotonic_ns()));
+    if (set && !was_killed)
+        log_warning("KILLED by the kill switch");
+    else if (!set)
+        log_notice("kill switch released; ClearKill re-arms the vehicle");
+    if (set && !was_killed)
+        actuator_.stop_wheels();
+    if (set)
+        actuator_.cancel_turn({Status::Killed, "the kill switch was set during the turn"});
+}
+
+} // namespace caracara

@@ -1,0 +1,132 @@
+// The vehicle as callers see it: the safety state machine, the commands (thrust, motion,
+// kill, clear, power-off) and who is commanding; the legacy packet is read by its
+// PacketHandler, which asks the Vehicle for each of these. The motor commands and their
+// values (requested, applied, the budget) are its MotorCommands' job; what the safety machine
+// decides is carried out by its SafetyActuator (on the bus, the safety lines and the Teensy);
+// the end of arming and the command timeout come from its DeadlineTimer; who commands and
+// who left, its PilotWatch.
+#pragma once
+
+#include "core/config.hpp"
+#include "core/mixing.hpp"
+#include "core/motor_demand.hpp"
+#include "core/safety.hpp"
+#include "core/status.hpp"
+#include "daemon/bus/thruster_bus.hpp"
+#include "daemon/interfaces/failsafe_gate.hpp"
+#include "daemon/loop/completion.hpp"
+#include "daemon/loop/deadline_timer.hpp"
+#include "daemon/safety/safety_actuator.hpp"
+#include "daemon/safety/safety_lines.hpp"
+#include "daemon/teensy/teensy_port.hpp"
+#include "daemon/interfaces/command_gate.hpp"
+#include "daemon/interfaces/demand_listener.hpp"
+#include "daemon/vehicle/motor_commands.hpp"
+#include "daemon/vehicle/pilot_watch.hpp"
+#include "daemon/vehicle/vehicle_condition.hpp"
+#include "daemon/interfaces/vehicle_events.hpp"
+#include "drivers/platform/event_loop.hpp"
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace caracara {
+
+class Vehicle final : public CommandGate, public SafetyLines::Listener {
+public:
+    Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
+            VehicleEvents& events);
+    // Where the motor values go down to the thrusters (the control loop).
+    void set_demand_listener(DemandListener* orders) { actuator_.set_demand_listener(orders); }
+    // Makes the deadline timer (end of arming, command timeout). "" or why it could not.
+    std::string start(sd_event* event);
+    void stop() { deadline_.stop(); }
+
+    // The motor commands are its MotorCommands' job.
+    Result set_thrust(std::span<const int32_t> values, std::string_view client) { return motors_.set_thrust(values, client); }
+    Result set_motion(const AxisDemand& demand, std::string_view client) { return motors_.set_motion(demand, client); }
+    Result kill(KillSource source, std::string_view reason = {});
+    Result clear_kill();
+    // A packet's "all clear" (killState 0): clears a kill only the packet made.
+    Result clear_packet_kill() { return clear(); }
+    static constexpr const char* kPowerOffConfirmation = "power-off";
+    Result power_off(std::string_view confirmation);
+    // A packet's motor values, as SetThrust's.
+    Result drive(const MotorValues& values, std::string_view client) { return motors_.accept(values, false, client); }
+    // The calls that stop the thrusters hand their result to `done` once the zero orders they
+    // put on the bus are on the wire (the bus worker's thread): a caller that gets it knows
+    // the thrusters were told zero. The loop does not wait for them; the kill output was
+    // asserted before any of them.
+    void kill(KillSource source, std::string_view reason, Completion done) {
+        actuator_.after_zeros(std::move(done), kill(source, reason));
+    }
+    void power_off(std::string_view confirmation, Completion done) {
+        actuator_.after_zeros(std::move(done), power_off(confirmation));
+    }
+    // `done(r)` once the zeros handed to the bus so far are on the wire.
+    void after_zeros(Completion done, Result r) { actuator_.after_zeros(std::move(done), std::move(r)); }
+    Result set_profile(std::string_view name) { return motors_.set_profile(name); }
+    void client_left(std::string_view unique_name) { pilots_.client_left(unique_name); }
+    // Once per cycle: arming and the command timeout.
+    void tick(uint64_t now_ns) { handle(safety_.tick(now_ns)); }
+
+    void kill_switch_read(bool set) override;
+    Result state_error() const override { return condition_.state_error(); }
+    bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
+    Result accept_command(std::string_view client) override { return pilots_.accept_command(client); }
+    // A line or a thruster went away under the daemon (SafetyLines, ThrusterHealth): killed,
+    // source device.
+    void device_lost(std::string_view why) override { kill(KillSource::Device, why); }
+    // The Teensy link (TeensyConnection): the failsafes kill, as teensy-link-lost.
+    void link_changed() override;
+
+    // What thruster i is to be ordered now: its applied value while the vehicle may drive.
+    int32_t order_value(size_t i) const { return motors_.order_value(i); }
+    bool may_drive() const { return safety_.may_drive(); }
+    bool kill_output_asserted() const { return safety_.kill_output_asserted(); }
+
+    const SafetyMachine& safety() const { return safety_; }
+    std::string_view state_name() const { return condition_.state_name(); }
+    std::string_view kill_source_name() const { return condition_.kill_source_name(); }
+    const MotorValues& motor_values() const { return motors_.demand().applied(); }
+    const MotorValues& requested_values() const { return motors_.demand().requested(); }
+    int32_t budget_limit() const { return motors_.demand().limit(); }
+    bool saturated() const { return motors_.demand().saturated(); }
+    int64_t command_age_ms() const { return condition_.command_age_ms(); }
+    const std::string& controller_client() const { return safety_.commanding_client(); }
+    const ThrustProfile& profile() const { return motors_.demand().profile(); }
+
+    // Failsafes (daemon/failsafe_monitor decides, the Vehicle carries out).
+    static constexpr std::string_view kFailsafeClient = MotorCommands::kFailsafeClient;
+    void set_failsafe_gate(FailsafeGate* gate) {
+        failsafes_ = gate;
+        condition_.set_failsafe_gate(gate);
+        pilots_.set_failsafe_gate(gate);
+    }
+    void exclude(const std::array<bool, kMotorCount>& excluded) { motors_.exclude(excluded); }
+    Result surface(const AxisDemand& ascent) { return motors_.surface(ascent); }
+    bool surfacing() const { return motors_.surfacing(); }
+
+private:
+    Result clear();
+    void arm_deadline() { deadline_.arm(safety_.next_deadline()); }
+    void handle(const SafetyAction& a);
+
+    const DaemonConfig& config_;
+    SafetyLines& lines_;
+    TeensyPort& teensy_;
+    VehicleEvents& events_;
+    SafetyActuator actuator_;
+    SafetyMachine safety_;
+    DeadlineTimer deadline_;
+
+    MotorCommands motors_;
+    VehicleCondition condition_;
+    PilotWatch pilots_;
+    FailsafeGate* failsafes_ = nullptr;
+};
+
+} // namespace caracara

@@ -1,0 +1,39 @@
+// The vehicle's condition as callers see it, read from the safety machine, the bus, the
+// safety lines and the failsafes: why a command is refused (state_error), why a ClearKill is
+// refused, the state's name (fault when no thruster can be reached). Owned by Vehicle.
+#pragma once
+
+#include "core/safety.hpp"
+#include "core/status.hpp"
+#include "daemon/bus/thruster_bus.hpp"
+#include "daemon/interfaces/failsafe_gate.hpp"
+#include "daemon/safety/safety_lines.hpp"
+
+#include <cstdint>
+#include <string_view>
+
+namespace caracara {
+
+class VehicleCondition final {
+public:
+    VehicleCondition(const SafetyMachine& safety, const ThrusterBus& bus, const SafetyLines& lines)
+        : safety_(safety), bus_(bus), lines_(lines) {}
+    void set_failsafe_gate(const FailsafeGate* gate) { failsafe_gate_ = gate; }
+
+    // Ok when the vehicle is ready to move; else the error a caller gets (Killed, Arming, ...).
+    Result state_error() const;
+    // Ok when nothing keeps a kill from being cleared (the bus, a thruster, the kill output,
+    // a failsafe); the safety machine has the last word.
+    Result clear_kill_refusal() const;
+    std::string_view state_name() const;
+    std::string_view kill_source_name() const;
+    int64_t command_age_ms() const;
+
+private:
+    const SafetyMachine& safety_;
+    const ThrusterBus& bus_;
+    const SafetyLines& lines_;
+    const FailsafeGate* failsafe_gate_ = nullptr;
+};
+
+} // namespace caracara

@@ -1,0 +1,147 @@
+#include "tools/caracaractl/bridge_forward.hpp"
+
+#include "tools/client/client.hpp"
+#include "tools/client/ssh_target.hpp"
+
+#include <arpa/inet.h>
+#include <cerrno>
+#include <charconv>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace caracaractl {
+
+namespace {
+
+constexpr const char* kDefaultSocket = "/run/caracara-bridge/bridge.sock";
+constexpr uint16_t kDefaultPort = 8765; // Foxglove's default for a WebSocket connection
+
+[[noreturn]] void usage(const std::string& m) { throw Failure{kExitUsage, m}; }
+
+bool port_listens(uint16_t port) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0)
+        return false;
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const bool ok = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    ::close(fd);
+    return ok;
+}
+
+// ssh's exit: 255 is its own failure (not reached, refused), anything else the forward's end.
+int exit_of(int status) {
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
+        return kExitOk;
+    return kExitUnavailable;
+}
+
+} // namespace
+
+const char* bridge_forward_help() {
+    return "\nFoxglove and the cockpit (caracara-bridge on the vehicle, docs/foxglove.md, docs/cockpit.md):\n"
+           "  -H [USER@]HOST[:PORT] bridge [--port N] [--socket PATH] [--ssh-config FILE]\n"
+           "                                   Forward the vehicle's bridge socket to localhost:N\n"
+           "                                   (default 8765) with ssh -L and print the addresses to\n"
+           "                                   open in Foxglove (ws://) and in a browser (http://,\n"
+           "                                   the cockpit); held until ^C\n";
+}
+
+int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vector<std::string>& args) {
+    uint16_t port = kDefaultPort;
+    std::string socket_path = kDefaultSocket, ssh_config;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        auto value = [&](const char* opt) {
+            if (i + 1 >= args.size())
+                usage(std::string(opt) + " needs a value");
+            return args[++i];
+        };
+        if (args[i] == "--port") {
+            const std::string p = value("--port");
+            const auto [end, ec] = std::from_chars(p.data(), p.data() + p.size(), port);
+            if (ec != std::errc() || end != p.data() + p.size() || port == 0)
+                usage("--port needs a port number 1..65535, not '" + p + "'");
+        } else if (args[i] == "--socket") {
+            socket_path = value("--socket");
+            if (socket_path.empty() || socket_path[0] != '/')
+                usage("--socket needs an absolute path");
+        } else if (args[i] == "--ssh-config") {
+            ssh_config = value("--ssh-config");
+        } else {
+            usage("unknown argument '" + args[i] + "' for bridge");
+        }
+    }
+    if (choice.kind != caracara::dbus::BusChoice::Kind::Remote)
+        usage("bridge forwards from the vehicle: give it with -H [USER@]HOST[:PORT]");
+    const auto target = parse_ssh_target(choice.address);
+    if (!target)
+        usage("-H needs [USER@]HOST[:PORT], not '" + choice.address + "'");
+    if (port_listens(port))
+        throw Failure{kExitRefused, "localhost:" + std::to_string(port) + " is in use; choose another with --port"};
+
+    std::vector<std::string> argv = {"ssh", "-N", "-T", "-x", "-o", "ExitOnForwardFailure=yes"};
+    if (!ssh_config.empty())
+        argv.insert(argv.end(), {"-F", ssh_config});
+    if (!target->port.empty())
+        argv.insert(argv.end(), {"-p", target->port});
+    argv.insert(argv.end(), {"-L", "127.0.0.1:" + std::to_string(port) + ":" + socket_path, "--", target->destination()});
+
+    sigset_t mask;
+    sigemptyset(&mask);
+    sigaddset(&mask, SIGINT);
+    sigaddset(&mask, SIGTERM);
+    sigaddset(&mask, SIGCHLD);
+    sigset_t old;
+    sigprocmask(SIG_BLOCK, &mask, &old);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        sigprocmask(SIG_SETMASK, &old, nullptr);
+        std::vector<char*> cargv;
+        for (std::string& a : argv)
+            cargv.push_back(a.data());
+        cargv.push_back(nullptr);
+        ::execvp("ssh", cargv.data());
+        std::fprintf(stderr, "caracaractl: cannot run ssh: %s\n", std::strerror(errno));
+        ::_exit(127);
+    }
+    if (pid < 0)
+        throw Failure{kExitUnavailable, std::string("fork: ") + std::strerror(errno)};
+
+    bool announced = false;
+    for (;;) {
+        int status = 0;
+        if (::waitpid(pid, &status, WNOHANG) == pid) {
+            if (!announced || exit_of(status) != kExitOk)
+                throw Failure{kExitUnavailable, "ssh to " + choice.address + " ended (status " +
+                                                    std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : 255) +
+                                                    "); the forward is gone"};
+            return kExitOk;
+        }
+        if (!announced && port_listens(port)) {
+            announced = true;
+            // The Foxglove address, then the cockpit's (the same socket serves both, docs/cockpit.md).
+            std::printf("ws://localhost:%u\nhttp://localhost:%u/\n", port, port);
+            std::fflush(stdout);
+            std::fprintf(stderr, "caracaractl: open ws://localhost:%u in Foxglove (Open connection, Foxglove "
+                                 "WebSocket), or the cockpit at http://localhost:%u/ in a browser; Ctrl-C ends "
+                                 "the forward\n", port, port);
+        }
+        const timespec tick{0, 50'000'000};
+        const int sig = sigtimedwait(&mask, nullptr, &tick);
+        if (sig == SIGINT || sig == SIGTERM) {
+            ::kill(pid, SIGTERM);
+            ::waitpid(pid, &status, 0);
+            return kExitOk;
+        }
+    }
+}
+
+} // namespace caracaractl
