@@ -2,25 +2,31 @@
 
 namespace caracara {
 
-void SafetyActuator::carry_out(const SafetyAction& a, bool kill_output_asserted) {
-    // A kill reaches the kill output first: it is one GPIO write, and the zero orders behind it
-    // are bus transfers that a hung device can delay. Releasing it (arming) waits for the zeros.
-    const bool assert_first = a.state_changed && kill_output_asserted;
-    if (assert_first) {
-        bus_.hold_orders();
-        lines_.set_kill_output(true);
+void SafetyActuator::carry_out(const SafetyAction& a, bool kill_output_asserted, const Result* kill) {
+    if (kill_output_asserted) {
+        // The kill output first: it is one GPIO write, and the zero orders behind it are bus
+        // transfers that a hung device can delay. The zeros go before anything queued.
+        if (a.state_changed) {
+            bus_.hold_orders();
+            lines_.set_kill_output(true);
+        }
+        if (a.zero_outputs)
+            orders_->zero_all(ZeroOrder::First);
+        // The wheels are motors too; a running turn is told why it ends.
+        if (kill) {
+            teensy_.stop_motion();
+            teensy_.cancel_turn(*kill);
+        }
+        return;
     }
+    // A timeout's or a departed client's zeros go behind what that client had sent; the wheels
+    // stop only if they move. Releasing the kill output (arming) waits for the zeros.
     if (a.zero_outputs) {
-        // A kill's zeros go before anything queued; a timeout's or a departed client's go
-        // behind what that client had sent.
-        orders_->zero_all(kill_output_asserted ? ZeroOrder::First : ZeroOrder::Behind);
-        // The wheels are motors too. A kill or power-off stops them itself, and tells a
-        // running turn why.
-        if (!kill_output_asserted)
-            teensy_.stop_if_moving();
+        orders_->zero_all(ZeroOrder::Behind);
+        teensy_.stop_if_moving();
     }
-    if (a.state_changed && !assert_first)
-        lines_.set_kill_output(kill_output_asserted);
+    if (a.state_changed)
+        lines_.set_kill_output(false);
 }
 
 void SafetyActuator::power_off() {

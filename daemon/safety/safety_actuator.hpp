@@ -1,7 +1,9 @@
-// Carries out what the safety machine decided (a SafetyAction) on the hardware, in the order
-// docs/architecture.md gives: the kill output first (one GPIO write), then the zeros on the
-// bus (through the DemandListener, the loop), then the wheels; and the power-off line once
-// the zeros are on the wire.
+// Carries out what the safety machine decided (a SafetyAction) on the hardware. Every kill (Kill,
+// a packet's kill, the kill switch, a failsafe, a lost device, power-off) takes one sequence,
+// `carry_out` with the reason a running turn ends: the bus held, the kill output (one GPIO
+// write), the zeros on the bus (through the DemandListener, the loop) in front of anything
+// queued, the wheels stopped, the turn ended. The power-off line goes once the zeros are on
+// the wire.
 #pragma once
 
 #include "core/motor_demand.hpp"
@@ -22,15 +24,14 @@ public:
     // Where the motor values go down to the thrusters (the control loop).
     void set_demand_listener(DemandListener* orders) { orders_ = orders; }
 
-    // `kill_output_asserted`: what the safety machine says after the action.
-    void carry_out(const SafetyAction& a, bool kill_output_asserted);
+    // `kill_output_asserted`: what the safety machine says after the action. `kill`: the action
+    // is a kill (the reason a running turn ends), or null (arming, a tick, a timeout, a client
+    // that left).
+    void carry_out(const SafetyAction& a, bool kill_output_asserted, const Result* kill);
     // The orders standing now, down to the thrusters.
     void hand_down(const MotorValues& orders) { orders_->demand_changed(orders); }
     // Thrusters to zero first, then the power-off line once the zeros are on the wire.
     void power_off();
-    // The wheels: stop a motion, and tell a running turn why it ends.
-    void stop_wheels() { teensy_.stop_motion(); }
-    void cancel_turn(const Result& why) { teensy_.cancel_turn(why); }
     // `done(r)` once the transfers handed to the bus so far are on the wire.
     void after_zeros(Completion done, Result r);
 

@@ -1,6 +1,5 @@
 #include "daemon/vehicle/motor_commands.hpp"
 
-#include "core/clock.hpp"
 #include "core/status_of.hpp"
 
 #include "daemon/loop/log.hpp"
@@ -9,12 +8,11 @@
 
 namespace caracara {
 
-MotorCommands::MotorCommands(const DaemonConfig& config, SafetyMachine& safety, const CommandGate& gate,
-                             DeadlineTimer& deadline, SafetyActuator& actuator, VehicleEvents& events)
+MotorCommands::MotorCommands(const DaemonConfig& config, const SafetyMachine& safety, CommandGate& gate,
+                             SafetyActuator& actuator, VehicleEvents& events)
     : config_(config),
       safety_(safety),
       gate_(gate),
-      deadline_(deadline),
       actuator_(actuator),
       events_(events),
       demand_(config.control.budget_policy, *find_profile(config, config.control.profile)) {}
@@ -27,22 +25,15 @@ void MotorCommands::hand_down() {
 }
 
 Result MotorCommands::accept(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
-    if (surfacing_ && client != kFailsafeClient)
-        return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
     const BudgetResult b = demand_.evaluate(wanted);
     if (!b.ok())
         return {status_of(b.error), b.message};
-    if (Result r = gate_.state_error(); !r.ok())
+    if (Result r = gate_.accept_command(client); !r.ok())
         return r;
-    const std::string previous = safety_.commanding_client();
-    SafetyAction a = safety_.accept_command(monotonic_ns(), client);
-    if (!a.ok())
-        return gate_.state_error();
-    deadline_.arm(safety_.next_deadline());
     // A stream re-sending the same command changes nothing worth announcing.
     const bool changed = demand_.take(wanted, b, mix_saturated);
     hand_down();
-    events_.changed((changed ? kChangeMotors : 0u) | (previous != safety_.commanding_client() ? kChangeController : 0u));
+    events_.changed(changed ? kChangeMotors : 0u);
     return {};
 }
 

@@ -9,7 +9,6 @@
 #include "core/motor_demand.hpp"
 #include "core/safety.hpp"
 #include "core/status.hpp"
-#include "daemon/loop/deadline_timer.hpp"
 #include "daemon/safety/safety_actuator.hpp"
 #include "daemon/interfaces/command_gate.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
@@ -25,15 +24,15 @@ class MotorCommands final {
 public:
     static constexpr std::string_view kFailsafeClient = "failsafe"; // who drives an ascent
 
-    // `gate`: the vehicle's state (state_error); `safety` takes the command.
-    MotorCommands(const DaemonConfig& config, SafetyMachine& safety, const CommandGate& gate,
-                  DeadlineTimer& deadline, SafetyActuator& actuator, VehicleEvents& events);
+    // `gate`: the vehicle, where a command is accepted (CommandGate::accept_command).
+    MotorCommands(const DaemonConfig& config, const SafetyMachine& safety, CommandGate& gate,
+                  SafetyActuator& actuator, VehicleEvents& events);
 
     Result set_thrust(std::span<const int32_t> values, std::string_view client);
     Result set_motion(const AxisDemand& demand, std::string_view client);
     // Selects a thrust profile by name; the current command goes out again under it at once.
     Result set_profile(std::string_view name);
-    // Through the budget, the state and the safety machine; then handed down.
+    // Through the budget, then accepted (CommandGate::accept_command); then handed down.
     Result accept(const MotorValues& wanted, bool mix_saturated, std::string_view client);
     // These thrusters to zero and out of the budget's count; the standing command goes on.
     void exclude(const std::array<bool, kMotorCount>& excluded);
@@ -54,9 +53,8 @@ private:
     void hand_down();
 
     const DaemonConfig& config_;
-    SafetyMachine& safety_;
-    const CommandGate& gate_;
-    DeadlineTimer& deadline_;
+    const SafetyMachine& safety_;
+    CommandGate& gate_;
     SafetyActuator& actuator_;
     VehicleEvents& events_;
     MotorDemand demand_;

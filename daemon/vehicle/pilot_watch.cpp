@@ -8,7 +8,7 @@
 namespace caracara {
 
 Result PilotWatch::accept_command(std::string_view client) {
-    if (motors_.surfacing())
+    if (motors_.surfacing() && client != MotorCommands::kFailsafeClient)
         return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
     if (Result r = condition_.state_error(); !r.ok())
         return r;

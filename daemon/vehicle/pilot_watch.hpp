@@ -29,7 +29,10 @@ public:
           events_(events), handle_(std::move(handle)) {}
     void set_failsafe_gate(FailsafeGate* gate) { failsafes_ = gate; }
 
-    // CommandGate::accept_command: refused while a failsafe surfaces or the state refuses it.
+    // The one place a command is accepted (CommandGate::accept_command: SetThrust, SetMotion, a
+    // packet's motors, the wheels, a turn, the failsafe's ascent): refused while a failsafe
+    // surfaces (but for the ascent itself) or the state refuses it; else `client` commands,
+    // the command timeout restarts, and a new controller is announced.
     Result accept_command(std::string_view client);
     void client_left(std::string_view unique_name);
 

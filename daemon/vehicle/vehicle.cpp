@@ -4,6 +4,8 @@
 #include "core/status_of.hpp"
 #include "daemon/loop/log.hpp"
 
+#include <utility>
+
 namespace caracara {
 
 static_assert(DeadlineTimer::kNever == SafetyMachine::kNoDeadline);
@@ -17,11 +19,11 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       actuator_(bus, lines, teensy),
       safety_(safety_config(config), false, monotonic_ns()),
       deadline_([this] { tick(monotonic_ns()); }),
-      motors_(config, safety_, *this, deadline_, actuator_, events),
+      motors_(config, safety_, *this, actuator_, events),
       condition_(safety_, bus, lines),
       pilots_(config.failsafe, safety_, motors_, condition_, deadline_, events, [this](const SafetyAction& a) { handle(a); }) {}
 
-void Vehicle::handle(const SafetyAction& a) {
+void Vehicle::handle(const SafetyAction& a, const Result* kill) {
     uint32_t changes = 0;
     if (a.clear_commands) {
         motors_.clear();
@@ -29,7 +31,11 @@ void Vehicle::handle(const SafetyAction& a) {
     }
     if (safety_.kill_output_asserted())
         motors_.end_surfacing(); // a kill ends an ascent at once
-    actuator_.carry_out(a, safety_.kill_output_asserted());
+    // A line that fails under the sequence (SafetyLines tells device_lost) is killed for once
+    // this sequence is done, not inside it.
+    in_sequence_ = true;
+    actuator_.carry_out(a, safety_.kill_output_asserted(), kill);
+    in_sequence_ = false;
     if (a.state_changed)
         changes |= kChangeState;
     if (a.command_stale)
@@ -37,6 +43,15 @@ void Vehicle::handle(const SafetyAction& a) {
                  static_cast<unsigned long long>(config_.control.command_timeout_ms));
     events_.changed(changes);
     arm_deadline();
+    if (!lost_in_sequence_.empty())
+        device_lost(std::exchange(lost_in_sequence_, {}));
+}
+
+void Vehicle::device_lost(std::string_view why) {
+    if (in_sequence_)
+        lost_in_sequence_ = why;
+    else
+        kill(KillSource::Device, why);
 }
 
 std::string Vehicle::start(sd_event* event) {
@@ -47,12 +62,11 @@ std::string Vehicle::start(sd_event* event) {
 
 Result Vehicle::kill(KillSource source, std::string_view reason) {
     const bool was_killed = safety_.state() == SafetyState::Killed;
-    handle(safety_.kill(source, monotonic_ns(), reason));
+    const Result turn_ends{Status::Killed, "the vehicle was killed during the turn"};
+    handle(safety_.kill(source, monotonic_ns(), reason), &turn_ends);
     if (!was_killed && safety_.state() == SafetyState::Killed)
         log_warning("KILLED by %s%s%s", std::string(kill_source_name()).c_str(), reason.empty() ? "" : ": ",
                     std::string(reason).c_str());
-    actuator_.stop_wheels();
-    actuator_.cancel_turn({Status::Killed, "the vehicle was killed during the turn"});
     return {};
 }
 
@@ -80,11 +94,10 @@ Result Vehicle::power_off(std::string_view confirmation) {
     SafetyAction a = safety_.power_off(monotonic_ns());
     if (a.error == SafetyError::PoweredOff)
         return {Status::PoweredOff, a.message};
-    handle(a);
+    const Result turn_ends{Status::PoweredOff, "the vehicle was powered off during the turn"};
+    handle(a, &turn_ends);
     actuator_.power_off(); // thrusters first, whatever handle() decided; then the line
     log_warning("POWER-OFF confirmed: thrusters to zero%s", lines_.has_power_off() ? ", then the power-off line" : "");
-    actuator_.stop_wheels();
-    actuator_.cancel_turn({Status::PoweredOff, "the vehicle was powered off during the turn"});
     return {};
 }
 
@@ -101,15 +114,12 @@ void Vehicle::kill_switch_read(bool set) {
     if (set == safety_.kill_switch_set())
         return;
     const bool was_killed = safety_.state() == SafetyState::Killed;
-    handle(safety_.switch_changed(set, monotonic_ns()));
+    const Result turn_ends{Status::Killed, "the kill switch was set during the turn"};
+    handle(safety_.switch_changed(set, monotonic_ns()), set ? &turn_ends : nullptr);
     if (set && !was_killed)
         log_warning("KILLED by the kill switch");
     else if (!set)
         log_notice("kill switch released; ClearKill re-arms the vehicle");
-    if (set && !was_killed)
-        actuator_.stop_wheels();
-    if (set)
-        actuator_.cancel_turn({Status::Killed, "the kill switch was set during the turn"});
 }
 
 } // namespace caracara

@@ -79,7 +79,7 @@ public:
     Result accept_command(std::string_view client) override { return pilots_.accept_command(client); }
     // A line or a thruster went away under the daemon (SafetyLines, ThrusterHealth): killed,
     // source device.
-    void device_lost(std::string_view why) override { kill(KillSource::Device, why); }
+    void device_lost(std::string_view why) override;
     // The Teensy link (TeensyConnection): the failsafes kill, as teensy-link-lost.
     void link_changed() override;
 
@@ -113,7 +113,8 @@ public:
 private:
     Result clear();
     void arm_deadline() { deadline_.arm(safety_.next_deadline()); }
-    void handle(const SafetyAction& a);
+    // Every SafetyAction goes through here once; `kill`: it is a kill (SafetyActuator::carry_out).
+    void handle(const SafetyAction& a, const Result* kill = nullptr);
 
     const DaemonConfig& config_;
     SafetyLines& lines_;
@@ -127,6 +128,8 @@ private:
     VehicleCondition condition_;
     PilotWatch pilots_;
     FailsafeGate* failsafes_ = nullptr;
+    bool in_sequence_ = false;      // the actuator is carrying out an action
+    std::string lost_in_sequence_;  // a device lost meanwhile: killed once it is done
 };
 
 } // namespace caracara
