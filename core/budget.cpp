@@ -4,19 +4,6 @@
 
 namespace caracara {
 
-std::string_view policy_name(BudgetPolicy p) {
-    return p == BudgetPolicy::Reject ? "reject" : "scale";
-}
-
-std::string_view error_name(BudgetError e) {
-    switch (e) {
-    case BudgetError::None: return "None";
-    case BudgetError::OutOfRange: return "OutOfRange";
-    case BudgetError::OverBudget: return "OverBudget";
-    }
-    return "?";
-}
-
 int running_motors(const MotorValues& motors) {
     int n = 0;
     for (int32_t v : motors)

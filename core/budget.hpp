@@ -9,6 +9,7 @@
 // The seed lists 2, 4 and 8 motors; counts between its rows take the stricter row.
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/mixing.hpp"
 
 #include <string>
@@ -20,14 +21,29 @@ enum class BudgetPolicy {
     Scale,   // scale all motors by one factor so the largest fits (default)
     Reject,  // refuse the command with OverBudget and change nothing
 };
-std::string_view policy_name(BudgetPolicy p);  // "scale", "reject"
+template <>
+struct EnumNames<BudgetPolicy> {
+    static constexpr std::array<EnumName<BudgetPolicy>, 2> table{{
+        {BudgetPolicy::Scale, "scale"},
+        {BudgetPolicy::Reject, "reject"},
+    }};
+};
+inline std::string_view policy_name(BudgetPolicy p) { return name_of(p); }
 
 enum class BudgetError {
     None,
     OutOfRange,  // a motor value outside -kMotorMax..kMotorMax
     OverBudget,  // Reject policy: the largest |value| exceeds the limit for the count
 };
-std::string_view error_name(BudgetError e);  // "OutOfRange", "OverBudget"
+template <>
+struct EnumNames<BudgetError> {
+    static constexpr std::array<EnumName<BudgetError>, 3> table{{
+        {BudgetError::None, "None"},
+        {BudgetError::OutOfRange, "OutOfRange"},
+        {BudgetError::OverBudget, "OverBudget"},
+    }};
+};
+inline std::string_view error_name(BudgetError v) { return name_of(v); }
 
 int running_motors(const MotorValues& motors);  // number of non-zero values
 int32_t budget_limit(int running);              // see the table above; 0 -> kMotorMax

@@ -86,10 +86,8 @@ void parse_control(Checker& c, const toml::table& t, ControlSettings& out) {
     c.string(t, p, "profile", out.profile);
     std::string policy;
     if (c.string(t, p, "budget_policy", policy)) {
-        if (policy == "scale")
-            out.budget_policy = BudgetPolicy::Scale;
-        else if (policy == "reject")
-            out.budget_policy = BudgetPolicy::Reject;
+        if (const std::optional<BudgetPolicy> parsed = parse_name<BudgetPolicy>(policy))
+            out.budget_policy = *parsed;
         else
             c.fail(p + "budget_policy", "must be \"scale\" or \"reject\", got \"" + policy + "\"",
                    t.get("budget_policy"));

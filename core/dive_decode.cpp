@@ -211,18 +211,6 @@ private:
 
 } // namespace
 
-std::string_view read_error_name(ReadError e) {
-    switch (e) {
-    case ReadError::None: return "ok";
-    case ReadError::NotADive: return "not-a-dive";
-    case ReadError::Version: return "version";
-    case ReadError::Truncated: return "truncated";
-    case ReadError::Checksum: return "checksum";
-    case ReadError::Malformed: return "malformed";
-    }
-    return "malformed";
-}
-
 Dive decode(std::span<const uint8_t> bytes) {
     Dive d;
     Decoder(bytes, d).run();

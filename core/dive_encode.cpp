@@ -29,18 +29,6 @@ void record(Out& out, RecordKind kind, Fill fill) {
 
 } // namespace
 
-std::string_view event_kind_name(EventKind k) {
-    switch (k) {
-    case EventKind::State: return "state";
-    case EventKind::Fault: return "fault";
-    case EventKind::BusLost: return "bus-lost";
-    case EventKind::BusRestored: return "bus-restored";
-    case EventKind::Profile: return "profile";
-    case EventKind::Failsafe: return "failsafe";
-    }
-    return "unknown";
-}
-
 std::vector<uint8_t> encode_header(const Header& h) {
     std::vector<uint8_t> fields;
     ByteWriter f(fields);

@@ -12,6 +12,8 @@
 // byte offset; it never trusts a length before checking it against what is left.
 #pragma once
 
+#include "core/enum_names.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -96,7 +98,22 @@ enum class EventKind : uint8_t {
 // A failsafe event's value bits.
 inline constexpr uint32_t kFailsafeRaised = 1u << 0;  // raised (else cleared)
 inline constexpr uint32_t kFailsafeVehicle = 1u << 1; // the vehicle's own, not `thruster`'s
-std::string_view event_kind_name(EventKind k); // "state", "fault", "bus-lost", "bus-restored", "profile", "failsafe"
+} // namespace caracara::dive
+namespace caracara {
+template <>
+struct EnumNames<dive::EventKind> {
+    static constexpr std::array<EnumName<dive::EventKind>, 6> table{{
+        {dive::EventKind::State, "state"},
+        {dive::EventKind::Fault, "fault"},
+        {dive::EventKind::BusLost, "bus-lost"},
+        {dive::EventKind::BusRestored, "bus-restored"},
+        {dive::EventKind::Profile, "profile"},
+        {dive::EventKind::Failsafe, "failsafe"},
+    }};
+};
+} // namespace caracara
+namespace caracara::dive {
+inline std::string_view event_kind_name(EventKind v) { return name_of(v); }
 
 struct Event {
     uint32_t t_100us = 0;
@@ -137,7 +154,22 @@ enum class ReadError : uint8_t {
     Checksum,      // a header or block whose CRC-32 does not match
     Malformed,     // a block or record whose lengths or values make no sense
 };
-std::string_view read_error_name(ReadError e); // "not-a-dive", "version", ...
+} // namespace caracara::dive
+namespace caracara {
+template <>
+struct EnumNames<dive::ReadError> {
+    static constexpr std::array<EnumName<dive::ReadError>, 6> table{{
+        {dive::ReadError::None, "ok"},
+        {dive::ReadError::NotADive, "not-a-dive"},
+        {dive::ReadError::Version, "version"},
+        {dive::ReadError::Truncated, "truncated"},
+        {dive::ReadError::Checksum, "checksum"},
+        {dive::ReadError::Malformed, "malformed"},
+    }};
+};
+} // namespace caracara
+namespace caracara::dive {
+inline std::string_view read_error_name(ReadError v) { return name_of(v); }
 
 struct Dive {
     Header header;

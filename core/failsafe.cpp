@@ -2,34 +2,6 @@
 
 namespace caracara {
 
-namespace {
-constexpr std::array<std::string_view, kFailsafeConditionCount> kConditionNames{
-    "water-detect", "ground-fault", "overtemp", "stall", "hall", "pilot-lost",
-    "thruster-unreachable", "bus-lost", "teensy-link-lost", "kill-switch-unreadable"};
-constexpr std::array<std::string_view, 4> kActionNames{"warn", "exclude", "surface", "kill"};
-
-// The enum value whose name is `name`: the names are in enum order.
-template <typename E, std::size_t N>
-std::optional<E> from_name(const std::array<std::string_view, N>& names, std::string_view name) {
-    for (std::size_t i = 0; i < N; ++i)
-        if (names[i] == name)
-            return static_cast<E>(i);
-    return std::nullopt;
-}
-} // namespace
-
-std::string_view condition_name(FailsafeCondition c) { return kConditionNames[static_cast<std::size_t>(c)]; }
-
-std::optional<FailsafeCondition> condition_from_name(std::string_view name) {
-    return from_name<FailsafeCondition>(kConditionNames, name);
-}
-
-std::string_view action_name(FailsafeAction a) { return kActionNames[static_cast<std::size_t>(a)]; }
-
-std::optional<FailsafeAction> action_from_name(std::string_view name) {
-    return from_name<FailsafeAction>(kActionNames, name);
-}
-
 uint8_t condition_fault_bit(FailsafeCondition c) {
     switch (c) {
     case FailsafeCondition::Overtemp: return 1u << 0;

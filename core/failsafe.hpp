@@ -4,6 +4,8 @@
 // the daemon's own safety conditions, fixed at kill.
 #pragma once
 
+#include "core/enum_names.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -35,12 +37,36 @@ inline constexpr std::array<FailsafeCondition, kThrusterConditionCount> kThruste
 // In order of severity: when two conditions hold, the later action wins.
 enum class FailsafeAction : uint8_t { Warn, Exclude, Surface, Kill };
 
-// "water-detect", "ground-fault", "overtemp", "stall", "hall", "pilot-lost",
-// "thruster-unreachable", "bus-lost", "teensy-link-lost", "kill-switch-unreadable"
-std::string_view condition_name(FailsafeCondition c);
-std::optional<FailsafeCondition> condition_from_name(std::string_view name);
-std::string_view action_name(FailsafeAction a); // "warn", "exclude", "surface", "kill"
-std::optional<FailsafeAction> action_from_name(std::string_view name);
+template <>
+struct EnumNames<FailsafeCondition> {
+    static constexpr std::array<EnumName<FailsafeCondition>, kFailsafeConditionCount> table{{
+        {FailsafeCondition::WaterDetect, "water-detect"},
+        {FailsafeCondition::GroundFault, "ground-fault"},
+        {FailsafeCondition::Overtemp, "overtemp"},
+        {FailsafeCondition::Stall, "stall"},
+        {FailsafeCondition::Hall, "hall"},
+        {FailsafeCondition::PilotLost, "pilot-lost"},
+        {FailsafeCondition::ThrusterUnreachable, "thruster-unreachable"},
+        {FailsafeCondition::BusLost, "bus-lost"},
+        {FailsafeCondition::TeensyLinkLost, "teensy-link-lost"},
+        {FailsafeCondition::KillSwitchUnreadable, "kill-switch-unreadable"},
+    }};
+};
+template <>
+struct EnumNames<FailsafeAction> {
+    static constexpr std::array<EnumName<FailsafeAction>, 4> table{{
+        {FailsafeAction::Warn, "warn"},
+        {FailsafeAction::Exclude, "exclude"},
+        {FailsafeAction::Surface, "surface"},
+        {FailsafeAction::Kill, "kill"},
+    }};
+};
+inline std::string_view condition_name(FailsafeCondition c) { return name_of(c); }
+inline std::optional<FailsafeCondition> condition_from_name(std::string_view name) {
+    return parse_name<FailsafeCondition>(name);
+}
+inline std::string_view action_name(FailsafeAction a) { return name_of(a); }
+inline std::optional<FailsafeAction> action_from_name(std::string_view name) { return parse_name<FailsafeAction>(name); }
 
 // Fixed at kill; the config checker refuses a weaker action.
 constexpr bool condition_is_fixed(FailsafeCondition c) { return c >= FailsafeCondition::PilotLost; }

@@ -26,15 +26,6 @@ const MixMatrix& default_mix_matrix() {
     return m;
 }
 
-std::string_view error_name(MixError e) {
-    switch (e) {
-    case MixError::None: return "None";
-    case MixError::NotFinite: return "NotFinite";
-    case MixError::OutOfRange: return "OutOfRange";
-    }
-    return "?";
-}
-
 namespace {
 MixResult mix_error(MixError e, int axis, std::string message) {
     MixResult r;

@@ -15,6 +15,7 @@
 // nose down, counter-clockwise).
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/motor.hpp"
 
 #include <array>
@@ -43,7 +44,15 @@ enum class MixError {
     NotFinite,   // a demand (or, with a bad custom matrix, a result) is NaN or infinite
     OutOfRange,  // a demand is outside -1..1
 };
-std::string_view error_name(MixError e);  // "NotFinite", "OutOfRange" (for logs and tests)
+template <>
+struct EnumNames<MixError> {
+    static constexpr std::array<EnumName<MixError>, 3> table{{
+        {MixError::None, "None"},
+        {MixError::NotFinite, "NotFinite"},
+        {MixError::OutOfRange, "OutOfRange"},
+    }};
+};
+inline std::string_view error_name(MixError v) { return name_of(v); }
 
 struct MixResult {
     MixError error = MixError::None;

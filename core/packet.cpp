@@ -9,17 +9,6 @@ std::string_view packet_field_name(std::size_t index) {
     return index < names.size() ? names[index] : std::string_view("?");
 }
 
-std::string_view error_name(PacketError e) {
-    switch (e) {
-    case PacketError::None: return "None";
-    case PacketError::WrongLength: return "WrongLength";
-    case PacketError::MotorOutOfRange: return "MotorOutOfRange";
-    case PacketError::BadPowerOffState: return "BadPowerOffState";
-    case PacketError::ColorOutOfRange: return "ColorOutOfRange";
-    }
-    return "?";
-}
-
 namespace {
 PacketResult field_error(PacketError e, std::size_t index, int32_t value, std::string_view problem) {
     PacketResult r;

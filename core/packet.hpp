@@ -7,6 +7,7 @@
 // the decoded packet is left empty, so a bad packet can change nothing but a kill it asks for.
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/mixing.hpp"
 
 #include <array>
@@ -47,7 +48,17 @@ enum class PacketError {
     BadPowerOffState,   // powerOffState other than 0 or 1 (1 is irreversible: no guessing)
     ColorOutOfRange,    // red/green/blue outside 0..255
 };
-std::string_view error_name(PacketError e);  // "WrongLength", "MotorOutOfRange", ...
+template <>
+struct EnumNames<PacketError> {
+    static constexpr std::array<EnumName<PacketError>, 5> table{{
+        {PacketError::None, "None"},
+        {PacketError::WrongLength, "WrongLength"},
+        {PacketError::MotorOutOfRange, "MotorOutOfRange"},
+        {PacketError::BadPowerOffState, "BadPowerOffState"},
+        {PacketError::ColorOutOfRange, "ColorOutOfRange"},
+    }};
+};
+inline std::string_view error_name(PacketError v) { return name_of(v); }
 
 struct PacketResult {
     PacketError error = PacketError::None;

@@ -2,12 +2,23 @@
 // refused an event; each with the name logs, D-Bus and tests use.
 #pragma once
 
+#include "core/enum_names.hpp"
+
 #include <string_view>
 
 namespace caracara {
 
 enum class SafetyState { Arming, Ready, Killed, PoweredOff };
-std::string_view state_name(SafetyState s);  // "arming", "ready", "killed", "powered-off"
+template <>
+struct EnumNames<SafetyState> {
+    static constexpr std::array<EnumName<SafetyState>, 4> table{{
+        {SafetyState::Arming, "arming"},
+        {SafetyState::Ready, "ready"},
+        {SafetyState::Killed, "killed"},
+        {SafetyState::PoweredOff, "powered-off"},
+    }};
+};
+inline std::string_view state_name(SafetyState v) { return name_of(v); }
 
 enum class KillSource {
     None,    // not killed
@@ -20,7 +31,20 @@ enum class KillSource {
     Failsafe, // a failsafe's kill, or the end of its ascent (core/failsafe_policy)
 };
 // "none", "dbus", "switch", "packet", "bus", "start", "device", "failsafe"
-std::string_view kill_source_name(KillSource s);
+template <>
+struct EnumNames<KillSource> {
+    static constexpr std::array<EnumName<KillSource>, 8> table{{
+        {KillSource::None, "none"},
+        {KillSource::DBus, "dbus"},
+        {KillSource::Switch, "switch"},
+        {KillSource::Packet, "packet"},
+        {KillSource::Fault, "bus"}, // the escalated fault is the I2C bus that could not be recovered
+        {KillSource::Start, "start"},
+        {KillSource::Device, "device"},
+        {KillSource::Failsafe, "failsafe"},
+    }};
+};
+inline std::string_view kill_source_name(KillSource v) { return name_of(v); }
 
 enum class SafetyError {
     None,
@@ -29,6 +53,16 @@ enum class SafetyError {
     PoweredOff,     // anything that needs power after power-off
     NotReady,       // a thrust command while arming or killed
 };
-std::string_view error_name(SafetyError e);  // "NotKilled", "KillSwitchSet", ... (for logs and tests)
+template <>
+struct EnumNames<SafetyError> {
+    static constexpr std::array<EnumName<SafetyError>, 5> table{{
+        {SafetyError::None, "None"},
+        {SafetyError::NotKilled, "NotKilled"},
+        {SafetyError::KillSwitchSet, "KillSwitchSet"},
+        {SafetyError::PoweredOff, "PoweredOff"},
+        {SafetyError::NotReady, "NotReady"},
+    }};
+};
+inline std::string_view error_name(SafetyError v) { return name_of(v); }
 
 } // namespace caracara

@@ -2,6 +2,8 @@
 // org.caracara.Vehicle1.Error.<name> (dbus/ adds the prefix; nothing else names errors).
 #pragma once
 
+#include "core/enum_names.hpp"
+
 #include <string>
 #include <string_view>
 
@@ -30,7 +32,32 @@ enum class Status {
     Surfacing,       // a failsafe's ascent is running: other motion waits for it (Kill does not)
     FailsafeActive,  // ClearKill while the failsafe that killed still holds
 };
-std::string_view status_name(Status s); // "OutOfRange", ...
+template <>
+struct EnumNames<Status> {
+    static constexpr std::array<EnumName<Status>, 20> table{{
+        {Status::Ok, "Ok"},
+        {Status::InvalidLength, "InvalidLength"},
+        {Status::OutOfRange, "OutOfRange"},
+        {Status::InvalidValue, "InvalidValue"},
+        {Status::Killed, "Killed"},
+        {Status::Arming, "Arming"},
+        {Status::PoweredOff, "PoweredOff"},
+        {Status::OverBudget, "OverBudget"},
+        {Status::NotKilled, "NotKilled"},
+        {Status::KillSwitchSet, "KillSwitchSet"},
+        {Status::ConfirmationRequired, "ConfirmationRequired"},
+        {Status::Busy, "Busy"},
+        {Status::Timeout, "Timeout"},
+        {Status::LinkError, "LinkError"},
+        {Status::Hardware, "Hardware"},
+        {Status::UnknownProfile, "UnknownProfile"},
+        {Status::BusLost, "BusLost"},
+        {Status::ThrusterUnreachable, "ThrusterUnreachable"},
+        {Status::Surfacing, "Surfacing"},
+        {Status::FailsafeActive, "FailsafeActive"},
+    }};
+};
+inline std::string_view status_name(Status v) { return name_of(v); }
 
 struct Result {
     Status status = Status::Ok;

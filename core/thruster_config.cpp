@@ -4,22 +4,6 @@
 
 namespace caracara {
 
-std::string_view variant_name(Variant v) {
-    switch (v) {
-    case Variant::SeaBotix: return "seabotix";
-    case Variant::Legacy: return "legacy";
-    }
-    return "seabotix";
-}
-
-std::optional<Variant> parse_variant(std::string_view s) {
-    if (s == "seabotix")
-        return Variant::SeaBotix;
-    if (s == "legacy")
-        return Variant::Legacy;
-    return std::nullopt;
-}
-
 std::string validate_thruster_config(const ThrusterConfig& cfg) {
     if (!is_valid_mt(cfg.mt))
         return "mt " + hex(cfg.mt) + " is not an even 8-bit write address in 0x10..0xee";

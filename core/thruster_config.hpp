@@ -3,6 +3,8 @@
 // One definition for the configuration checker, the drivers and the simulator.
 #pragma once
 
+#include "core/enum_names.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -19,8 +21,15 @@ enum class Variant : uint8_t {
     Legacy,    // Aveox / legacy SeaBotix controller, default MT 0x54/0x55, 4-byte status
 };
 
-std::string_view variant_name(Variant v);                // "seabotix" / "legacy"
-std::optional<Variant> parse_variant(std::string_view s); // exact lowercase names only
+template <>
+struct EnumNames<Variant> {
+    static constexpr std::array<EnumName<Variant>, 2> table{{
+        {Variant::SeaBotix, "seabotix"},
+        {Variant::Legacy, "legacy"},
+    }};
+};
+inline std::string_view variant_name(Variant v) { return name_of(v); }
+inline std::optional<Variant> parse_variant(std::string_view s) { return parse_name<Variant>(s); }
 
 // Default 8-bit write address byte (MT) from IDS 6.4.2.
 constexpr uint8_t default_mt(Variant v) { return v == Variant::SeaBotix ? 0x52 : 0x54; }

@@ -2,6 +2,7 @@
 // them, wire time at the configured clock, and the wire log. One call = one I2C_RDWR.
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "sim/i2c_slave.hpp"
 #include "sim/pca9544.hpp"
 #include "sim/wire_log.hpp"
@@ -91,3 +92,13 @@ private:
 };
 
 } // namespace caracara::sim
+namespace caracara {
+template <>
+struct EnumNames<sim::I2cBusModel::Hang> {
+    static constexpr std::array<EnumName<sim::I2cBusModel::Hang>, 3> table{{
+        {sim::I2cBusModel::Hang::None, "none"},
+        {sim::I2cBusModel::Hang::SdaLow, "sda-low"},
+        {sim::I2cBusModel::Hang::SclLow, "scl-low"},
+    }};
+};
+} // namespace caracara

@@ -20,15 +20,6 @@ using dbus::property;
 
 SimVehicle& vehicle(void* userdata) { return static_cast<SimulatorParts*>(userdata)->vehicle; }
 
-const char* hang_name(I2cBusModel::Hang h) {
-    switch (h) {
-    case I2cBusModel::Hang::None: return "none";
-    case I2cBusModel::Hang::SdaLow: return "sda-low";
-    case I2cBusModel::Hang::SclLow: return "scl-low";
-    }
-    return "none";
-}
-
 int m_set_kill_switch(sd_bus_message* m, void* userdata, sd_bus_error*) {
     int on = 0;
     if (int r = sd_bus_message_read(m, "b", &on); r < 0)
@@ -203,7 +194,7 @@ constexpr dbus::Member kMembers[] = {
     property<[](I i) { return i.vehicle.driver_bound(); }>("DriverBound"),
     property<[](I i) { return i.vehicle.unbinds(); }>("Unbinds"),
     property<[](I i) { return i.vehicle.binds(); }>("Binds"),
-    property<[](I i) { return hang_name(i2c(i).hang()); }>("BusHang"),
+    property<[](I i) { return name_of(i2c(i).hang()); }>("BusHang"),
     property<[](I i) { return i2c(i).hang_pulses_seen(); }>("HangPulsesSeen"),
     property<[](I i) { return i2c(i).hang_pulses_needed(); }>("HangPulsesNeeded"),
     property<[](I i) { return gpio(i).scl_pulses(); }>("SclPulses"),

@@ -83,7 +83,7 @@ int m_frame_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
         int r = sd_bus_message_open_container(reply, 'a', "(tttysayay)");
         for (const auto& f : teensy(userdata).frames().records()) {
             if (r >= 0) r = sd_bus_message_open_container(reply, 'r', "tttysayay");
-            if (r >= 0) r = sd_bus_message_append(reply, "tttys", f.seq, f.start_ns, f.end_ns, f.command, std::string(to_string(f.outcome)).c_str());
+            if (r >= 0) r = sd_bus_message_append(reply, "tttys", f.seq, f.start_ns, f.end_ns, f.command, std::string(name_of(f.outcome)).c_str());
             if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.mosi.data(), f.mosi.size());
             if (r >= 0) r = sd_bus_message_append_array(reply, 'y', f.miso.data(), f.miso.size());
             if (r >= 0) r = sd_bus_message_close_container(reply);
@@ -106,7 +106,7 @@ constexpr dbus::Member kMembers[] = {
     property<[](V v) -> const auto& { return v.teensy().servo_degrees(); }>("Servos"),
     property<[](V v) -> const auto& { return v.teensy().distances_mm(); }>("Distances"),
     property<[](V v) { return v.teensy().stop_duty(); }>("StopDuty"),
-    property<[](V v) { return to_string(v.teensy().task_state()); }>("Task"),
+    property<[](V v) { return name_of(v.teensy().task_state()); }>("Task"),
     property<[](V v) { return v.teensy().acknowledgements(); }>("Acknowledgements"),
     property<[](V v) { return v.teensy().frames().total(); }>("Frames"),
     property<[](V v) { return double(v.teensy().last_turn_rad()); }>("LastTurn"),

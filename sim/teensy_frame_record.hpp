@@ -2,6 +2,8 @@
 // in, what went out, and what became of it.
 #pragma once
 
+#include "core/enum_names.hpp"
+
 #include <cstdint>
 #include <string_view>
 #include <vector>
@@ -29,6 +31,18 @@ struct TeensyFrameRecord {
     std::vector<uint8_t> miso;
 };
 
-std::string_view to_string(TeensyFrameOutcome o);
-
 } // namespace caracara::sim
+namespace caracara {
+template <>
+struct EnumNames<sim::TeensyFrameOutcome> {
+    static constexpr std::array<EnumName<sim::TeensyFrameOutcome>, 7> table{{
+        {sim::TeensyFrameOutcome::Ok, "ok"},
+        {sim::TeensyFrameOutcome::Busy, "busy"},
+        {sim::TeensyFrameOutcome::GarbageAck, "garbage-ack"},
+        {sim::TeensyFrameOutcome::NoAnswer, "no-answer"},
+        {sim::TeensyFrameOutcome::Invalid, "invalid"},
+        {sim::TeensyFrameOutcome::Unknown, "unknown"},
+        {sim::TeensyFrameOutcome::Incomplete, "incomplete"},
+    }};
+};
+} // namespace caracara

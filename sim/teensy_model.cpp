@@ -62,15 +62,6 @@ std::string_view teensy_command_name(uint8_t command) {
     }
 }
 
-std::string_view to_string(TeensyTaskState s) {
-    switch (s) {
-    case TeensyTaskState::Idle: return "idle";
-    case TeensyTaskState::Running: return "running";
-    case TeensyTaskState::FinishedAwaitingAck: return "finished-awaiting-ack";
-    }
-    return "?";
-}
-
 TeensyModel::TeensyModel(TeensyConfig cfg, AttitudeSource attitude)
     : cfg_(cfg), attitude_(std::move(attitude)), frames_(cfg.log_capacity) {
     if (!attitude_)

@@ -40,6 +40,7 @@
 // Not thread-safe: the simulator drives all models from one thread.
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "sim/spi_slave.hpp"
 #include "sim/stepped.hpp"
 #include "sim/teensy_config.hpp"
@@ -80,7 +81,18 @@ inline constexpr std::size_t kMaxServoDegrees = 180;
 enum class TeensyTaskState : uint8_t { Idle, Running, FinishedAwaitingAck };
 
 std::string_view teensy_command_name(uint8_t command);
-std::string_view to_string(TeensyTaskState s);
+} // namespace caracara::sim
+namespace caracara {
+template <>
+struct EnumNames<sim::TeensyTaskState> {
+    static constexpr std::array<EnumName<sim::TeensyTaskState>, 3> table{{
+        {sim::TeensyTaskState::Idle, "idle"},
+        {sim::TeensyTaskState::Running, "running"},
+        {sim::TeensyTaskState::FinishedAwaitingAck, "finished-awaiting-ack"},
+    }};
+};
+} // namespace caracara
+namespace caracara::sim {
 
 class TeensyModel : public SpiSlave, public Stepped {
 public:

@@ -5,15 +5,6 @@
 
 namespace caracara {
 
-std::string_view bus_state_name(BusState s) {
-    switch (s) {
-    case BusState::Ok: return "ok";
-    case BusState::Recovering: return "recovering";
-    case BusState::Lost: return "lost";
-    }
-    return "ok";
-}
-
 BusMonitor::BusMonitor(std::string device, VehicleEvents& events)
     : events_(events), device_(std::move(device)), lockup_(static_cast<uint32_t>(kMotorCount)) {}
 

@@ -4,6 +4,7 @@
 // closed for recovery on purpose, its failures say nothing.
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/lockup_detector.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
 #include "drivers/platform/io_error.hpp"
@@ -15,7 +16,15 @@
 namespace caracara {
 
 enum class BusState { Ok, Recovering, Lost };
-std::string_view bus_state_name(BusState s); // "ok", "recovering", "lost"
+template <>
+struct EnumNames<BusState> {
+    static constexpr std::array<EnumName<BusState>, 3> table{{
+        {BusState::Ok, "ok"},
+        {BusState::Recovering, "recovering"},
+        {BusState::Lost, "lost"},
+    }};
+};
+inline std::string_view bus_state_name(BusState v) { return name_of(v); }
 
 struct BusTelemetry {
     BusState state = BusState::Ok;

@@ -21,21 +21,6 @@ IoError io_error_from_errno(int err) {
     }
 }
 
-std::string_view io_error_name(IoError e) {
-    switch (e) {
-    case IoError::None: return "none";
-    case IoError::Nack: return "nack";
-    case IoError::Timeout: return "timeout";
-    case IoError::ClockStretch: return "clock-stretch";
-    case IoError::Arbitration: return "arbitration-lost";
-    case IoError::NoDevice: return "no-device";
-    case IoError::BadReply: return "bad-reply";
-    case IoError::Unsupported: return "unsupported";
-    case IoError::Other: return "other";
-    }
-    return "other";
-}
-
 std::string errno_name(int err) {
     const char* name = strerrorname_np(err);
     std::string s = name ? name : ("errno " + std::to_string(err));

@@ -3,6 +3,7 @@
 // NACK, ETIMEDOUT a timeout, EIO a clock-stretch timeout, EAGAIN lost arbitration).
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/lockup_detector.hpp"
 
 #include <string>
@@ -23,7 +24,21 @@ enum class IoError {
 };
 
 IoError io_error_from_errno(int err);   // err is positive errno
-std::string_view io_error_name(IoError e);
+template <>
+struct EnumNames<IoError> {
+    static constexpr std::array<EnumName<IoError>, 9> table{{
+        {IoError::None, "none"},
+        {IoError::Nack, "nack"},
+        {IoError::Timeout, "timeout"},
+        {IoError::ClockStretch, "clock-stretch"},
+        {IoError::Arbitration, "arbitration-lost"},
+        {IoError::NoDevice, "no-device"},
+        {IoError::BadReply, "bad-reply"},
+        {IoError::Unsupported, "unsupported"},
+        {IoError::Other, "other"},
+    }};
+};
+inline std::string_view io_error_name(IoError v) { return name_of(v); }
 std::string errno_name(int err);       // "ETIMEDOUT (Connection timed out)"
 // What a transfer's outcome says about the wire, for lockup detection: timeouts, EIO, lost
 // arbitration and a vanished adapter are the bus's; a NACK is one device's.

@@ -42,18 +42,6 @@ uint8_t checksum8(std::span<const uint8_t> bytes) {
     return static_cast<uint8_t>(sum & 0xFFu);
 }
 
-std::string_view codec_error_name(CodecError e) {
-    switch (e) {
-    case CodecError::None: return "none";
-    case CodecError::BadLength: return "bad-length";
-    case CodecError::BadFirstByte: return "bad-first-byte";
-    case CodecError::BadChecksum: return "bad-checksum";
-    case CodecError::BadSpeed: return "bad-speed";
-    case CodecError::BadAddress: return "bad-address";
-    }
-    return "none";
-}
-
 std::optional<OrderBytes> encode_order(uint8_t mt_write, uint8_t speed, uint8_t info) {
     if (!is_valid_mt(mt_write) || speed < kSpeedMin || speed > kSpeedMax)
         return std::nullopt;
@@ -79,17 +67,6 @@ DecodedOrder decode_order(uint8_t mt_write, std::span<const uint8_t> bytes) {
     if (bytes[0] < kSpeedMin || bytes[0] > kSpeedMax)
         out.error = CodecError::BadSpeed;
     return out;
-}
-
-std::string_view fault_name(Fault f) {
-    switch (f) {
-    case Fault::Overtemp: return "overtemp";
-    case Fault::Stall: return "stall";
-    case Fault::Hall: return "hall";
-    case Fault::GroundFault: return "ground-fault";
-    case Fault::WaterDetect: return "water-detect";
-    }
-    return "unknown";
 }
 
 std::string format_faults(FaultSet faults) {
@@ -127,26 +104,6 @@ bool faults_stop_motor(Variant v, FaultSet faults) {
         if (faults.has(f) && fault_stops_motor(v, f))
             return true;
     return false;
-}
-
-std::string_view legacy_software_name(LegacySoftware s) {
-    switch (s) {
-    case LegacySoftware::Original: return "original";
-    case LegacySoftware::AveoxBrushless: return "aveox-brushless";
-    case LegacySoftware::LegacyBrushed: return "legacy-brushed";
-    case LegacySoftware::BrushedRev4: return "brushed-rev4";
-    case LegacySoftware::Unknown: return "unknown";
-    }
-    return "unknown";
-}
-
-std::string_view max_power_meaning_name(MaxPowerMeaning m) {
-    switch (m) {
-    case MaxPowerMeaning::CurrentDeciAmps: return "current";
-    case MaxPowerMeaning::PowerSpeed: return "power-speed";
-    case MaxPowerMeaning::Unknown: return "unknown";
-    }
-    return "unknown";
 }
 
 namespace {

@@ -11,6 +11,7 @@
 // reply's MT=53h say 52h/53h, which is what this codec uses (the address is configurable anyway).
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/motor.hpp"
 #include "core/thruster_config.hpp"
 
@@ -62,7 +63,18 @@ enum class CodecError : uint8_t {
     BadSpeed,      // SPEED byte outside 0x19..0xE6
     BadAddress,    // MT is odd or a reserved I2C address
 };
-std::string_view codec_error_name(CodecError e);  // "bad-length", "bad-first-byte", ...
+template <>
+struct EnumNames<CodecError> {
+    static constexpr std::array<EnumName<CodecError>, 6> table{{
+        {CodecError::None, "none"},
+        {CodecError::BadLength, "bad-length"},
+        {CodecError::BadFirstByte, "bad-first-byte"},
+        {CodecError::BadChecksum, "bad-checksum"},
+        {CodecError::BadSpeed, "bad-speed"},
+        {CodecError::BadAddress, "bad-address"},
+    }};
+};
+inline std::string_view codec_error_name(CodecError v) { return name_of(v); }
 
 using OrderBytes = std::array<uint8_t, kOrderLength>;
 
@@ -93,7 +105,17 @@ inline constexpr std::array<Fault, 5> kAllFaults{Fault::Overtemp, Fault::Stall, 
 inline constexpr uint8_t kFaultMask = 0x1F;
 
 // "overtemp", "stall", "hall", "ground-fault", "water-detect"
-std::string_view fault_name(Fault f);
+template <>
+struct EnumNames<Fault> {
+    static constexpr std::array<EnumName<Fault>, 5> table{{
+        {Fault::Overtemp, "overtemp"},
+        {Fault::Stall, "stall"},
+        {Fault::Hall, "hall"},
+        {Fault::GroundFault, "ground-fault"},
+        {Fault::WaterDetect, "water-detect"},
+    }};
+};
+inline std::string_view fault_name(Fault f) { return name_of(f); }
 
 struct FaultSet {
     uint8_t bits = 0;  // only kFaultMask bits are ever set
@@ -122,7 +144,17 @@ enum class LegacySoftware : uint8_t {
     BrushedRev4,     // code 4 (bit 7): brushed DC, revision 4
     Unknown,         // codes 3, 5, 6, 7: not defined by the IDS
 };
-std::string_view legacy_software_name(LegacySoftware s);  // "original", "aveox-brushless", ...
+template <>
+struct EnumNames<LegacySoftware> {
+    static constexpr std::array<EnumName<LegacySoftware>, 5> table{{
+        {LegacySoftware::Original, "original"},
+        {LegacySoftware::AveoxBrushless, "aveox-brushless"},
+        {LegacySoftware::LegacyBrushed, "legacy-brushed"},
+        {LegacySoftware::BrushedRev4, "brushed-rev4"},
+        {LegacySoftware::Unknown, "unknown"},
+    }};
+};
+inline std::string_view legacy_software_name(LegacySoftware v) { return name_of(v); }
 
 // What the legacy MAX POWER byte means depends on the software (IDS 8.4.1).
 enum class MaxPowerMeaning : uint8_t {
@@ -130,7 +162,15 @@ enum class MaxPowerMeaning : uint8_t {
     PowerSpeed,       // brushed software: power set into the motor, in SPEED byte units
     Unknown,          // original or undefined software: the IDS does not say
 };
-std::string_view max_power_meaning_name(MaxPowerMeaning m);  // "current", "power-speed", "unknown"
+template <>
+struct EnumNames<MaxPowerMeaning> {
+    static constexpr std::array<EnumName<MaxPowerMeaning>, 3> table{{
+        {MaxPowerMeaning::CurrentDeciAmps, "current"},
+        {MaxPowerMeaning::PowerSpeed, "power-speed"},
+        {MaxPowerMeaning::Unknown, "unknown"},
+    }};
+};
+inline std::string_view max_power_meaning_name(MaxPowerMeaning v) { return name_of(v); }
 
 struct SeaBotixStatus {
     // Raw bytes as received.

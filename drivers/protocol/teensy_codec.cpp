@@ -26,28 +26,6 @@ const CommandInfo& command_info(Command c) {
 static_assert(kCommands[0].id == Command::Confirm && kCommands[8].id == Command::SetLeds);
 static_assert(static_cast<uint8_t>(kCommands[8].id) + 1 == kFirstReservedCommand);
 
-std::string_view teensy_error_name(TeensyError e) {
-    switch (e) {
-    case TeensyError::None: return "none";
-    case TeensyError::SpeedOutOfRange: return "speed-out-of-range";
-    case TeensyError::AngleNotFinite: return "angle-not-finite";
-    case TeensyError::DutyOutOfRange: return "duty-out-of-range";
-    case TeensyError::ServoIdOutOfRange: return "servo-id-out-of-range";
-    case TeensyError::ServoAngleOutOfRange: return "servo-angle-out-of-range";
-    case TeensyError::SensorIdOutOfRange: return "sensor-id-out-of-range";
-    case TeensyError::AxisOutOfRange: return "axis-out-of-range";
-    case TeensyError::LedValueOutOfRange: return "led-value-out-of-range";
-    case TeensyError::Busy: return "busy";
-    case TeensyError::BusyExhausted: return "busy-exhausted";
-    case TeensyError::LinkError: return "link-error";
-    case TeensyError::BadAnswer: return "bad-answer";
-    case TeensyError::Io: return "io";
-    case TeensyError::ConfirmTimeout: return "confirm-timeout";
-    case TeensyError::ConfirmAckFailed: return "confirm-ack-failed";
-    }
-    return "unknown";
-}
-
 void put_u16_le(uint8_t* out, uint16_t v) {
     out[0] = static_cast<uint8_t>(v & 0xFFu);
     out[1] = static_cast<uint8_t>(v >> 8);

@@ -5,6 +5,7 @@
 // confirm_handshake.hpp). No system calls, no clock.
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/link_config.hpp"
 #include "core/status.hpp"
 
@@ -87,7 +88,32 @@ enum class TeensyError : uint8_t {
     ConfirmAckFailed,     // finished, but the acknowledgement could not be delivered
 };
 
-std::string_view teensy_error_name(TeensyError e);
+} // namespace caracara::teensy
+namespace caracara {
+template <>
+struct EnumNames<teensy::TeensyError> {
+    static constexpr std::array<EnumName<teensy::TeensyError>, 16> table{{
+        {teensy::TeensyError::None, "none"},
+        {teensy::TeensyError::SpeedOutOfRange, "speed-out-of-range"},
+        {teensy::TeensyError::AngleNotFinite, "angle-not-finite"},
+        {teensy::TeensyError::DutyOutOfRange, "duty-out-of-range"},
+        {teensy::TeensyError::ServoIdOutOfRange, "servo-id-out-of-range"},
+        {teensy::TeensyError::ServoAngleOutOfRange, "servo-angle-out-of-range"},
+        {teensy::TeensyError::SensorIdOutOfRange, "sensor-id-out-of-range"},
+        {teensy::TeensyError::AxisOutOfRange, "axis-out-of-range"},
+        {teensy::TeensyError::LedValueOutOfRange, "led-value-out-of-range"},
+        {teensy::TeensyError::Busy, "busy"},
+        {teensy::TeensyError::BusyExhausted, "busy-exhausted"},
+        {teensy::TeensyError::LinkError, "link-error"},
+        {teensy::TeensyError::BadAnswer, "bad-answer"},
+        {teensy::TeensyError::Io, "io"},
+        {teensy::TeensyError::ConfirmTimeout, "confirm-timeout"},
+        {teensy::TeensyError::ConfirmAckFailed, "confirm-ack-failed"},
+    }};
+};
+} // namespace caracara
+namespace caracara::teensy {
+inline std::string_view teensy_error_name(TeensyError v) { return name_of(v); }
 // The Status a caller gets for it (core/status.cpp names it).
 Status status_of(TeensyError e);
 

@@ -310,7 +310,7 @@ TEST_CASE("the frame log is a bounded ring of raw bytes and outcomes") {
     CHECK(log[2].miso == Bytes{0, 0, 0, 0, 0x09});
     CHECK(log[2].name == "SetLeds");
     CHECK(log[3].outcome == TeensyFrameOutcome::Busy);
-    CHECK(to_string(log[3].outcome) == "busy");
+    CHECK(caracara::name_of(log[3].outcome) == "busy");
     CHECK(log[3].miso == Bytes{0, 0, 0xFF});
 }
 
