@@ -32,7 +32,7 @@ void SafetyMachine::enter_killed(KillSource source, uint64_t now, std::string_vi
 
 SafetyAction SafetyMachine::kill(KillSource source, uint64_t now, std::string_view reason) {
     if (source == KillSource::None)
-        source = KillSource::Fault;  // a kill without a named source is still a kill
+        source = KillSource::Bus;  // a kill without a named source is still a kill
     if (state_ == SafetyState::PoweredOff)
         return SafetyAction::zeroing("powered off", false);
     if (state_ == SafetyState::Killed && kill_source_ != KillSource::Start)

@@ -25,7 +25,7 @@ enum class KillSource {
     DBus,    // the Kill method
     Switch,  // the kill switch GPIO
     Packet,  // a legacy packet with killState != 0
-    Fault,   // an escalated fault, e.g. the I2C bus could not be recovered
+    Bus,     // the I2C bus lost: it could not be recovered, or a lockup outlasted the command timeout
     Start,   // every start of the daemon, until someone decides to arm it (ClearKill)
     Device,  // a line or device the daemon drives went away (kill/power-off output, the Teensy's SPI)
     Failsafe, // a failsafe's kill, or the end of its ascent (core/failsafe_policy)
@@ -38,7 +38,7 @@ struct EnumNames<KillSource> {
         {KillSource::DBus, "dbus"},
         {KillSource::Switch, "switch"},
         {KillSource::Packet, "packet"},
-        {KillSource::Fault, "bus"}, // the escalated fault is the I2C bus that could not be recovered
+        {KillSource::Bus, "bus"},
         {KillSource::Start, "start"},
         {KillSource::Device, "device"},
         {KillSource::Failsafe, "failsafe"},

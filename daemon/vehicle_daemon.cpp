@@ -18,14 +18,14 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
       recovery_(event, config_, io, gpio, bus_, loop_, vehicle_, events_),
       status_(event, vehicle_, bus_, loop_),
       failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); },
-                 [this] { return fixed_conditions(); }, vehicle_, events_) {
+                 [this] { return vehicle_conditions(); }, vehicle_, events_) {
     vehicle_.set_demand_listener(&loop_);
     bus_.monitor().set_listener(&recovery_);
     events_.attach_status(&status_);
     status_.set_failsafe_summary([this] { return failsafes_.summary(); });
 }
 
-std::array<bool, kFailsafeConditionCount> VehicleDaemon::fixed_conditions() const {
+std::array<bool, kFailsafeConditionCount> VehicleDaemon::vehicle_conditions() const {
     std::array<bool, kFailsafeConditionCount> c{};
     c[static_cast<std::size_t>(FailsafeCondition::BusLost)] = bus_.monitor().telemetry().state == BusState::Lost;
     c[static_cast<std::size_t>(FailsafeCondition::ThrusterUnreachable)] = bus_.health().first_unreachable().has_value();

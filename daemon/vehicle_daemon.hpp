@@ -4,18 +4,18 @@
 #pragma once
 
 #include "core/config.hpp"
-#include "daemon/recovery/bus_recovery.hpp"
 #include "daemon/bus/thruster_bus.hpp"
+#include "daemon/control/control_loop.hpp"
 #include "daemon/dive/dive_recorder.hpp"
 #include "daemon/dive/dive_writer.hpp"
 #include "daemon/failsafe/failsafe_monitor.hpp"
+#include "daemon/interfaces/vehicle_events.hpp"
+#include "daemon/recovery/bus_recovery.hpp"
 #include "daemon/safety/safety_lines.hpp"
 #include "daemon/service_status.hpp"
 #include "daemon/teensy/teensy_port.hpp"
-#include "daemon/control/control_loop.hpp"
 #include "daemon/vehicle/packet_handler.hpp"
 #include "daemon/vehicle/vehicle.hpp"
-#include "daemon/interfaces/vehicle_events.hpp"
 #include "drivers/devices/emergency_stop.hpp"
 #include "drivers/platform/device_io.hpp"
 #include "drivers/platform/gpio_backend.hpp"
@@ -67,7 +67,7 @@ private:
     std::optional<FailsafeReading> reading(std::size_t i) const;
     // The fixed conditions: bus lost, a thruster unreachable, the kill switch unreadable (each
     // kills where it arises), pilot lost and the Teensy link lost (the failsafes kill).
-    std::array<bool, kFailsafeConditionCount> fixed_conditions() const;
+    std::array<bool, kFailsafeConditionCount> vehicle_conditions() const;
 
     sd_event* event_;
     DaemonConfig config_;

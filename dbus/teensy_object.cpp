@@ -11,7 +11,7 @@ namespace caracara::dbus {
 
 namespace {
 
-TeensyPort& ctl(void* userdata) { return *static_cast<TeensyPort*>(userdata); }
+TeensyPort& teensy(void* userdata) { return *static_cast<TeensyPort*>(userdata); }
 
 // Every Teensy command is carried by its worker: replied to when the Teensy answered (other
 // calls are served meanwhile), or at once when refused before anything was sent.
@@ -21,21 +21,21 @@ int m_set_speed(sd_bus_message* m, void* userdata, sd_bus_error*) {
     int32_t left = 0, right = 0;
     if (int r = sd_bus_message_read(m, "ii", &left, &right); r < 0)
         return r;
-    return reply_when_done(m, ctl(userdata).set_speed(left, right, sender(m), reply_later(m)));
+    return reply_when_done(m, teensy(userdata).set_speed(left, right, sender(m), reply_later(m)));
 }
 
 int m_stop(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint8_t duty = 0;
     if (int r = sd_bus_message_read(m, "y", &duty); r < 0)
         return r;
-    return reply_when_done(m, ctl(userdata).stop(duty, reply_later(m)));
+    return reply_when_done(m, teensy(userdata).stop(duty, reply_later(m)));
 }
 
 int m_servo(sd_bus_message* m, void* userdata, sd_bus_error*) {
     uint8_t id = 0, degrees = 0;
     if (int r = sd_bus_message_read(m, "yy", &id, &degrees); r < 0)
         return r;
-    return reply_when_done(m, ctl(userdata).servo(id, degrees, reply_later(m)));
+    return reply_when_done(m, teensy(userdata).servo(id, degrees, reply_later(m)));
 }
 
 int m_distance(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -43,7 +43,7 @@ int m_distance(sd_bus_message* m, void* userdata, sd_bus_error*) {
     if (int r = sd_bus_message_read(m, "y", &sensor); r < 0)
         return r;
     auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
-    return reply_when_done(m, ctl(userdata).distance(sensor, [held](const Result& res, uint16_t mm) {
+    return reply_when_done(m, teensy(userdata).distance(sensor, [held](const Result& res, uint16_t mm) {
         if (!res.ok())
             reply(held.get(), res);
         else
@@ -56,7 +56,7 @@ int turn(sd_bus_message* m, void* userdata, bool absolute) {
     if (int r = sd_bus_message_read(m, "d", &radians); r < 0)
         return r;
     // Replied to when the Teensy confirms; other calls are served meanwhile.
-    return reply_when_done(m, ctl(userdata).turn(radians, absolute, sender(m), reply_later(m)));
+    return reply_when_done(m, teensy(userdata).turn(radians, absolute, sender(m), reply_later(m)));
 }
 
 int m_turn(sd_bus_message* m, void* userdata, sd_bus_error*) { return turn(m, userdata, false); }

@@ -13,7 +13,7 @@ namespace caracara::dbus {
 namespace {
 
 using Parts = VehicleObject::Parts;
-Vehicle& ctl(void* userdata) { return static_cast<Parts*>(userdata)->vehicle; }
+Vehicle& vehicle(void* userdata) { return static_cast<Parts*>(userdata)->vehicle; }
 
 int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
     const void* p = nullptr;
@@ -31,14 +31,14 @@ int m_set_thrust(sd_bus_message* m, void* userdata, sd_bus_error*) {
     std::vector<int32_t> v;
     if (int r = read_ints(m, v); r < 0)
         return r;
-    return reply(m, ctl(userdata).set_thrust(v, sender(m)));
+    return reply(m, vehicle(userdata).set_thrust(v, sender(m)));
 }
 
 int m_set_motion(sd_bus_message* m, void* userdata, sd_bus_error*) {
     AxisDemand d{};
     if (int r = sd_bus_message_read(m, "dddddd", &d[0], &d[1], &d[2], &d[3], &d[4], &d[5]); r < 0)
         return r;
-    return reply(m, ctl(userdata).set_motion(d, sender(m)));
+    return reply(m, vehicle(userdata).set_motion(d, sender(m)));
 }
 
 int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -51,11 +51,11 @@ int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error*) {
 }
 
 int m_kill(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    ctl(userdata).kill(KillSource::DBus, "Kill() from " + sender(m), reply_later(m));
+    vehicle(userdata).kill(KillSource::DBus, "Kill() from " + sender(m), reply_later(m));
     return 1;
 }
 
-int m_clear_kill(sd_bus_message* m, void* userdata, sd_bus_error*) { return reply(m, ctl(userdata).clear_kill()); }
+int m_clear_kill(sd_bus_message* m, void* userdata, sd_bus_error*) { return reply(m, vehicle(userdata).clear_kill()); }
 
 int m_clear_kill_override(sd_bus_message* m, void* userdata, sd_bus_error*) {
     const char* condition = nullptr;
@@ -75,7 +75,7 @@ int m_power_off(sd_bus_message* m, void* userdata, sd_bus_error*) {
     const char* confirmation = nullptr;
     if (int r = sd_bus_message_read(m, "s", &confirmation); r < 0)
         return r;
-    ctl(userdata).power_off(confirmation, reply_later(m));
+    vehicle(userdata).power_off(confirmation, reply_later(m));
     return 1;
 }
 
@@ -93,7 +93,7 @@ int m_set_profile(sd_bus_message* m, void* userdata, sd_bus_error*) {
     const char* name = nullptr;
     if (int r = sd_bus_message_read(m, "s", &name); r < 0)
         return r;
-    return reply(m, ctl(userdata).set_profile(name));
+    return reply(m, vehicle(userdata).set_profile(name));
 }
 
 const ControlSettings& control(D d) { return d.control; }

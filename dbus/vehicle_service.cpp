@@ -7,7 +7,7 @@ namespace caracara::dbus {
 
 VehicleService::VehicleService(sd_bus* bus, const Parts& parts)
     : bus_(bus), events_(parts.events), vehicle_(bus, parts.vehicle), teensy_(bus, parts.teensy),
-      bus_object_(bus, parts.monitor), clients_(bus, parts.vehicle.vehicle),
+      i2c_bus_object_(bus, parts.monitor), clients_(bus, parts.vehicle.vehicle),
       announcer_(bus, [this](uint32_t changes) { announce(changes); }) {
     for (size_t i = 0; i < parts.thrusters.size(); ++i)
         thrusters_.push_back(std::make_unique<ThrusterObject>(bus, parts.thrusters, i));
@@ -36,7 +36,7 @@ int VehicleService::start() {
     for (auto& t : thrusters_)
         if ((r = t->start()) < 0)
             return r;
-    if ((r = teensy_.start()) < 0 || (r = bus_object_.start()) < 0 || (r = clients_.start()) < 0)
+    if ((r = teensy_.start()) < 0 || (r = i2c_bus_object_.start()) < 0 || (r = clients_.start()) < 0)
         return r;
     return sd_bus_request_name(bus_, kBusName, 0);
 }
@@ -46,7 +46,7 @@ void VehicleService::announce(uint32_t changes) {
     for (auto& t : thrusters_)
         t->announce(changes);
     teensy_.announce(changes);
-    bus_object_.announce(changes);
+    i2c_bus_object_.announce(changes);
 }
 
 } // namespace caracara::dbus

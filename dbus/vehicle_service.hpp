@@ -4,12 +4,12 @@
 
 #include "daemon/bus/bus_monitor.hpp"
 #include "daemon/bus/thruster_bus.hpp"
-#include "daemon/teensy/teensy_port.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
 #include "daemon/interfaces/vehicle_observer.hpp"
+#include "daemon/teensy/teensy_port.hpp"
 #include "dbus/announcer.hpp"
-#include "dbus/bus_object.hpp"
 #include "dbus/client_tracker.hpp"
+#include "dbus/i2c_bus_object.hpp"
 #include "dbus/teensy_object.hpp"
 #include "dbus/thruster_object.hpp"
 #include "dbus/vehicle_names.hpp"
@@ -41,8 +41,8 @@ public:
     void vehicle_changed(uint32_t changes) override { announcer_.request(changes); }
     void telemetry() override { announcer_.request(kTelemetryTick); }
     void orders_in_flight(bool in_flight) override { announcer_.hold(in_flight); }
-    void bus_lost(const std::string& reason) override { bus_object_.emit_lost(reason); }
-    void bus_restored(uint32_t pulses, double milliseconds) override { bus_object_.emit_restored(pulses, milliseconds); }
+    void bus_lost(const std::string& reason) override { i2c_bus_object_.emit_lost(reason); }
+    void bus_restored(uint32_t pulses, double milliseconds) override { i2c_bus_object_.emit_restored(pulses, milliseconds); }
     void failsafe(const ActiveFailsafe& f, bool raised) override {
         if (raised)
             vehicle_.emit_failsafe(f);
@@ -57,7 +57,7 @@ private:
     VehicleObject vehicle_;
     std::vector<std::unique_ptr<ThrusterObject>> thrusters_;
     TeensyObject teensy_;
-    BusObject bus_object_;
+    I2cBusObject i2c_bus_object_;
     ClientTracker clients_;
     Announcer announcer_; // last: gone first, before the objects it announces
 };

@@ -9,13 +9,13 @@
 //
 // Input: requests, each [u16 length][that many bytes], to the end; the length's top bit marks
 // a request the server received truncated.
+#include "drivers/protocol/sim_protocol.hpp"
 #include "fuzz/byte_source.hpp"
 #include "fuzz/check.hpp"
-#include "drivers/protocol/sim_protocol.hpp"
 #include "sim/device_ops.hpp"
 #include "sim/device_session.hpp"
 #include "sim/sim_config.hpp"
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <cerrno>
 #include <cstdio>

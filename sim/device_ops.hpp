@@ -5,7 +5,7 @@
 
 #include "drivers/protocol/sim_protocol.hpp"
 #include "sim/device_session.hpp"
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <cstdint>
 #include <span>

@@ -3,11 +3,11 @@
 // the reply timing live here; what each request does is DeviceOps'.
 #pragma once
 
-#include "drivers/sdbus/sdbus.hpp"
 #include "drivers/protocol/sim_protocol.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 #include "sim/device_ops.hpp"
 #include "sim/device_session.hpp"
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <array>
 #include <cstdint>

@@ -2,7 +2,7 @@
 // process's file descriptors are to the kernel.
 #pragma once
 
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <map>
 #include <string>

@@ -1,6 +1,6 @@
 #include "sim/dive_replay.hpp"
 
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <cmath>
 #include <cstdio>

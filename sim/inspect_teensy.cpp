@@ -2,7 +2,7 @@
 
 #include "drivers/sdbus/property.hpp"
 #include "sim/inspect_reply.hpp"
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <string>
 #include <tuple>

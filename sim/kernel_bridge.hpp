@@ -8,7 +8,7 @@
 
 #include "drivers/sdbus/sdbus.hpp"
 #include "sim/sim_config.hpp"
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <cstdint>
 #include <functional>

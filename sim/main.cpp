@@ -2,14 +2,14 @@
 // Unix socket) and for people and tests (org.caracara.Simulator1 on D-Bus).
 #include "core/dive_format.hpp"
 #include "drivers/platform/dive_files.hpp"
+#include "drivers/platform/io_error.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 #include "sim/device_server.hpp"
 #include "sim/dive_replay.hpp"
-#include "drivers/platform/io_error.hpp"
 #include "sim/inspector.hpp"
 #include "sim/kernel_bridge.hpp"
-#include "drivers/sdbus/sdbus.hpp"
 #include "sim/sim_config.hpp"
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <csignal>
 #include <cstdio>

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "sim/device_server.hpp"
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 namespace caracara::sim {
 

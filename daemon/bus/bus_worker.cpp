@@ -93,13 +93,13 @@ bool BusWorker::run_job(std::unique_lock<std::mutex>& lk) {
     // One wake-up of the loop per batch (the queue ran dry), or every kWakeEvery jobs so the
     // books stay fresh when the bus never rests: a wake-up per transfer would cost the loop
     // more than the transfer when the device answers at once.
-    return (queue_.empty() && (eager_ || owed_)) || done_.size() >= kWakeEvery;
+    return (queue_.empty() && (wake_at_once_ || owed_)) || done_.size() >= kWakeEvery;
 }
 
-void BusWorker::set_eager(bool eager) {
+void BusWorker::set_wake_at_once(bool at_once) {
     std::lock_guard lk(thread_.mutex());
-    eager_ = eager;
-    if (eager && !done_.empty() && queue_.empty() && !busy_)
+    wake_at_once_ = at_once;
+    if (at_once && !done_.empty() && queue_.empty() && !busy_)
         thread_.wake_loop(); // the batch was over before: its results now
 }
 

@@ -60,11 +60,11 @@ public:
     void set_gate(BusGate* gate) { gate_.store(gate); }
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
     bool idle() const { return outstanding_ == 0; }
-    // Eager (the default): the loop is woken as soon as a batch is over. Otherwise it takes the
+    // At once (the default): the loop is woken as soon as a batch is over. Otherwise it takes the
     // results itself (collect(), at its next tick: a cycle's routine transfers need no wake-up
     // of their own), and only a failed transfer or a long batch wakes it.
-    void set_eager(bool eager);
-    // Eager for the jobs handed over so far (call after the last of them): the loop is woken
+    void set_wake_at_once(bool at_once);
+    // At once for the jobs handed over so far (call after the last of them): the loop is woken
     // once they are done (a command's orders: its properties show what is on the wire).
     void wake_when_done();
     void collect() { deliver(); }
@@ -95,7 +95,7 @@ private:
     std::vector<BusJobDone> done_;     // under the lock
     std::vector<BusJobDone> delivering_; // loop thread; reused
     bool busy_ = false;                // under the lock: a job is on the wire
-    bool eager_ = true;                // under the lock
+    bool wake_at_once_ = true;                // under the lock
     bool owed_ = false;                // under the lock: the loop must hear of this batch (a failure)
     DoneFn on_done_;
     WorkerThread thread_{*this}; // last: joined before the rest goes

@@ -60,14 +60,14 @@ void ThrusterBus::when_idle(std::function<void()> fn) {
         return;
     }
     when_idle_.push_back(std::move(fn));
-    update_eager();
+    update_wake_at_once();
 }
 
-void ThrusterBus::update_eager() {
-    const bool eager = !lazy_ || !when_idle_.empty() || recovering();
-    if (eager != eager_)
-        worker_.set_eager(eager);
-    eager_ = eager;
+void ThrusterBus::update_wake_at_once() {
+    const bool at_once = !results_at_tick_ || !when_idle_.empty() || recovering();
+    if (at_once != wake_at_once_)
+        worker_.set_wake_at_once(at_once);
+    wake_at_once_ = at_once;
 }
 
 void ThrusterBus::done(const BusJobDone& d) {
@@ -82,7 +82,7 @@ void ThrusterBus::done(const BusJobDone& d) {
         when_idle_.clear();
         for (auto& fn : fns)
             fn();
-        update_eager();
+        update_wake_at_once();
     }
     if (on_done_)
         on_done_(d.job);
@@ -92,7 +92,7 @@ void ThrusterBus::set_recovering(bool r) {
     monitor_.set_recovering(r);
     if (r)
         worker_.drop_queued(); // the adapter is about to close; what is on the wire finishes
-    update_eager();
+    update_wake_at_once();
 }
 
 bool ThrusterBus::any_online() const {

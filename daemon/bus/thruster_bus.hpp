@@ -54,15 +54,15 @@ public:
     bool idle() const { return worker_.idle(); }
     // Runs `fn` once the transfers handed over so far are done (at once when idle).
     void when_idle(std::function<void()> fn);
-    // Lazy: the loop takes the results of its routine transfers at its tick (collect()) rather
+    // At its tick: the loop takes the results of its routine transfers at its tick (collect()) rather
     // than being woken for them; it is woken anyway while something waits for the bus to be
-    // idle (when_idle, a recovery) and for a failure (see BusWorker::set_eager).
-    void set_lazy(bool lazy) {
-        lazy_ = lazy;
-        update_eager();
+    // idle (when_idle, a recovery) and for a failure (see BusWorker::set_wake_at_once).
+    void set_results_at_tick(bool at_tick) {
+        results_at_tick_ = at_tick;
+        update_wake_at_once();
     }
     void collect() { worker_.collect(); }
-    // The transfers handed over so far come back at once, lazy or not (see BusWorker).
+    // The transfers handed over so far come back at once, whatever set_results_at_tick says (see BusWorker).
     void wake_when_done() { worker_.wake_when_done(); }
 
     // The adapter closed for a bus recovery (its queued work dropped) and open again.
@@ -83,7 +83,7 @@ public:
 
 private:
     void done(const BusJobDone& d);
-    void update_eager();
+    void update_wake_at_once();
 
     BusMonitor monitor_;
     ThrusterHealth health_;
@@ -94,8 +94,8 @@ private:
     std::vector<int32_t> ordered_;
     std::function<void(const BusJob&)> on_done_;
     std::vector<std::function<void()>> when_idle_;
-    bool lazy_ = false;
-    bool eager_ = true; // as last told to the worker
+    bool results_at_tick_ = false;
+    bool wake_at_once_ = true; // as last told to the worker
 };
 
 } // namespace caracara

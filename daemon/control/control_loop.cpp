@@ -44,7 +44,7 @@ std::string ControlLoop::start() {
 void ControlLoop::stop() {
     orders_out(false);
     started_ = false;
-    bus_.set_lazy(false); // no more ticks to take the results
+    bus_.set_results_at_tick(false); // no more ticks to take the results
     tick_source_.reset();
     work_.stop();
 }
@@ -117,12 +117,12 @@ void ControlLoop::cycle() {
         // it is done, as at loop rate 0. Refreshing the orders now instead would put them in
         // front of that cycle's status reads at every tick, and they would never be read.
         cycle_overrun_ = true;
-        bus_.set_lazy(false); // its end starts the next one: the loop must hear of it at once
+        bus_.set_results_at_tick(false); // its end starts the next one: the loop must hear of it at once
         publish_telemetry_if_due(t);
         return;
     }
     // At a loop rate the next tick takes this cycle's results; flat out, its end starts the next.
-    bus_.set_lazy(settings_.loop_rate_hz != 0);
+    bus_.set_results_at_tick(settings_.loop_rate_hz != 0);
     ++cycles_;
     in_cycle_ = true;
     work_.start_cycle(settings_.status_reads_per_tick);

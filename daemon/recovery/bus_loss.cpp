@@ -37,7 +37,7 @@ void BusLoss::declare(const std::string& why) {
         return;
     tm.state = BusState::Lost;
     tm.last_recovery_error = why;
-    vehicle_.kill(KillSource::Fault, "I2C bus lost: " + why);
+    vehicle_.kill(KillSource::Bus, "I2C bus lost: " + why);
     events_.changed(kChangeState | kChangeBus);
 }
 

@@ -1,13 +1,13 @@
 // Declaring the I2C bus lost: the thrusters cannot be reached, so the vehicle is killed
-// (source fault) and stays so until the bus is back. A lockup under recovery that outlasts the
+// (source bus) and stays so until the bus is back. A lockup under recovery that outlasts the
 // command timeout is a lost bus too: it has left the thrusters unreachable for longer than any
 // command may stand. Owns that timer; when to recover is BusRecovery's.
 #pragma once
 
 #include "core/config.hpp"
 #include "daemon/bus/thruster_bus.hpp"
-#include "daemon/vehicle/vehicle.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
+#include "daemon/vehicle/vehicle.hpp"
 #include "drivers/platform/event_loop.hpp"
 
 #include <cstdint>

@@ -83,7 +83,7 @@ TEST_CASE("starting with the kill switch set starts killed") {
 }
 
 TEST_CASE("a kill zeroes at once, drops commands and latches") {
-    for (KillSource src : {KillSource::DBus, KillSource::Switch, KillSource::Packet, KillSource::Fault}) {
+    for (KillSource src : {KillSource::DBus, KillSource::Switch, KillSource::Packet, KillSource::Bus}) {
         INFO(kill_source_name(src));
         uint64_t now = 0;
         SafetyMachine s = ready_machine(now);
@@ -112,7 +112,7 @@ TEST_CASE("a kill zeroes at once, drops commands and latches") {
     CHECK(kill_source_name(KillSource::DBus) == "dbus");
     CHECK(kill_source_name(KillSource::Switch) == "switch");
     CHECK(kill_source_name(KillSource::Packet) == "packet");
-    CHECK(kill_source_name(KillSource::Fault) == "bus");
+    CHECK(kill_source_name(KillSource::Bus) == "bus");
     CHECK(kill_source_name(KillSource::Device) == "device");
 }
 
@@ -120,7 +120,7 @@ TEST_CASE("a second kill keeps the first source and still asks for zero") {
     uint64_t now = 0;
     SafetyMachine s = ready_machine(now);
     s.kill(KillSource::Packet, now);
-    const SafetyAction a = s.kill(KillSource::Fault, now + 1, "bus recovery failed");
+    const SafetyAction a = s.kill(KillSource::Bus, now + 1, "bus recovery failed");
     CHECK(a.ok());
     CHECK_FALSE(a.state_changed);
     CHECK(a.zero_outputs);

@@ -1,4 +1,4 @@
-#include "dbus/bus_object.hpp"
+#include "dbus/i2c_bus_object.hpp"
 
 #include "dbus/announcer.hpp"
 #include "dbus/vehicle_names.hpp"
@@ -29,14 +29,14 @@ constexpr auto kVtable = vtable(kMembers);
 
 } // namespace
 
-BusObject::BusObject(sd_bus* bus, BusMonitor& monitor)
+I2cBusObject::I2cBusObject(sd_bus* bus, BusMonitor& monitor)
     : object_(bus, kBusPath, kBusIface, kMembers, kVtable, &monitor) {}
 
-void BusObject::emit_lost(const std::string& reason) {
+void I2cBusObject::emit_lost(const std::string& reason) {
     sd_bus_emit_signal(object_.bus(), object_.path().c_str(), object_.iface(), "BusLost", "s", reason.c_str());
 }
 
-void BusObject::emit_restored(uint32_t pulses, double milliseconds) {
+void I2cBusObject::emit_restored(uint32_t pulses, double milliseconds) {
     sd_bus_emit_signal(object_.bus(), object_.path().c_str(), object_.iface(), "BusRestored", "ud", pulses, milliseconds);
 }
 

@@ -1,4 +1,4 @@
-#include "sim/vehicle.hpp"
+#include "sim/sim_vehicle.hpp"
 
 #include <cerrno>
 #include <linux/spi/spidev.h>

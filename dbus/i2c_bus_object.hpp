@@ -8,9 +8,9 @@
 
 namespace caracara::dbus {
 
-class BusObject {
+class I2cBusObject {
 public:
-    BusObject(sd_bus* bus, BusMonitor& monitor);
+    I2cBusObject(sd_bus* bus, BusMonitor& monitor);
     int start() { return object_.start(); }
     // The properties of the changes whose values moved since they were last announced.
     void announce(uint32_t changes) { object_.announce(changes, AnnouncedObject::When::Changed); }
