@@ -834,14 +834,17 @@ def print_table(rows, out=sys.stdout):
               file=out)
 
 
+# Every phase, in the order a full run takes them (bench/report.py: a record missing one is partial).
+ALL_PHASES = ["dbus", "wire", "faults", "loop", "cost", "ssh", "bridge"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", required=True, help="build tree with caracarad, caracara-sim and bench/")
     ap.add_argument("--out", default=os.path.join(HERE, "results.json"), help="JSON results (default bench/results.json)")
     ap.add_argument("--quick", action="store_true", help="shorten every phase (smoke run)")
     ap.add_argument("--rss-seconds", type=float, default=None, help="length of the RSS run (default 600, quick 20)")
-    ap.add_argument("--only", default="dbus,wire,faults,loop,cost,ssh,bridge",
-                    help="comma-separated phases: dbus,wire,faults,loop,cost,ssh,bridge")
+    ap.add_argument("--only", default=",".join(ALL_PHASES), help="comma-separated phases: " + ",".join(ALL_PHASES))
     ap.add_argument("--keep", action="store_true", help="keep the temporary directory (logs, callgrind files)")
     ap.add_argument("--raw", action="store_true", help="keep every latency sample in the JSON (large)")
     ap.add_argument("--rt", action="store_true",
