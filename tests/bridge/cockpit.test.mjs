@@ -120,6 +120,15 @@ test("the page shows the state and the values the simulator reports, loading not
 
 const xMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in X_AXIS ? speedByte(X_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
 const allZero = () => simSpeeds().every((s) => s === ZERO);
+// A page armed on purpose and driving forward (the stick at -0.6) on a freshly armed vehicle.
+async function drivingPage() {
+  await rearm();
+  const { page } = await open();
+  await armPad(page);
+  await stick(page, -0.6);
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
+  return page;
+}
 
 test("a scripted gamepad drives motion to the wire as the mixing says only while the deadman is held", async () => {
   await rearm();
@@ -187,11 +196,7 @@ test("the mapping and the gain (selector and d-pad) are editable and kept in the
 });
 
 test("closing the page while driving zeroes the thrusters within the client-loss bound; the kill follows after pilot-lost's persistence", async () => {
-  await rearm();
-  const { page } = await open();
-  await armPad(page);
-  await stick(page, -0.6);
-  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
+  const page = await drivingPage();
   const since = wireNext();
   const closedAt = process.hrtime.bigint(); // CLOCK_MONOTONIC, as the wire log's times
   await page.close();
@@ -315,7 +320,8 @@ test("after a kill and Clear kill, or a reconnect, with the deadman and the stic
   const since = wireNext();
   const sent0 = await sent(page);
   await clearKill(page); // deadman and stick held all along
-  assert.match(await text(page, "#arm"), /release the deadman and centre the sticks/);
+  await page.waitForFunction(() => /release the deadman and centre the sticks/.test(document.getElementById("arm").textContent),
+    { timeout: 1000 });
   await shotView(page, "rearm-wait");
   await sleep(1500);
   await deadman(page, false); // released, the stick still forward: not centred
@@ -372,11 +378,7 @@ test("the gamepad's B kills on its press; Start clears the kill only when held 2
 });
 
 test("a failsafe shows in the header's banner, on screen when scrolled, and stops the page sending: surfacing with its time, an excluded thruster", async () => {
-  await rearm();
-  const { page } = await open();
-  await armPad(page);
-  await stick(page, -0.6);
-  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
+  const page = await drivingPage();
   const surfacing = '#banner li[data-kind="surfacing"]';
   simFault(3, "water-detect", true);
   try {

@@ -187,6 +187,22 @@ TEST_CASE("every channel's message has exactly its schema's fields", "[foxglove]
     }
 }
 
+TEST_CASE("the state's failsafes as the daemon has them, the excluded thrusters from the exclude ones", "[foxglove]") {
+    fg::VehicleState s;
+    s.failsafes = {{"overtemp", "exclude", 2}, {"water-detect", "surface", 3}, {"stall", "exclude", 5}, {"pilot-lost", "kill", -1}};
+    s.surfacing_ms = 1200;
+    const auto j = nlohmann::json::parse(fg::to_json(s));
+    CHECK(j["excluded"] == nlohmann::json::array({2, 5}));
+    REQUIRE(j["failsafes"].size() == 4);
+    CHECK(j["failsafes"][1] == nlohmann::json({{"condition", "water-detect"}, {"action", "surface"}, {"thruster", 3}}));
+    CHECK(j["failsafes"][3]["thruster"] == -1);
+    CHECK(j["surfacing_ms"] == 1200);
+    const auto none = nlohmann::json::parse(fg::to_json(fg::VehicleState{}));
+    CHECK(none["failsafes"].empty());
+    CHECK(none["excluded"].empty());
+    CHECK(none["surfacing_ms"] == -1);
+}
+
 TEST_CASE("the attitude quaternion: identity at rest, yaw clockwise from above is a turn about -z", "[foxglove]") {
     const auto rest = nlohmann::json::parse(fg::attitude_json(0, 0, 0, 0))["rotation"];
     CHECK(rest["w"].get<double>() == Approx(1.0));

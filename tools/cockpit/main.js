@@ -146,6 +146,7 @@ function showState(m) {
   if (m.state === "killed") cockpit.killNotSentAt = null; // killed after all (another pilot, the vehicle)
   if (m.state === "ready" && m.surfacing_ms < 0 && before?.state !== "ready") cockpit.refusal = null;
   showStateWords(fresh());
+  showArming();
   $("budget").textContent = m.budget_limit;
   $("profile").textContent = `${m.profile} ×${m.profile_factor}`;
   $("saturated").textContent = m.saturated ? "SATURATED" : "not saturated";

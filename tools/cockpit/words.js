@@ -70,7 +70,7 @@ export function banner({ state, up, lostMs, killNotSentMs, refusal }) {
     else
       add("warning", "warn", `WARNING: ${conditionWords(f)}`);
   }
-  if (refusal && state.state === "ready")
+  if (refusal && state.state === "ready" && !(state.surfacing_ms >= 0))
     add("refused", "warn", `Motion refused (${refusal}): release the deadman, centre the sticks and press it again`);
   return out;
 }
