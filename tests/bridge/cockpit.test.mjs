@@ -6,7 +6,7 @@ import assert from "node:assert/strict";
 import fs from "node:fs";
 import net from "node:net";
 import path from "node:path";
-import { launch, openCockpit, surge } from "./chromium.mjs";
+import { armPad, launch, openCockpit, surge } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
 import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, VEHICLE, X_AXIS, ZERO, busctl, killEdges,
   poll, rearm, simSpeeds, simThruster, sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
@@ -33,14 +33,6 @@ const deadman = (page, on) => page.evaluate(button(4, on));
 const stick = (page, v) => page.evaluate(`window.__pad.axes[1] = ${v}`);
 const sent = (page) => page.evaluate(() => window.cockpit.sent);
 const arm = (page) => page.$eval("#arm", (e) => e.dataset.arm);
-// Arming on purpose (docs/cockpit.md): deadman released with the sticks centred, then pressed.
-async function armPad(page) {
-  await deadman(page, false);
-  await stick(page, 0);
-  await page.waitForFunction(() => document.getElementById("arm").dataset.arm === "press", { timeout: 10000 });
-  await deadman(page, true);
-  await page.waitForFunction(() => document.getElementById("arm").dataset.arm === "armed", { timeout: 2000 });
-}
 // The element wholly inside the viewport and not covered by another.
 async function onScreen(page, sel) {
   const r = await page.$eval(sel, (e) => {
