@@ -9,7 +9,7 @@ import path from "node:path";
 import { armPad, launch, openCockpit, surge } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
 import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, VEHICLE, X_AXIS, ZERO, busctl, killEdges,
-  poll, rearm, simSpeeds, simThruster, sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
+  hold, poll, rearm, simSpeeds, simThruster, sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
 
 const HTTP = process.env.CARACARA_HTTP_URL;
 const ART = process.env.CARACARA_ARTIFACTS;
@@ -406,6 +406,24 @@ test("a failsafe shows in the header's banner, on screen when scrolled, and stop
     simFault(2, "overtemp", false);
   }
   await page.waitForFunction((s) => !document.querySelector(s), { timeout: 15000 }, excluded);
+  await page.close();
+});
+
+test("the controller in words: the commanding process by name, \"this page\" while this page drives", async () => {
+  const page = await drivingPage();
+  await page.waitForFunction(() => document.getElementById("controller").textContent === "this page", { timeout: 5000 });
+  await deadman(page, false);
+  await stick(page, 0);
+  await rearm();
+  const p = hold("thrust", 500, 0, 0, 0, 0, 0, 0, 0, "--for", 10);
+  try {
+    await page.waitForFunction(() => /^caracaractl \(pid \d+\)$/.test(document.getElementById("controller").textContent),
+      { timeout: 10000 });
+    const pid = Number(/pid (\d+)/.exec(await text(page, "#controller"))[1]);
+    assert.equal(pid, p.pid, "the caracaractl that commands");
+  } finally {
+    p.kill();
+  }
   await page.close();
 });
 
