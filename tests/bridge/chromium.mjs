@@ -46,3 +46,13 @@ export function surge(stick) {
   const t = (Math.abs(stick) - 0.1) / 0.9;
   return -Math.sign(stick) * (0.7 * t + 0.3 * t ** 3) * 0.5;
 }
+
+// Arms a cockpit page's scripted gamepad on purpose (docs/cockpit.md, "Arming on purpose"):
+// the deadman released with the sticks centred, then pressed; it is left held. A page sends
+// no motion before this, after loading, reconnecting or any kill.
+export async function armPad(page) {
+  await page.evaluate(() => { window.__pad.buttons[4] = { pressed: false, touched: false, value: 0 }; window.__pad.axes.fill(0); });
+  await page.waitForFunction(() => document.getElementById("arm").dataset.arm === "press", { timeout: 10000 });
+  await page.evaluate(() => { window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; });
+  await page.waitForFunction(() => document.getElementById("arm").dataset.arm === "armed", { timeout: 2000 });
+}

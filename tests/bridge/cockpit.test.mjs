@@ -6,10 +6,10 @@ import assert from "node:assert/strict";
 import fs from "node:fs";
 import net from "node:net";
 import path from "node:path";
-import { launch, openCockpit, surge } from "./chromium.mjs";
+import { armPad, launch, openCockpit, surge } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
-import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, X_AXIS, ZERO, killEdges, poll, rearm, simSpeeds, simThruster,
-  sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
+import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, VEHICLE, X_AXIS, ZERO, busctl, killEdges,
+  hold, poll, rearm, simSpeeds, simThruster, sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
 
 const HTTP = process.env.CARACARA_HTTP_URL;
 const ART = process.env.CARACARA_ARTIFACTS;
@@ -27,6 +27,27 @@ const open = () => openCockpit(browser, HTTP);
 const text = (page, sel) => page.$eval(sel, (e) => e.textContent.trim());
 const shot = (page, name) => page.screenshot({ path: path.join(ART, `${name}.png`), fullPage: true });
 const setPad = (page, fn) => page.evaluate(fn);
+const shotView = (page, name) => page.screenshot({ path: path.join(ART, `${name}.png`) }); // what is on screen
+const button = (i, on) => `window.__pad.buttons[${i}] = { pressed: ${on}, touched: ${on}, value: ${on ? 1 : 0} }`;
+const deadman = (page, on) => page.evaluate(button(4, on));
+const stick = (page, v) => page.evaluate(`window.__pad.axes[1] = ${v}`);
+const sent = (page) => page.evaluate(() => window.cockpit.sent);
+const arm = (page) => page.$eval("#arm", (e) => e.dataset.arm);
+// The element wholly inside the viewport and not covered by another.
+async function onScreen(page, sel) {
+  const r = await page.$eval(sel, (e) => {
+    const b = e.getBoundingClientRect();
+    const hit = document.elementFromPoint((b.left + b.right) / 2, (b.top + b.bottom) / 2);
+    return { top: b.top, left: b.left, bottom: b.bottom, right: b.right, w: innerWidth, h: innerHeight,
+      visible: Boolean(hit && (e.contains(hit) || hit.contains(e))) };
+  });
+  assert.ok(r.top >= 0 && r.left >= 0 && r.bottom <= r.h && r.right <= r.w && r.visible, `${sel} not on screen: ${JSON.stringify(r)}`);
+}
+const simFault = (i, name, on) =>
+  busctl("call", SIM, `${SIM_ROOT}/thruster/${i}`, "org.caracara.Simulator1.Thruster", "SetFault", "sb", name, on);
+// I2C orders of a motor value other than zero on the wire since `since`.
+const nonZeroOrders = (since) => wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3 &&
+  DEFAULT_MT.includes(e.addr << 1) && e.data[0] !== ZERO);
 
 // A raw HTTP request (no client-side normalisation of the path): [status line, headers, body].
 function raw(request) {
@@ -69,6 +90,7 @@ test("the page shows the state and the values the simulator reports, loading not
   await page.waitForFunction((s) => document.getElementById("state").textContent === s, { timeout: 10000 }, vget("State"));
   assert.equal(await text(page, "#state"), "ready");
   assert.equal(await text(page, "#kill-source"), "none");
+  assert.equal(await page.$eval("#banner", (e) => e.hidden), true, "no banner with nothing wrong");
   for (let i = 0; i < MOTORS; i++) {
     await poll(async () => {
       const t = Number(await text(page, `#thr-${i} .temperature`));
@@ -90,6 +112,15 @@ test("the page shows the state and the values the simulator reports, loading not
 
 const xMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in X_AXIS ? speedByte(X_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
 const allZero = () => simSpeeds().every((s) => s === ZERO);
+// A page armed on purpose and driving forward (the stick at -0.6) on a freshly armed vehicle.
+async function drivingPage() {
+  await rearm();
+  const { page } = await open();
+  await armPad(page);
+  await stick(page, -0.6);
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
+  return page;
+}
 
 test("a scripted gamepad drives motion to the wire as the mixing says only while the deadman is held", async () => {
   await rearm();
@@ -98,7 +129,8 @@ test("a scripted gamepad drives motion to the wire as the mixing says only while
   await sleep(600);
   assert.ok(allZero(), "stick forward without the deadman: nothing moves");
   assert.equal(await page.evaluate(() => window.cockpit.sent), 0, "no command without the deadman");
-  await setPad(page, () => { window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; });
+  await armPad(page);
+  await stick(page, -0.6);
   const expected = xMotion(surge(-0.6));
   await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "the gamepad's surge on the wire");
   assert.equal(await text(page, "#deadman"), "HELD");
@@ -156,10 +188,7 @@ test("the mapping and the gain (selector and d-pad) are editable and kept in the
 });
 
 test("closing the page while driving zeroes the thrusters within the client-loss bound; the kill follows after pilot-lost's persistence", async () => {
-  await rearm();
-  const { page } = await open();
-  await setPad(page, () => { window.__pad.axes[1] = -0.6; window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; });
-  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
+  const page = await drivingPage();
   const since = wireNext();
   const closedAt = process.hrtime.bigint(); // CLOCK_MONOTONIC, as the wire log's times
   await page.close();
@@ -183,7 +212,8 @@ test("closing the page while driving zeroes the thrusters within the client-loss
   // Another page shows why, and its plain clear-kill re-arms (nothing is left to lose).
   const { page: other } = await open();
   await other.waitForFunction(() => document.getElementById("state").textContent === "killed", { timeout: 10000 });
-  assert.equal(await text(other, "#kill-source"), "failsafe");
+  assert.equal(await other.$eval("#kill-source", (e) => e.dataset.source), "failsafe");
+  assert.equal(await text(other, "#kill-source"), "a failsafe");
   await clearKill(other);
   await other.close();
 });
@@ -194,7 +224,8 @@ async function killedBy(page, action) {
   await poll(() => wireLog(since).some((e) => e.bus === "gpio" && e.addr === KILL_OUT && e.data[0] === 1), 5000,
     "the kill output on the wire");
   await page.waitForFunction(() => document.getElementById("state").textContent === "killed", { timeout: 5000 });
-  assert.equal(await text(page, "#kill-source"), "dbus");
+  assert.equal(await page.$eval("#kill-source", (e) => e.dataset.source), "dbus");
+  assert.equal(await text(page, "#kill-source"), "Kill command (a pilot or caracaractl)", "the source in a pilot's words");
   assert.equal(vget("State"), "killed");
 }
 async function clearKill(page) {
@@ -217,7 +248,8 @@ test("the kill button and the Space (while driving) and Escape keys each kill; c
   assert.equal(vget("State"), "killed");
   await clearKill(page);
   // Space while driving, with a form control focused: killed, zero, and the page stops sending.
-  await setPad(page, () => { window.__pad.axes[1] = -0.6; window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; });
+  await armPad(page);
+  await stick(page, -0.6);
   await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
   await page.focus("#gain");
   await killedBy(page, () => page.keyboard.press("Space"));
@@ -229,6 +261,16 @@ test("the kill button and the Space (while driving) and Escape keys each kill; c
   await setPad(page, () => { window.__pad.buttons[4] = { pressed: false, touched: false, value: 0 }; });
   await clearKill(page);
   await killedBy(page, () => page.keyboard.press("Escape"));
+  // Escape with the Clear-kill question open: killed, and the question gone (Enter clears nothing).
+  await clearKill(page);
+  await page.click("#clear-kill");
+  assert.ok(await page.$eval("#confirm-clear", (d) => d.open));
+  await killedBy(page, () => page.keyboard.press("Escape"));
+  assert.equal(await page.$eval("#confirm-clear", (d) => d.open), false, "the dialog closed by the kill");
+  await page.keyboard.press("Enter");
+  await sleep(800);
+  assert.equal(vget("State"), "killed", "Enter after the Escape cleared nothing");
+  await page.$eval("#confirm-clear", (d) => { if (d.open) d.close("cancel"); }); // Enter may have asked again
   await clearKill(page);
   await page.close();
 });
@@ -240,7 +282,8 @@ test("the recorded dives: the list as caracaractl dives has it, each one's .cdiv
   assert.ok(listed.length > 0, "the kills above closed dives");
   await page.waitForFunction((n) => document.querySelectorAll("#dives tbody tr button").length === n, { timeout: 5000 },
     listed.length);
-  assert.deepEqual(await page.$$eval("#dives tbody tr", (rows) => rows.map((r) => r.cells[0].textContent)), listed);
+  assert.deepEqual(await page.$$eval("#dives tbody tr", (rows) => rows.map((r) => r.cells[0].textContent)),
+    [...listed].reverse(), "newest first");
   const name = listed[0];
   const cdive = await fetch(new URL(`dives/${name}.cdive`, HTTP));
   assert.equal(cdive.status, 200);
@@ -257,13 +300,194 @@ test("the recorded dives: the list as caracaractl dives has it, each one's .cdiv
   await page.close();
 });
 
-test("a page whose connection drops shows it at once, with the age of the last message", async () => {
+test("after a kill and Clear kill, or a reconnect, with the deadman and the stick held, nothing moves until released, centred and pressed again", async () => {
+  await rearm();
   const { page } = await open();
+  assert.match(await text(page, "#arm"), /press the deadman|release the deadman/, "a loaded page says how to arm");
+  await armPad(page);
+  await stick(page, -0.6);
+  const expected = xMotion(surge(-0.6));
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving");
+  await killedBy(page, () => page.click("#kill"));
+  const since = wireNext();
+  const sent0 = await sent(page);
+  await clearKill(page); // deadman and stick held all along
+  await page.waitForFunction(() => /release the deadman and centre the sticks/.test(document.getElementById("arm").textContent),
+    { timeout: 1000 });
+  await shotView(page, "rearm-wait");
+  await sleep(1500);
+  await deadman(page, false); // released, the stick still forward: not centred
+  await sleep(400);
+  assert.equal(await arm(page), "release", "the stick is not centred");
+  await deadman(page, true); // pressed again with the stick forward
+  await sleep(800);
+  assert.deepEqual(nonZeroOrders(since).length, 0, "thrust on the wire before arming on purpose");
+  assert.equal(await sent(page), sent0, "a motion command sent before arming on purpose");
+  assert.equal(vget("State"), "ready");
+  // Released, centred, pressed: armed; then the stick drives.
+  await armPad(page);
+  assert.match(await text(page, "#arm"), /armed/);
+  await stick(page, -0.6);
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving once armed on purpose");
+  // The connection drops and comes back within pilot-lost's persistence, deadman and stick held.
+  const connects = await page.evaluate(() => window.cockpit.connects);
+  await page.evaluate(() => window.cockpit.client.close());
+  await poll(allZero, 2000, "the daemon zeroes the pilot that left");
+  const since2 = wireNext();
+  await page.waitForFunction((n) => window.cockpit.connects > n && window.cockpit.state !== null, { timeout: PILOT_LOST_MS },
+    connects);
+  const sent1 = await sent(page);
+  await sleep(600);
+  assert.equal(await sent(page), sent1, "a motion command sent after the reconnect");
+  assert.deepEqual(nonZeroOrders(since2).length, 0, "thrust on the wire after the reconnect");
+  // No pilot came back: the daemon's pilot-lost kill, and the page shows the daemon's state.
+  await page.waitForFunction(() => document.getElementById("state").textContent === "killed", { timeout: PILOT_LOST_MS + 5000 });
+  assert.equal(await page.$eval("#kill-source", (e) => e.dataset.source), "failsafe");
+  await deadman(page, false);
+  await stick(page, 0);
+  await page.close();
+});
+
+test("the gamepad's B kills on its press; Start clears the kill only when held 2 s, never on a tap", async () => {
+  await rearm();
+  const { page } = await open();
+  await page.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 20000 });
+  await killedBy(page, () => page.evaluate(button(1, true)));
+  await page.evaluate(button(1, false));
+  await page.evaluate(button(9, true));
+  await sleep(300);
+  await page.evaluate(button(9, false));
+  await sleep(2500);
+  assert.equal(vget("State"), "killed", "a tap of Start cleared the kill");
+  await page.evaluate(button(9, true));
+  await page.waitForFunction(() => /Clear kill: hold/.test(document.getElementById("arm").textContent), { timeout: 2000 });
+  await sleep(1000);
+  assert.equal(vget("State"), "killed", "cleared before 2 s");
+  await poll(() => vget("State") !== "killed", 5000, "the kill cleared by the long press");
+  await page.evaluate(button(9, false));
+  await page.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 10000 });
+  await page.close();
+});
+
+test("a failsafe shows in the header's banner, on screen when scrolled, and stops the page sending: surfacing with its time, an excluded thruster", async () => {
+  const page = await drivingPage();
+  const surfacing = '#banner li[data-kind="surfacing"]';
+  simFault(3, "water-detect", true);
+  try {
+    await page.waitForSelector(surfacing, { timeout: 5000 });
+    assert.match(await text(page, surfacing), /^SURFACING: water in the thruster \(thruster 3\)\. Ascent running \d+\.\d s/);
+    await page.waitForFunction(() => document.getElementById("arm").dataset.arm === "release", { timeout: 2000 });
+    const s0 = await sent(page);
+    await sleep(1000);
+    assert.equal(await sent(page), s0, "motion sent while surfacing");
+    const refusals = await page.$$eval("#events li", (l) => l.filter((e) => /refused/.test(e.textContent)).length);
+    assert.ok(refusals <= 1, `${refusals} refusal events (one at most)`);
+    await page.evaluate(() => window.scrollTo(0, document.documentElement.scrollHeight));
+    await sleep(200);
+    for (const sel of ["#kill", "#state", surfacing]) await onScreen(page, sel);
+    await shotView(page, "surfacing");
+    await page.waitForFunction(() => document.getElementById("state").textContent === "killed", { timeout: 10000 });
+    assert.equal(vget("State"), "killed");
+  } finally {
+    simFault(3, "water-detect", false);
+  }
+  await page.waitForFunction((s) => !document.querySelector(s), { timeout: 10000 }, surfacing);
+  await deadman(page, false);
+  await stick(page, 0);
+  await rearm();
+  const excluded = '#banner li[data-kind="excluded"]';
+  simFault(2, "overtemp", true);
+  try {
+    await page.waitForSelector(excluded, { timeout: 5000 });
+    assert.match(await text(page, excluded), /^THRUSTER 2 EXCLUDED: over-temperature/);
+    assert.deepEqual(vget("Failsafes"), [["overtemp", "exclude", 2]]);
+    await shotView(page, "excluded");
+  } finally {
+    simFault(2, "overtemp", false);
+  }
+  await page.waitForFunction((s) => !document.querySelector(s), { timeout: 15000 }, excluded);
+  await page.close();
+});
+
+test("the controller in words: the commanding process by name, \"this page\" while this page drives", async () => {
+  const page = await drivingPage();
+  await page.waitForFunction(() => document.getElementById("controller").textContent === "this page", { timeout: 5000 });
+  await deadman(page, false);
+  await stick(page, 0);
+  await rearm();
+  const p = hold("thrust", 500, 0, 0, 0, 0, 0, 0, 0, "--for", 10);
+  try {
+    await page.waitForFunction(() => /^caracaractl \(pid \d+\)$/.test(document.getElementById("controller").textContent),
+      { timeout: 10000 });
+    const pid = Number(/pid (\d+)/.exec(await text(page, "#controller"))[1]);
+    assert.equal(pid, p.pid, "the caracaractl that commands");
+  } finally {
+    p.kill();
+  }
+  await page.close();
+});
+
+test("phone (412 px) and tablet widths: no sideways scrolling; KILL and the state on screen at every scroll position; the Clear-kill question fully on screen", async () => {
+  const { page } = await open();
+  for (const [w, h, name] of [[412, 915, "phone-412"], [800, 1280, "tablet-800"], [1024, 768, "tablet-1024"], [1400, 900, "desktop"]]) {
+    await page.setViewport({ width: w, height: h });
+    await sleep(300);
+    const [laid, wide] = await page.evaluate(() => [document.documentElement.scrollWidth, innerWidth]);
+    assert.ok(laid <= wide, `${name}: laid out ${laid} px wide in ${wide}`);
+    for (const f of [0, 0.5, 1]) {
+      await page.evaluate((y) => window.scrollTo(0, y * (document.documentElement.scrollHeight - innerHeight)), f);
+      await sleep(100);
+      for (const sel of ["#kill", "#state", "#kill-source", "#clear-kill", "#link"]) await onScreen(page, sel);
+    }
+    await shotView(page, name);
+    await page.click("#clear-kill");
+    for (const sel of ["#confirm-clear", "#confirm-clear-yes"]) await onScreen(page, sel);
+    if (w === 412) await shotView(page, `${name}-clear-kill`);
+    await page.$eval("#confirm-clear", (d) => d.close("cancel"));
+  }
+  await page.close();
+});
+
+test("two tabs fetch the dive list once per change between them, not once each per event", async () => {
+  for (const p of await browser.pages()) await p.close(); // only these two tabs of the cockpit
+  await rearm();
+  const a = await open();
+  const b = await open();
+  await sleep(1500);
+  const fetches = () => [...a.log.requests, ...b.log.requests].filter((u) => new URL(u).pathname === "/dives/").length;
+  const rows = (p) => p.$$eval("#dives tbody tr", (r) => r.length);
+  const before = fetches();
+  const rowsBefore = await rows(a.page);
+  busctl("call", VEHICLE, ROOT, VEHICLE, "Kill");
+  await sleep(300);
+  busctl("call", VEHICLE, ROOT, VEHICLE, "ClearKill");
+  await poll(() => vget("State") === "ready", 20000, "ready again");
+  await poll(async () => (await rows(a.page)) === rowsBefore + 1 && (await rows(b.page)) === rowsBefore + 1, 5000,
+    "the new dive in both tabs");
+  await sleep(1500);
+  console.log(`# /dives/ fetches for one kill and clear-kill in two tabs: ${fetches() - before}`);
+  assert.equal(fetches() - before, 1, "one fetch between the two tabs");
+  await a.page.close();
+  await b.page.close();
+});
+
+test("a page whose connection drops shows it at once, with the age of the last message, and a kill it could not send", async () => {
+  await rearm();
+  const { page } = await open();
+  await armPad(page); // held, sticks centred: zero motion at 20 Hz
   process.kill(Number(process.env.CARACARA_FORWARD_PID), "SIGTERM"); // the ssh -L forward goes
   await page.waitForFunction(() => document.getElementById("link").dataset.lost === "true", { timeout: 2000 });
   await sleep(1200);
   assert.match(await text(page, "#link"), /CONNECTION LOST — last message \d+\.\d s ago/);
   assert.ok(await page.evaluate(() => document.body.classList.contains("stale")), "the last known values dimmed");
+  assert.equal(await text(page, "#state"), "unknown", "no state from memory");
+  assert.match(await text(page, '#banner li[data-kind="link-lost"]'), /^LINK LOST \d+\.\d s/);
+  assert.notEqual(await text(page, "#deadman"), "HELD", "the deadman said HELD with no link");
+  const s0 = await sent(page);
+  await sleep(500);
+  assert.equal(await sent(page), s0, "sends counted with no link");
+  await page.click("#kill");
+  assert.match(await text(page, '#banner li[data-kind="kill-not-sent"]'), /^KILL NOT SENT/);
   await shot(page, "lost");
   await page.close();
 });

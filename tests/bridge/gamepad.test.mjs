@@ -71,3 +71,22 @@ test("the gain buttons step through the gains and stop at the ends", () => {
   assert.equal(stepGain(0.6, -1), 0.5); // a gain between steps goes to its neighbours
   assert.equal(stepGain(0.6, 1), 0.75);
 });
+
+test("centred: every term of every axis inside the dead zone, with or without the deadman", () => {
+  const m = { ...DEFAULT_MAPPING };
+  assert.equal(sample(pad({ axes: [0.05, -0.09, 0, 0.1] }), m).centred, true);
+  assert.equal(sample(pad({ axes: [0.05, -0.09, 0, 0.1], pressed: [4] }), m).centred, true);
+  assert.equal(sample(pad({ axes: [0, -0.6, 0, 0] }), m).centred, false, "a stick forward, deadman released");
+  assert.equal(sample(pad({ axes: [0, -0.6, 0, 0], pressed: [4] }), m).centred, false);
+  assert.equal(sample(pad({ values: { 7: 0.5 } }), m).centred, false, "a trigger pulled (heave)");
+  assert.equal(sample(pad({ pressed: [15] }), m).centred, false, "the d-pad (roll)");
+  assert.equal(sample(pad({ pressed: [1, 9, 12] }), m).centred, true, "kill, clear-kill and gain buttons are no motion");
+});
+
+test("the kill and clear-kill buttons are in the mapping, each a button of its own", () => {
+  const st = new Storage();
+  assert.equal(loadMapping(st).kill, 1);
+  assert.equal(loadMapping(st).clear_kill, 9);
+  assert.throws(() => saveMapping({ ...DEFAULT_MAPPING, clear_kill: 4 }, st), /a button each/);
+  assert.throws(() => saveMapping({ ...DEFAULT_MAPPING, kill: 40 }, st), /kill must be/);
+});

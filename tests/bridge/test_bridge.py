@@ -28,6 +28,8 @@ NPM_CACHE = "/var/cache/caracara-npm"
 # [failsafe.pilot-lost] persistence_ms of the rig: a closed tab, the last pilot, kills this long
 # after (5 s by default; shorter here, the tests wait for it).
 PILOT_LOST_MS = 1000
+# [failsafe.surface] duration_ms of the rig: the ascent the cockpit's banner shows.
+SURFACE_MS = 3000
 CI = os.environ.get("CI") == "true"
 
 
@@ -104,8 +106,13 @@ class BridgeRig:
             raise AssertionError("caracara-bridge is not built in %s" % BUILD_DIR)
         if not shutil.which("ssh") or not shutil.which("ssh-keygen"):
             missing("the OpenSSH client is needed")
+        # Water detect surfaces and overtemp excludes soon, and the ascent is short: the cockpit's
+        # banner test (cockpit.test.mjs) raises both.
         cls.rig = Rig(control={"arming_delay_ms": 300}, extra_config={
-            "failsafe": {"pilot-lost": {"action": "kill", "persistence_ms": PILOT_LOST_MS}}})
+            "failsafe": {"pilot-lost": {"action": "kill", "persistence_ms": PILOT_LOST_MS},
+                         "water-detect": {"action": "surface", "persistence_ms": 300},
+                         "overtemp": {"action": "exclude", "persistence_ms": 300},
+                         "surface": {"heave": -0.5, "duration_ms": SURFACE_MS}}})
         cls.procs = []
         cls.sshd = None
         try:

@@ -6,7 +6,9 @@
 #include "core/crc32.hpp"
 #include "tests/catch.hpp"
 #include "tools/bridge/client_protocol.hpp"
+#include "core/safety_state.hpp"
 #include "tools/foxglove/channels.hpp"
+#include "tools/foxglove/dive_mcap.hpp"
 #include "tools/foxglove/mcap_writer.hpp"
 
 #include <map>
@@ -185,6 +187,51 @@ TEST_CASE("every channel's message has exactly its schema's fields", "[foxglove]
         INFO(c.topic);
         CHECK(fields == required);
     }
+}
+
+TEST_CASE("the state's failsafes as the daemon has them, the excluded thrusters from the exclude ones", "[foxglove]") {
+    fg::VehicleState s;
+    s.failsafes = {{"overtemp", "exclude", 2}, {"water-detect", "surface", 3}, {"stall", "exclude", 5}, {"pilot-lost", "kill", -1}};
+    s.surfacing_ms = 1200;
+    const auto j = nlohmann::json::parse(fg::to_json(s));
+    CHECK(j["excluded"] == nlohmann::json::array({2, 5}));
+    REQUIRE(j["failsafes"].size() == 4);
+    CHECK(j["failsafes"][1] == nlohmann::json({{"condition", "water-detect"}, {"action", "surface"}, {"thruster", 3}}));
+    CHECK(j["failsafes"][3]["thruster"] == -1);
+    CHECK(j["surfacing_ms"] == 1200);
+    const auto none = nlohmann::json::parse(fg::to_json(fg::VehicleState{}));
+    CHECK(none["failsafes"].empty());
+    CHECK(none["excluded"].empty());
+    CHECK(none["surfacing_ms"] == -1);
+}
+
+TEST_CASE("a dive exported to MCAP: the state's failsafes, excluded thrusters and surfacing follow its events", "[foxglove]") {
+    namespace dive = caracara::dive;
+    dive::Dive d;
+    d.header.start_unix_ms = 1'700'000'000'000;
+    d.header.profile = "water";
+    for (uint32_t t : {0u, 1000u, 2000u, 3000u}) {
+        dive::Sample s;
+        s.t_100us = t;
+        d.samples.push_back(s);
+    }
+    d.events = {{500, dive::EventKind::Failsafe, 0, 0, 3, dive::kFailsafeRaised, 0, "water-detect surface", ""},
+                {600, dive::EventKind::Failsafe, 0, 0, 2, dive::kFailsafeRaised, 0, "overtemp exclude", ""},
+                {2500, dive::EventKind::State, static_cast<uint8_t>(caracara::SafetyState::Killed),
+                 static_cast<uint8_t>(caracara::KillSource::Failsafe), 0, 0, 0, "ascent done", ""},
+                {2600, dive::EventKind::Failsafe, 0, 0, 2, 0, 0, "overtemp exclude", ""}};
+    const std::vector<uint8_t> f = fg::dive_to_mcap(d);
+    const std::string bytes(f.begin(), f.end()); // uncompressed: each message's JSON is in the file
+    // 0.1 s in: both failsafes, thruster 2 excluded, the ascent 50 ms old (since its event at 50 ms).
+    CHECK(bytes.find(R"("excluded":[2],"failsafes":[{"action":"surface","condition":"water-detect","thruster":3},)"
+                     R"({"action":"exclude","condition":"overtemp","thruster":2}])") != std::string::npos);
+    CHECK(bytes.find(R"("state":"arming","surfacing_ms":50})") != std::string::npos);
+    // After the ascent's kill and overtemp cleared: water detect still holds, nothing excluded, not surfacing.
+    CHECK(bytes.find(R"("excluded":[],"failsafes":[{"action":"surface","condition":"water-detect","thruster":3}],)"
+                     R"("kill_source":"failsafe")") != std::string::npos);
+    CHECK(bytes.find(R"("state":"killed","surfacing_ms":-1})") != std::string::npos);
+    // The failsafe event's words: condition -> action, not "failsafe: " again after its name.
+    CHECK(bytes.find(R"j("message":"water-detect -> surface (thruster 3)")j") != std::string::npos);
 }
 
 TEST_CASE("the attitude quaternion: identity at rest, yaw clockwise from above is a turn about -z", "[foxglove]") {

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <unistd.h>
 
 namespace caracara::bridge {
 
@@ -52,6 +53,31 @@ int thruster_of(const std::string& path) {
     return n[0] - '0';
 }
 
+// The daemon's Failsafes, a(ssi).
+std::vector<fg::ActiveFailsafe> failsafes(const Props& p) {
+    std::vector<fg::ActiveFailsafe> out;
+    for (const Value& f : get(p, "Failsafes").items)
+        if (f.items.size() == 3)
+            out.push_back({f.items[0].s, f.items[1].s, f.items[2].integer()});
+    return out;
+}
+
+// A process's name as the kernel has it (/proc/PID/comm), "" when gone.
+std::string process_name(uint32_t pid) {
+    char path[48];
+    std::snprintf(path, sizeof path, "/proc/%u/comm", pid);
+    std::FILE* f = std::fopen(path, "re");
+    if (!f)
+        return "";
+    char name[64] = {};
+    const bool ok = std::fgets(name, sizeof name, f) != nullptr;
+    std::fclose(f);
+    std::string out = ok ? name : "";
+    while (!out.empty() && (out.back() == '\n' || out.back() == ' '))
+        out.pop_back();
+    return out;
+}
+
 } // namespace
 
 Telemetry::Telemetry(boost::asio::io_context& io, caracara::dbus::BusChoice bus, Publish publish)
@@ -61,6 +87,13 @@ Telemetry::~Telemetry() {
     *alive_ = false;
     watch_.reset();
     slots_.clear();
+    controller_slot_.reset();
+}
+
+void Telemetry::loaded() {
+    const Props& root = props(kRoot, caracara::dbus::kVehicleIface);
+    follow_surfacing(root);
+    name_controller(text(root, "Controller"));
 }
 
 void Telemetry::start() {
@@ -79,6 +112,7 @@ void Telemetry::retry() {
 bool Telemetry::connect() {
     watch_.reset();
     slots_.clear();
+    controller_slot_.reset();
     client_ = std::make_unique<caracaractl::Client>(choice_);
     try {
         sd_bus* bus = client_->bus();
@@ -117,6 +151,7 @@ bool Telemetry::connect() {
                 retry();
         });
     });
+    loaded();
     for (std::size_t i = 0; i < fg::channels().size(); ++i)
         if (fg::channels()[i].kind != ChannelKind::Events)
             mark(i);
@@ -167,7 +202,7 @@ int Telemetry::on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error
         int32_t thruster = -1;
         if (sd_bus_message_read(m, "ssi", &condition, &action, &thruster) >= 0)
             self->log(3, "failsafe",
-                      std::string("failsafe: ") + (condition ? condition : "") + " -> " + (action ? action : "") +
+                      std::string(condition ? condition : "") + " -> " + (action ? action : "") +
                           (thruster >= 0 ? " (thruster " + std::to_string(thruster) + ")" : ""));
     }
     return 0;
@@ -196,6 +231,7 @@ void Telemetry::reload() {
         std::fprintf(stderr, "caracara-bridge: reloading caracarad's objects failed (%s)\n", f.message.c_str());
         return;
     }
+    loaded();
     for (std::size_t i = 0; i < fg::channels().size(); ++i)
         if (fg::channels()[i].kind != ChannelKind::Events)
             mark(i);
@@ -215,6 +251,9 @@ void Telemetry::changed(const std::string& path, const std::string& iface, const
             mark(fg::channel_position(ChannelKind::Motors));
         if (state)
             mark(fg::channel_position(ChannelKind::VehicleState));
+        follow_surfacing(stored);
+        if (changes.contains("Controller"))
+            name_controller(text(stored, "Controller"));
         if (changes.contains("State") && text(before, "State") != text(stored, "State")) {
             const std::string s = text(stored, "State");
             const std::string source = text(stored, "KillSource");
@@ -246,6 +285,47 @@ void Telemetry::changed(const std::string& path, const std::string& iface, const
                                                    get(stored, "Recoveries").unsigned_integer())
             log(2, "recovery", "I2C bus recoveries: " + std::to_string(get(stored, "Recoveries").unsigned_integer()));
     }
+}
+
+void Telemetry::follow_surfacing(const Props& root) {
+    const std::string state = text(root, "State");
+    bool surfacing = false;
+    if (state != "killed" && state != "powered-off")
+        for (const fg::ActiveFailsafe& f : failsafes(root))
+            surfacing = surfacing || f.action == "surface";
+    if (!surfacing)
+        surfacing_since_ = 0;
+    else if (!surfacing_since_)
+        surfacing_since_ = now_ns();
+}
+
+void Telemetry::name_controller(const std::string& unique_name) {
+    controller_ = {unique_name, ""};
+    controller_slot_.reset();
+    if (unique_name.empty() || !client_)
+        return;
+    // Asked of the bus daemon without waiting: this thread also carries the kills.
+    sd_bus_slot* slot = nullptr;
+    if (sd_bus_call_method_async(client_->bus(), &slot, "org.freedesktop.DBus", "/org/freedesktop/DBus",
+                                 "org.freedesktop.DBus", "GetConnectionUnixProcessID", on_controller_pid, this, "s",
+                                 unique_name.c_str()) >= 0)
+        controller_slot_.reset(slot);
+    if (watch_)
+        watch_->kick();
+}
+
+int Telemetry::on_controller_pid(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto* self = static_cast<Telemetry*>(userdata);
+    uint32_t pid = 0;
+    if (sd_bus_message_is_method_error(m, nullptr) || sd_bus_message_read(m, "u", &pid) < 0 || pid == 0)
+        return 0;
+    const std::string name = process_name(pid);
+    // Each browser tab or Foxglove client of this bridge commands through a connection of its own.
+    self->controller_.words = pid == static_cast<uint32_t>(getpid()) ? "a cockpit or Foxglove client of this bridge"
+                              : name.empty()                          ? "process " + std::to_string(pid)
+                                                                      : name + " (pid " + std::to_string(pid) + ")";
+    self->mark(fg::channel_position(ChannelKind::VehicleState));
+    return 0;
 }
 
 void Telemetry::log(int level, const std::string& name, const std::string& message) {
@@ -283,9 +363,12 @@ void Telemetry::build(std::size_t channel, uint64_t now) {
     switch (info.kind) {
     case ChannelKind::VehicleState: {
         const Props& p = props(kRoot, caracara::dbus::kVehicleIface);
+        const std::string controller = text(p, "Controller");
         fg::VehicleState s{text(p, "State"), text(p, "KillSource"), text(p, "Profile"),
                            get(p, "ProfileFactor").number(), get(p, "BudgetLimit").integer(),
-                           get(p, "Saturated").boolean(), get(p, "CommandAgeMs").integer(), text(p, "Controller"), {}};
+                           get(p, "Saturated").boolean(), get(p, "CommandAgeMs").integer(), controller,
+                           controller == controller_.unique_name ? controller_.words : "", {}, failsafes(p),
+                           surfacing_since_ ? static_cast<int64_t>((now - surfacing_since_) / 1'000'000u) : -1};
         const Value& leds = get(p, "Leds");
         for (std::size_t i = 0; i < 3 && i < leds.items.size(); ++i)
             s.leds[i] = leds.items[i].integer();

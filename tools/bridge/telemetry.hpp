@@ -38,7 +38,13 @@ private:
     static int on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
     static int on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error* error);
     static int on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
+    static int on_controller_pid(sd_bus_message* m, void* userdata, sd_bus_error* error);
+    // When a surface failsafe's ascent began (surfacing_ms in the state), from the root's properties.
+    void follow_surfacing(const caracaractl::Props& root);
+    // The controller in words: its process, asked of the bus daemon (controller_name in the state).
+    void name_controller(const std::string& unique_name);
     void reload();
+    void loaded(); // after the objects were (re)loaded
     bool connect();
     void retry();
     void changed(const std::string& path, const std::string& iface, const caracaractl::Props& props);
@@ -59,6 +65,11 @@ private:
     std::set<std::size_t> dirty_;
     bool flush_posted_ = false;
     std::vector<Payload> latest_;
+    uint64_t surfacing_since_ = 0; // CLOCK_REALTIME ns; 0 not surfacing
+    struct ControllerName {
+        std::string unique_name, words;
+    } controller_;
+    caracara::dbus::SlotPtr controller_slot_;
     std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 

@@ -14,7 +14,8 @@ export function drawAttitude(canvas, yaw, pitch, roll) {
   ctx.clip();
   ctx.translate(cx, cy);
   ctx.rotate(-roll);
-  ctx.translate(0, pitch * DEG * pxPerDeg);
+  const shift = pitch * DEG * pxPerDeg;
+  ctx.translate(0, shift);
   ctx.fillStyle = "#2d6fa8"; // water above
   ctx.fillRect(-2 * r, -4 * r, 4 * r, 4 * r);
   ctx.fillStyle = "#6b4b2a"; // below
@@ -34,7 +35,9 @@ export function drawAttitude(canvas, yaw, pitch, roll) {
     ctx.moveTo(-half, y);
     ctx.lineTo(half, y);
     ctx.stroke();
-    if (d % 20 === 0) ctx.fillText(String(d), half + 4, y + 4);
+    // A label only where all of it is inside the instrument (the rim would cut it).
+    const label = String(d), font = r / 9, far = half + 4 + ctx.measureText(label).width;
+    if (d % 20 === 0 && Math.hypot(far, Math.abs(y + shift) + font / 2) <= r - 3) ctx.fillText(label, half + 4, y + 4);
   }
   ctx.restore();
   // The vehicle's fixed symbol and the rim.
@@ -71,7 +74,9 @@ export function drawAttitude(canvas, yaw, pitch, roll) {
     ctx.moveTo(x, top);
     ctx.lineTo(x, top + (n % 30 === 0 ? 12 : 6));
     ctx.stroke();
-    if (n % 30 === 0) ctx.fillText(names[n] ?? String(n), x - 8, top + 26);
+    const label = names[n] ?? String(n), half = ctx.measureText(label).width / 2;
+    // Whole labels only: one cut by the scale's ends reads as another heading.
+    if (n % 30 === 0 && x - half >= 12 && x + half <= 8 + span) ctx.fillText(label, x - half, top + 26);
   }
   ctx.restore();
   ctx.fillStyle = "#ffcc00";

@@ -2,27 +2,70 @@
 // each dive's .cdive and MCAP for download and a plot of its thrust drawn here as SVG.
 const SVG = "http://www.w3.org/2000/svg";
 
-export async function showDives(table, plotBox, token) {
-  const q = token ? `?token=${encodeURIComponent(token)}` : "";
-  const body = table.tBodies[0];
-  let list;
-  try {
-    const r = await fetch(`/dives/${q}`);
-    if (!r.ok) throw new Error(`${r.status}`);
-    list = await r.json();
-  } catch (e) {
-    body.innerHTML = `<tr><td colspan="6" class="dim">no dives served (${e.message})</td></tr>`;
-    return;
+// The list is fetched once per change for all of this browser's tabs: one tab (holding a Web
+// Lock) fetches when a kill closed a dive, and the others get the list from it on a
+// BroadcastChannel. Where locks are not offered (a page not from localhost) each tab fetches.
+const CHANNEL = "caracara.cockpit.dives";
+const SETTLE_MS = 500; // the kills of one event (a failsafe, then its kill) make one fetch
+
+export class DiveList {
+  constructor(table, plotBox, token) {
+    this.table = table;
+    this.plotBox = plotBox;
+    this.q = token ? `?token=${encodeURIComponent(token)}` : "";
+    this.fetches = 0;
+    this.timer = null;
+    this.leader = !navigator.locks;
+    this.shown = null;
+    this.channel = typeof BroadcastChannel === "function" ? new BroadcastChannel(CHANNEL) : null;
+    if (this.channel) this.channel.onmessage = (e) => this.show(e.data);
+    navigator.locks?.request(CHANNEL, () => { this.leader = true; return new Promise(() => {}); });
   }
-  body.innerHTML = "";
-  if (!list.length) body.innerHTML = `<tr><td colspan="6" class="dim">no dive recorded yet</td></tr>`;
-  for (const d of list) {
-    const tr = document.createElement("tr");
-    const link = (ext, label) => `<a href="/dives/${d.name}.${ext}${q}" download>${label}</a>`;
-    tr.innerHTML = `<td>${d.name}</td><td>${new Date(d.start_ms).toLocaleString()}</td><td>${d.seconds.toFixed(1)}</td>` +
-      `<td>${d.samples}</td><td>${link("cdive", ".cdive")} ${link("mcap", "MCAP")}</td><td><button>plot</button></td>`;
-    tr.querySelector("button").addEventListener("click", () => plot(d.name, plotBox, q));
-    body.append(tr);
+
+  // The list as it is now, for this tab (at load).
+  load() { return this.fetch(false); }
+
+  // A dive may have closed: the leading tab fetches once things settle, and tells the others.
+  changed() {
+    if (!this.leader) return;
+    clearTimeout(this.timer);
+    this.timer = setTimeout(() => this.fetch(true), SETTLE_MS);
+  }
+
+  async fetch(share) {
+    this.fetches++;
+    let result;
+    try {
+      const r = await fetch(`/dives/${this.q}`);
+      if (!r.ok) throw new Error(`${r.status}`);
+      result = { list: await r.json() };
+    } catch (e) {
+      result = { error: e.message };
+    }
+    this.show(result);
+    if (share && this.channel && !result.error) this.channel.postMessage(result);
+  }
+
+  show({ list, error }) {
+    const body = this.table.tBodies[0];
+    if (error) {
+      body.innerHTML = `<tr><td colspan="6" class="dim">no dives served (${error})</td></tr>`;
+      return;
+    }
+    const key = JSON.stringify(list);
+    if (key === this.shown) return;
+    this.shown = key;
+    body.innerHTML = "";
+    if (!list.length) body.innerHTML = `<tr><td colspan="6" class="dim">no dive recorded yet</td></tr>`;
+    // Newest first: the dive a pilot just made is the one looked for.
+    for (const d of [...list].sort((a, b) => b.start_ms - a.start_ms)) {
+      const tr = document.createElement("tr");
+      const link = (ext, label) => `<a href="/dives/${d.name}.${ext}${this.q}" download>${label}</a>`;
+      tr.innerHTML = `<td>${d.name}</td><td>${new Date(d.start_ms).toLocaleString()}</td><td>${d.seconds.toFixed(1)}</td>` +
+        `<td>${d.samples}</td><td>${link("cdive", ".cdive")} ${link("mcap", "MCAP")}</td><td><button>plot</button></td>`;
+      tr.querySelector("button").addEventListener("click", () => plot(d.name, this.plotBox, this.q));
+      body.append(tr);
+    }
   }
 }
 

@@ -1,9 +1,11 @@
 // Gamepad piloting (docs/cockpit.md): the Gamepad API's standard mapping to the six motion
 // axes. Each axis is a sum of terms ("-a1", "b7-b6": aN a stick axis, bN a button's value),
 // each stick term through a dead zone and an expo curve, then times the gain. Nothing moves
-// unless the deadman button is held.
+// unless the deadman button is held. Kill on a button's press; Clear kill on another held for
+// CLEAR_HOLD_MS, never on a tap.
 export const AXES = ["x", "y", "z", "yaw", "pitch", "roll"];
 export const GAINS = [0.25, 0.5, 0.75, 1.0];
+export const CLEAR_HOLD_MS = 2000;
 const KEY = "caracara.cockpit.mapping";
 
 export const DEFAULT_MAPPING = {
@@ -16,6 +18,8 @@ export const DEFAULT_MAPPING = {
   deadman: 4,    // left bumper, held
   gain_up: 12,   // d-pad up: the next gain
   gain_down: 13, // d-pad down: the one before
+  kill: 1,       // B (right face button): kills on its press
+  clear_kill: 9, // Start, held for CLEAR_HOLD_MS: clears the kill
   deadzone: 0.1,
   expo: 0.3,
   gain: 0.5,
@@ -38,11 +42,14 @@ export function parseTerms(text) {
 
 export function validMapping(m) {
   for (const a of AXES) parseTerms(m[a]);
-  for (const [k, lo, hi] of [["deadman", 0, 31], ["gain_up", 0, 31], ["gain_down", 0, 31], ["deadzone", 0, 0.9],
+  for (const [k, lo, hi] of [["deadman", 0, 31], ["gain_up", 0, 31], ["gain_down", 0, 31], ["kill", 0, 31],
+    ["clear_kill", 0, 31], ["deadzone", 0, 0.9],
     ["expo", 0, 1], ["gain", 0, 1]]) {
     const v = Number(m[k]);
     if (!Number.isFinite(v) || v < lo || v > hi) throw new Error(`${k} must be ${lo}..${hi}`);
   }
+  const buttons = ["deadman", "gain_up", "gain_down", "kill", "clear_kill"].map((k) => Number(m[k]));
+  if (new Set(buttons).size !== buttons.length) throw new Error("deadman, gain_up, gain_down, kill and clear_kill need a button each");
   return true;
 }
 
@@ -75,20 +82,22 @@ export function shape(v, deadzone, expo) {
   return Math.sign(v) * ((1 - expo) * t + expo * t * t * t);
 }
 
-// A gamepad's state -> {held, motion: {x..roll}}; motion is all zero unless the deadman is held.
+// A gamepad's state -> {held, centred, motion: {x..roll}}; motion is all zero unless the
+// deadman is held; centred: every term of every axis inside the dead zone, deadman or not.
 export function sample(pad, mapping) {
   const button = (i) => pad.buttons[i]?.value ?? (pad.buttons[i]?.pressed ? 1 : 0);
   const held = Boolean(pad.buttons[mapping.deadman]?.pressed);
   const motion = {};
+  let centred = true;
   for (const axis of AXES) {
     let v = 0;
-    if (held) {
-      for (const t of parseTerms(mapping[axis])) {
-        const raw = t.kind === "a" ? (pad.axes[t.index] ?? 0) : button(t.index);
-        v += t.sign * shape(raw, mapping.deadzone, mapping.expo);
-      }
+    for (const t of parseTerms(mapping[axis])) {
+      const raw = t.kind === "a" ? (pad.axes[t.index] ?? 0) : button(t.index);
+      const shaped = shape(raw, mapping.deadzone, mapping.expo);
+      if (shaped !== 0) centred = false;
+      if (held) v += t.sign * shaped;
     }
     motion[axis] = Math.max(-1, Math.min(1, v * mapping.gain)) || 0;
   }
-  return { held, motion };
+  return { held, centred, motion };
 }

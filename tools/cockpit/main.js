@@ -1,9 +1,10 @@
 // The cockpit (docs/cockpit.md): one Foxglove WebSocket client of the bridge that serves this
 // page, showing the vehicle live, killing from anywhere on the page, and piloting with a gamepad.
 import { FoxgloveClient } from "./foxglove.js";
-import { AXES, GAINS, loadMapping, sample, saveMapping, stepGain, validMapping } from "./gamepad.js";
+import { AXES, CLEAR_HOLD_MS, GAINS, loadMapping, sample, saveMapping, stepGain, validMapping } from "./gamepad.js";
 import { degrees, drawAttitude } from "./attitude.js";
-import { showDives } from "./dives.js";
+import { DiveList } from "./dives.js";
+import { banner, controllerWords, killSourceWords } from "./words.js";
 
 const MOTORS = 8, MOTOR_MAX = 8850;
 const SEND_MS = 50;        // motion commands while the deadman is held: 20 per second
@@ -15,33 +16,112 @@ const wsUrl = `ws://${location.host}/${token ? `?token=${encodeURIComponent(toke
 let client = null;
 let lastMessageAt = 0;     // performance.now() of the last message from the bridge
 let connected = false;
-const cockpit = { state: null, motors: null, thrusters: [], teensy: null, i2c: null, sent: 0, kills: 0 };
+let lostAt = null;         // performance.now() when the link was first seen lost; null while fresh
+// Arming on purpose (docs/cockpit.md): after a page load, a reconnect, a kill, a Clear kill, a
+// state other than ready or a refused motion command, nothing is sent until the pilot has
+// released the deadman with the sticks centred ("release") and pressed it again ("press").
+const ARM_RELEASE = "release", ARM_PRESS = "press", ARM_ARMED = "armed";
+const cockpit = { state: null, motors: null, thrusters: [], teensy: null, i2c: null, sent: 0, kills: 0,
+  arm: ARM_RELEASE, killNotSentAt: null, refusal: null, clearHeldSince: null, connects: 0 };
 window.cockpit = cockpit;  // for the tests and the curious
+const dives = new DiveList($("dives"), $("dive-plot"), token);
+
+// Back to the start of arming: the pilot must release, centre and press again.
+function disarm() {
+  cockpit.arm = ARM_RELEASE;
+  stopDriving();
+}
+const fresh = () => connected && lastMessageAt !== 0 && performance.now() - lastMessageAt < STALE_MS;
 
 // --- the connection ------------------------------------------------------------------------------
+let retries = 0;
 function connect() {
   client = new FoxgloveClient(wsUrl, {
-    onOpen: () => { connected = true; },
+    onOpen: () => { connected = true; retries = 0; cockpit.connects++; disarm(); },
     onMessage: (topic, msg) => { lastMessageAt = performance.now(); show(topic, msg); },
-    onStatus: (level, text) => logEvent(level >= 2 ? 4 : 2, "bridge", text, Date.now()),
+    onStatus: (level, text) => bridgeStatus(level, text),
     onClose: () => {
       connected = false;
-      stopDriving();
-      setTimeout(connect, 2000);
+      // What the vehicle is now is unknown: the old state is not kept as if it were current.
+      cockpit.state = null;
+      disarm();
+      // Soon the first time (a dropped connection comes back within pilot-lost's persistence), then calmly.
+      setTimeout(connect, retries++ ? 2000 : 250);
     },
   });
+  cockpit.client = client; // the tests drop it
+}
+
+// A refusal of the bridge or the daemon: a motion command refused (a failsafe's ascent, a kill
+// on the way) stops the sending and makes one event, not one per command.
+function bridgeStatus(level, text) {
+  const refused = /^\/command\/(motion|thrust) refused: \S*?([A-Za-z]+)(?::|$)/.exec(text);
+  if (refused) {
+    const first = cockpit.refusal === null;
+    cockpit.refusal = refused[2];
+    disarm();
+    if (!first) return;
+  }
+  logEvent(level >= 2 ? 4 : 2, "bridge", text, Date.now());
 }
 
 function showLink() {
   const el = $("link");
   const age = lastMessageAt ? ((performance.now() - lastMessageAt) / 1000).toFixed(1) : null;
-  const fresh = connected && age !== null && age * 1000 < STALE_MS;
-  el.className = `link ${fresh ? "up" : "down"}`;
-  el.dataset.lost = fresh ? "false" : "true";
+  const up = fresh();
+  if (up) lostAt = null; else lostAt ??= performance.now();
+  if (!up && cockpit.arm !== ARM_RELEASE) disarm();
+  el.className = `link ${up ? "up" : "down"}`;
+  el.dataset.lost = up ? "false" : "true";
   // What is shown is only the last thing heard: dimmed until the data is fresh again.
-  document.body.classList.toggle("stale", !fresh);
-  el.textContent = fresh ? "connected"
+  document.body.classList.toggle("stale", !up);
+  el.textContent = up ? "connected"
     : `${connected ? "NO DATA" : "CONNECTION LOST"}${age === null ? "" : ` — last message ${age} s ago`}`;
+  showStateWords(up);
+  showBanner(up);
+  showArming();
+}
+
+// The state the daemon last said, and only while it is current: never "ready" from memory.
+function showStateWords(up) {
+  const m = cockpit.state;
+  const state = up && m ? m.state : "unknown";
+  $("state").textContent = state;
+  $("state").className = `state ${state}`;
+  $("state").title = m && !up ? `last known: ${m.state}` : "";
+  const source = up && m ? m.kill_source : "";
+  $("kill-source").textContent = up && m ? killSourceWords(source) : "unknown";
+  $("kill-source").dataset.source = source;
+  $("kill-source").className = `state small ${source ? "killed" : ""}`;
+}
+
+function showBanner(up) {
+  const items = banner({
+    state: cockpit.state, up, lostMs: lostAt === null ? 0 : performance.now() - lostAt,
+    killNotSentMs: cockpit.killNotSentAt === null ? null : performance.now() - cockpit.killNotSentAt,
+    refusal: cockpit.refusal,
+  });
+  const list = $("banner");
+  const html = items.map((i) => `<li class="${i.level}" data-kind="${i.kind}">${i.text}</li>`).join("");
+  if (list.innerHTML !== html) list.innerHTML = html;
+  list.hidden = items.length === 0;
+}
+
+function showArming() {
+  const el = $("arm");
+  const p = pad();
+  let text = "";
+  if (!p) text = "no gamepad";
+  else if (!fresh() || cockpit.state?.state !== "ready") text = "not ready: nothing is sent";
+  else if (cockpit.state.surfacing_ms >= 0) text = "surfacing: the vehicle refuses motion";
+  else if (cockpit.arm === ARM_RELEASE) text = "to drive: release the deadman and centre the sticks";
+  else if (cockpit.arm === ARM_PRESS) text = "to drive: press the deadman";
+  else text = "armed: the deadman drives";
+  if (cockpit.clearHeldSince !== null)
+    text = `Clear kill: hold ${Math.max(0, (CLEAR_HOLD_MS - (performance.now() - cockpit.clearHeldSince)) / 1000).toFixed(1)} s more`;
+  el.textContent = text;
+  el.dataset.arm = cockpit.arm;
+  el.className = `arm ${cockpit.arm}`;
 }
 
 // --- what the vehicle says ---------------------------------------------------------------------
@@ -52,23 +132,26 @@ function show(topic, m) {
   if (topic === "/teensy") return showTeensy(m);
   if (topic === "/i2c") return showI2c(m);
   if (topic === "/events") {
-    // A kill closes a dive and arming opens one: the list follows.
-    if (m.name === "kill" || m.name === "arming") setTimeout(() => showDives($("dives"), $("dive-plot"), token), 500);
+    // A kill closes a dive: the list follows (one fetch for all this browser's tabs).
+    if (m.name === "kill") dives.changed();
     return logEvent(m.level, m.name, m.message, m.timestamp.sec * 1000 + m.timestamp.nsec / 1e6);
   }
 }
 
 function showState(m) {
+  const before = cockpit.state;
   cockpit.state = m;
-  $("state").textContent = m.state;
-  $("state").className = `state ${m.state}`;
-  $("kill-source").textContent = m.kill_source || "none";
-  $("kill-source").className = `state ${m.kill_source ? "killed" : ""}`;
+  // Not ready, or surfacing: what was armed is no more; the same once it changed under us.
+  if (m.state !== "ready" || m.surfacing_ms >= 0 || (before && before.state !== "ready")) disarm();
+  if (m.state === "killed") cockpit.killNotSentAt = null; // killed after all (another pilot, the vehicle)
+  if (m.state === "ready" && m.surfacing_ms < 0 && before?.state !== "ready") cockpit.refusal = null;
+  showStateWords(fresh());
+  showArming();
   $("budget").textContent = m.budget_limit;
   $("profile").textContent = `${m.profile} ×${m.profile_factor}`;
   $("saturated").textContent = m.saturated ? "SATURATED" : "not saturated";
   $("saturated").className = m.saturated ? "pill bad" : "pill ok";
-  $("controller").textContent = m.controller || "none";
+  $("controller").textContent = controllerWords(m, driving);
 }
 
 function thrusterRow(i) {
@@ -152,9 +235,20 @@ function logEvent(level, name, message, ms) {
 function kill() {
   cockpit.kills++;
   // The kill first: nothing of ours goes out ahead of it.
-  if (!client?.publish("/command/kill", {}))
+  const sent = client?.publish("/command/kill", {});
+  if (!sent) {
+    cockpit.killNotSentAt = performance.now();
     logEvent(4, "cockpit", "kill NOT sent: no connection to the bridge (the vehicle zeroes a lost pilot's thrust)", Date.now());
-  stopDriving();
+  }
+  disarm();
+  const dialog = $("confirm-clear");
+  if (dialog.open) dialog.close("cancel"); // a kill answers the question: nothing is cleared
+  showLink();
+}
+
+function clearKill() {
+  if (client?.publish("/command/clear_kill", {})) logEvent(2, "cockpit", "Clear kill sent", Date.now());
+  disarm();
 }
 
 $("kill").addEventListener("click", kill);
@@ -166,9 +260,14 @@ window.addEventListener("keydown", (e) => {
     if (!e.repeat) kill();
   }
 }, { capture: true });
-$("clear-kill").addEventListener("click", () => $("confirm-clear").showModal());
+$("clear-kill").addEventListener("click", () => {
+  const dialog = $("confirm-clear");
+  if (dialog.open) return;
+  dialog.returnValue = "";
+  dialog.showModal();
+});
 $("confirm-clear").addEventListener("close", () => {
-  if ($("confirm-clear").returnValue === "clear") client?.publish("/command/clear_kill", {});
+  if ($("confirm-clear").returnValue === "clear") clearKill();
 });
 
 // --- gamepad -------------------------------------------------------------------------------------
@@ -190,11 +289,11 @@ function pad() {
 
 function sendMotion(motion) {
   const at = performance.now();
+  if (!client?.publish("/command/motion", motion)) return;
   cockpit.sent++;
   // When the command changed (bench/bridge_bench.mjs times a sample to the wire from here).
   if (AXES.some((a) => motion[a] !== cockpit.lastSent?.motion[a])) cockpit.lastChange = { motion, at };
   cockpit.lastSent = { motion, at };
-  client?.publish("/command/motion", motion);
 }
 
 const ZERO = Object.fromEntries(AXES.map((a) => [a, 0]));
@@ -203,24 +302,48 @@ const ZERO = Object.fromEntries(AXES.map((a) => [a, 0]));
 function stopDriving() {
   if (driving) sendMotion(ZERO);
   driving = false;
-  $("deadman").textContent = "released";
-  $("deadman").className = "pill";
+  const held = Boolean(pad()?.buttons[mapping.deadman]?.pressed);
+  // Held but not driving (not armed, not ready, no link): said as such, never HELD.
+  $("deadman").textContent = held ? "held, not driving" : "released";
+  $("deadman").className = held ? "pill bad" : "pill";
 }
 
 function tick() {
   const p = document.visibilityState === "visible" ? pad() : null;
   $("pad").textContent = p ? p.id || "gamepad" : "no gamepad";
-  if (!p) return stopDriving();
-  // The gain buttons act on their press, not while held.
-  const press = (i) => Boolean(p.buttons[i]?.pressed);
-  for (const [button, step] of [[mapping.gain_up, 1], [mapping.gain_down, -1]]) {
-    if (press(button) && !gainButtons.has(button)) setGain(stepGain(mapping.gain, step));
-    if (press(button)) gainButtons.add(button); else gainButtons.delete(button);
+  if (!p) {
+    cockpit.clearHeldSince = null;
+    return stopDriving();
   }
+  // The gain and kill buttons act on their press, not while held.
+  const press = (i) => Boolean(p.buttons[i]?.pressed);
+  const pressed = (i) => press(i) && !gainButtons.has(i);
+  if (pressed(mapping.kill)) kill();
+  for (const [button, step] of [[mapping.gain_up, 1], [mapping.gain_down, -1]])
+    if (pressed(button)) setGain(stepGain(mapping.gain, step));
+  // Clear kill: held for CLEAR_HOLD_MS, once per hold; a tap does nothing.
+  if (!press(mapping.clear_kill)) cockpit.clearHeldSince = null;
+  else if (pressed(mapping.clear_kill)) cockpit.clearHeldSince = performance.now();
+  else if (cockpit.clearHeldSince !== null && performance.now() - cockpit.clearHeldSince >= CLEAR_HOLD_MS) {
+    cockpit.clearHeldSince = null;
+    clearKill();
+  }
+  for (const button of [mapping.gain_up, mapping.gain_down, mapping.kill, mapping.clear_kill])
+    if (press(button)) gainButtons.add(button); else gainButtons.delete(button);
   const s = sample(p, mapping);
   $("pad-motion").textContent = AXES.map((a) => `${a} ${s.motion[a].toFixed(2)}`).join(" · ");
-  // Not ready (killed, arming, fault): nothing to send, the daemon would refuse it.
-  if (!s.held || cockpit.state?.state !== "ready") return stopDriving();
+  // Not ready (killed, arming, fault, surfacing, link lost): nothing to send, and arming again.
+  const ready = fresh() && cockpit.state?.state === "ready" && !(cockpit.state.surfacing_ms >= 0);
+  if (!ready) {
+    if (cockpit.arm !== ARM_RELEASE) cockpit.arm = ARM_RELEASE;
+    return stopDriving();
+  }
+  if (cockpit.arm === ARM_RELEASE && !s.held && s.centred) cockpit.arm = ARM_PRESS;
+  else if (cockpit.arm === ARM_PRESS && s.held && s.centred) {
+    cockpit.arm = ARM_ARMED;
+    cockpit.refusal = null; // armed again on purpose: a new refusal makes a new event
+  }
+  if (!s.held || cockpit.arm !== ARM_ARMED) return stopDriving();
   driving = true;
   $("deadman").textContent = "HELD";
   $("deadman").className = "pill held";
@@ -234,7 +357,7 @@ window.addEventListener("pagehide", () => { stopDriving(); client?.close(); });
 function mappingForm() {
   const form = $("mapping");
   form.innerHTML = "";
-  const fields = [...AXES, "deadman", "gain_up", "gain_down", "deadzone", "expo"];
+  const fields = [...AXES, "deadman", "gain_up", "gain_down", "kill", "clear_kill", "deadzone", "expo"];
   for (const k of fields) {
     const label = document.createElement("label");
     label.textContent = k;
@@ -273,4 +396,4 @@ for (let i = 0; i < MOTORS; i++) thrusterRow(i);
 connect();
 sendTimer = setInterval(tick, SEND_MS);
 setInterval(showLink, 100);
-showDives($("dives"), $("dive-plot"), token);
+dives.load();

@@ -54,7 +54,16 @@ std::vector<ChannelInfo> make_channels() {
                            {"saturated", boolean()},
                            {"command_age_ms", integer()},
                            {"controller", string()},
-                           {"leds", fixed_array(integer(), 3)}})
+                           {"controller_name", string()},
+                           {"leds", fixed_array(integer(), 3)},
+                           {"failsafes", array_of({{"type", "object"},
+                                                   {"properties", {{"condition", string()},
+                                                                   {"action", {{"enum", {"warn", "exclude", "surface", "kill"}}}},
+                                                                   {"thruster", integer()}}},
+                                                   {"required", {"condition", "action", "thruster"}},
+                                                   {"additionalProperties", false}})},
+                           {"excluded", array_of(integer())},
+                           {"surfacing_ms", integer()}})
                        .dump()});
     out.push_back({ChannelKind::Motors, 0, "/vehicle/motors", "caracara.Motors",
                    object("caracara.Motors", {{"applied", fixed_array(integer(), kThrusters)},
@@ -138,6 +147,13 @@ std::size_t channel_position(ChannelKind kind, unsigned index) {
 }
 
 std::string to_json(const VehicleState& m) {
+    json failsafes = json::array();
+    std::vector<int64_t> excluded;
+    for (const ActiveFailsafe& f : m.failsafes) {
+        failsafes.push_back({{"condition", f.condition}, {"action", f.action}, {"thruster", f.thruster}});
+        if (f.action == "exclude" && f.thruster >= 0)
+            excluded.push_back(f.thruster);
+    }
     return json{{"state", m.state},
                 {"kill_source", m.kill_source},
                 {"profile", m.profile},
@@ -146,7 +162,11 @@ std::string to_json(const VehicleState& m) {
                 {"saturated", m.saturated},
                 {"command_age_ms", m.command_age_ms},
                 {"controller", m.controller},
-                {"leds", m.leds}}
+                {"controller_name", m.controller_name},
+                {"leds", m.leds},
+                {"failsafes", failsafes},
+                {"excluded", excluded},
+                {"surfacing_ms", m.surfacing_ms}}
         .dump();
 }
 

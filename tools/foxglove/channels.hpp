@@ -34,6 +34,13 @@ inline constexpr const char* kSchemaEncoding = "jsonschema";
 
 // --- messages (what a channel carries) ---------------------------------------------------------
 
+// One active failsafe, as the daemon's Failsafes property has it (dbus/org.caracara.Vehicle1.xml).
+struct ActiveFailsafe {
+    std::string condition;       // "water-detect", "pilot-lost", ...
+    std::string action;          // "warn", "exclude", "surface", "kill"
+    int64_t thruster = -1;       // -1: not one thruster's
+};
+
 struct VehicleState {
     std::string state;           // "arming", "ready", "killed", "powered-off", "fault"
     std::string kill_source;     // "" when not killed
@@ -43,7 +50,11 @@ struct VehicleState {
     bool saturated = false;
     int64_t command_age_ms = -1; // -1: no motion command yet, or not recorded
     std::string controller;      // the commanding client's unique bus name
+    std::string controller_name; // who that is in words ("caracaractl (pid 812)"); "" unknown
     std::array<int64_t, 3> leds{}; // red, green, blue (not recorded in a dive: 0)
+    std::vector<ActiveFailsafe> failsafes;
+    int64_t surfacing_ms = -1;   // how long a surface failsafe's ascent has run; -1 none
+    // In the JSON also "excluded": the thrusters an exclude failsafe holds at zero (from failsafes).
 };
 
 struct Motors {

@@ -4,6 +4,7 @@
 #include "tools/foxglove/channels.hpp"
 #include "tools/foxglove/mcap_writer.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -50,9 +51,14 @@ LogEvent log_of(const dive::Event& e, uint64_t time_ns, VehicleState& state) {
         const std::string condition = e.text.substr(0, space);
         const std::string action = space == std::string::npos ? "" : e.text.substr(space + 1);
         const bool raised = e.value & dive::kFailsafeRaised;
+        const int64_t thruster = e.value & dive::kFailsafeVehicle ? -1 : int64_t{e.thruster};
+        std::erase_if(state.failsafes,
+                      [&](const ActiveFailsafe& f) { return f.condition == condition && f.thruster == thruster; });
+        if (raised)
+            state.failsafes.push_back({condition, action, thruster});
         log.name = "failsafe";
         log.level = raised ? LogLevel::Warning : LogLevel::Info;
-        log.message = "failsafe: " + condition + " -> " + action +
+        log.message = condition + " -> " + action +
                       (e.value & dive::kFailsafeVehicle ? "" : " (thruster " + std::to_string(e.thruster) + ")") +
                       (raised ? "" : " cleared");
         break;
@@ -77,20 +83,25 @@ std::vector<uint8_t> dive_to_mcap(const dive::Dive& d) {
     const uint64_t start_ns = d.header.start_unix_ms * 1'000'000u;
     auto at = [&](uint32_t t_100us) { return start_ns + uint64_t{t_100us} * 100'000u; };
 
-    VehicleState state{"arming", "", d.header.profile, 1.0, 0, false, -1, "", {}};
+    VehicleState state{"arming", "", d.header.profile, 1.0, 0, false, -1, "", "", {}, {}, -1};
     std::size_t next_event = 0;
+    uint64_t surfacing_since = 0; // when the ascent of a surface failsafe began; 0 none
     auto events_until = [&](uint32_t t) {
         for (; next_event < d.events.size() && d.events[next_event].t_100us <= t; ++next_event) {
             const uint64_t ns = at(d.events[next_event].t_100us);
             w.add_message(id(ChannelKind::Events), ns, ns, to_json(log_of(d.events[next_event], ns, state)));
+            const bool surfacing = state.state != "killed" && state.state != "powered-off" &&
+                                   std::ranges::any_of(state.failsafes, [](const ActiveFailsafe& f) { return f.action == "surface"; });
+            surfacing_since = surfacing ? (surfacing_since ? surfacing_since : ns) : 0;
         }
     };
     for (const dive::Sample& s : d.samples) {
-        events_until(s.t_100us);
         const uint64_t ns = at(s.t_100us);
+        events_until(s.t_100us);
         auto put = [&](uint16_t channel, const std::string& json) { w.add_message(channel, ns, ns, json); };
         state.budget_limit = s.budget_limit;
         state.saturated = s.flags & dive::kSaturated;
+        state.surfacing_ms = surfacing_since ? static_cast<int64_t>((ns - surfacing_since) / 1'000'000u) : -1;
         put(id(ChannelKind::VehicleState), to_json(state));
         Motors m;
         for (std::size_t i = 0; i < kThrusters; ++i) {

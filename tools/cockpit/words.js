@@ -1,0 +1,76 @@
+// The vehicle's state in a pilot's words (docs/cockpit.md): kill sources, failsafe conditions,
+// the controller, and the banner of everything that holds the vehicle back.
+const KILL_SOURCES = {
+  "": "none",
+  start: "daemon start (every start is killed)",
+  dbus: "Kill command (a pilot or caracaractl)",
+  switch: "the kill switch",
+  packet: "a kill packet",
+  bus: "I2C bus lost",
+  device: "hardware (a kill line gone or a thruster failing)",
+  failsafe: "a failsafe",
+};
+const CONDITIONS = {
+  "water-detect": "water in the thruster",
+  "ground-fault": "ground fault",
+  overtemp: "over-temperature",
+  stall: "stalled motor",
+  hall: "hall sensor error",
+  "pilot-lost": "no pilot left",
+  "thruster-unreachable": "a thruster does not answer",
+  "bus-lost": "I2C bus lost",
+  "teensy-link-lost": "Teensy link lost",
+  "kill-switch-unreadable": "kill switch unreadable",
+};
+// The daemon's pilot-lost persistence when not configured otherwise (daemon/caracarad.toml.example);
+// the daemon does not publish the configured one.
+export const PILOT_LOST_DEFAULT_MS = 5000;
+
+const escape = (t) => String(t).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" })[c]);
+
+export const killSourceWords = (source) => KILL_SOURCES[source] ?? source;
+
+export function conditionWords(f) {
+  const what = CONDITIONS[f.condition] ?? f.condition;
+  return f.thruster >= 0 ? `${what} (thruster ${f.thruster})` : what;
+}
+
+// The commanding client: its process where the bridge could name it; "this page" while it drives.
+export function controllerWords(state, driving) {
+  if (!state.controller) return "none";
+  const bridgeClient = state.controller_name?.includes("this bridge");
+  if (driving && bridgeClient) return "this page";
+  return state.controller_name || `client ${state.controller}`;
+}
+
+// [{kind, level, text}]: what keeps the vehicle from doing what the pilot asks, most urgent first.
+export function banner({ state, up, lostMs, killNotSentMs, refusal }) {
+  const out = [];
+  const add = (kind, level, text) => out.push({ kind, level, text: escape(text) });
+  if (killNotSentMs !== null)
+    add("kill-not-sent", "alarm", `KILL NOT SENT ${(killNotSentMs / 1000).toFixed(0)} s ago: no link to the bridge. ` +
+      "Press KILL again once connected, or use the kill switch");
+  if (!up) {
+    const s = lostMs / 1000;
+    const left = Math.max(0, (PILOT_LOST_DEFAULT_MS - lostMs) / 1000);
+    add("link-lost", "alarm", `LINK LOST ${s.toFixed(1)} s: this page cannot kill. The vehicle zeroed this page's thrust; ` +
+      (left > 0 ? `pilot-lost kill in ${left.toFixed(1)} s (default time) unless another pilot drives`
+        : "pilot-lost kill due (default time) unless another pilot drives"));
+  }
+  if (!state || !up) return out;
+  for (const f of state.failsafes ?? []) {
+    if (f.action === "surface")
+      add("surfacing", "alarm", `SURFACING: ${conditionWords(f)}. ` + (state.surfacing_ms >= 0
+        ? `Ascent running ${(state.surfacing_ms / 1000).toFixed(1)} s, then the vehicle kills itself; motion is refused`
+        : "Ascent over or ended by a kill; Clear kill is refused while it holds"));
+    else if (f.action === "exclude")
+      add("excluded", "alarm", `THRUSTER ${f.thruster} EXCLUDED: ${CONDITIONS[f.condition] ?? f.condition}; held at zero, the others drive`);
+    else if (f.action === "kill")
+      add("failsafe-kill", "alarm", `FAILSAFE: ${conditionWords(f)}; killed, Clear kill refused while it holds`);
+    else
+      add("warning", "warn", `WARNING: ${conditionWords(f)}`);
+  }
+  if (refusal && state.state === "ready" && !(state.surfacing_ms >= 0))
+    add("refused", "warn", `Motion refused (${refusal}): release the deadman, centre the sticks and press it again`);
+  return out;
+}
