@@ -24,15 +24,16 @@ DiveWorker::~DiveWorker() {
 }
 
 bool DiveWorker::submit(std::shared_ptr<const StaticFiles::Request> request, Done done) {
-    if (waiting_ >= kMaxWaiting)
+    std::shared_ptr<void> ticket = answers_.claim();
+    if (!ticket)
         return false;
-    ++waiting_;
-    boost::asio::post(pool_, [this, request = std::move(request), done = std::move(done)]() mutable {
+    // The ticket and `done` (which holds the session) are counted and destroyed on the I/O
+    // thread only: they travel in the posted function's state, never copied on the worker.
+    boost::asio::post(pool_, [this, request = std::move(request), done = std::move(done),
+                              ticket = std::move(ticket)]() mutable {
         auto response = std::make_shared<StaticFiles::Response>(routes_.respond(*request));
-        // `done` (which holds the session) moves to the I/O thread: it is never destroyed here.
-        boost::asio::post(io_, [this, response, done = std::move(done)] {
-            --waiting_;
-            done(std::move(*response));
+        boost::asio::post(io_, [response, done = std::move(done), ticket = std::move(ticket)] {
+            done(std::move(*response), ticket);
         });
     });
     return true;

@@ -141,9 +141,9 @@ void Session::reject(http::status status, std::string body) {
     answer(std::move(res));
 }
 
-void Session::answer(std::shared_ptr<http::response<http::string_body>> res) {
+void Session::answer(std::shared_ptr<http::response<http::string_body>> res, std::shared_ptr<void> ticket) {
     close_after(kAnswerTimeout);
-    http::async_write(ws_.next_layer(), *res, [self = shared_from_this(), res](boost::system::error_code, std::size_t) {
+    http::async_write(ws_.next_layer(), *res, [self = shared_from_this(), res, ticket](boost::system::error_code, std::size_t) {
         boost::system::error_code ignored;
         self->ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
     });
@@ -167,11 +167,12 @@ void Session::on_request(boost::system::error_code ec) {
         // Listing and converting take their time: on the worker, never on this (the I/O) thread.
         close_after(kAnswerTimeout);
         const bool queued = dives_.submit(std::make_shared<const http::request<http::string_body>>(request_),
-                                          [self = shared_from_this()](StaticFiles::Response res) {
-                                              self->answer(std::make_shared<http::response<http::string_body>>(std::move(res)));
+                                          [self = shared_from_this()](StaticFiles::Response res, std::shared_ptr<void> ticket) {
+                                              self->answer(std::make_shared<http::response<http::string_body>>(std::move(res)),
+                                                           std::move(ticket));
                                           });
         if (!queued)
-            reject(http::status::service_unavailable, "caracara-bridge: too many dive requests at once; try again");
+            reject(http::status::service_unavailable, "caracara-bridge: too many dive requests in progress; try again");
         return;
     }
     if (!offers_subprotocol(request_))

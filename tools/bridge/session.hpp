@@ -60,7 +60,9 @@ private:
 
     void on_request(boost::system::error_code ec);
     void reject(boost::beast::http::status status, std::string body);
-    void answer(std::shared_ptr<boost::beast::http::response<boost::beast::http::string_body>> res);
+    // ticket: a DiveWorker's, held until the answer is written.
+    void answer(std::shared_ptr<boost::beast::http::response<boost::beast::http::string_body>> res,
+                std::shared_ptr<void> ticket = nullptr);
     void on_accept(boost::system::error_code ec);
     void read();
     void on_frame(boost::system::error_code ec);
