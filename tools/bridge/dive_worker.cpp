@@ -1,20 +1,30 @@
 #include "tools/bridge/dive_worker.hpp"
 
 #include <boost/asio/post.hpp>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <sys/resource.h>
-#include <unistd.h>
 
 namespace caracara::bridge {
 
 namespace {
 
-constexpr int kNice = 10;
+// The lowest priority of SCHED_OTHER: the worker gets the CPU that the I/O thread, caracarad
+// and the bus leave. Not SCHED_IDLE: a thread that may not run at all for as long as the CPU
+// is busy can hold the process's memory map lock (a page fault while reading a dive) while the
+// I/O thread waits for it.
+constexpr int kNice = 19;
 
 } // namespace
 
 DiveWorker::DiveWorker(boost::asio::io_context& io, std::string directory) : io_(io), routes_(std::move(directory)) {
-    // On Linux a thread's id names the thread alone: only the worker is lowered.
-    boost::asio::post(pool_, [] { (void)::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), kNice); });
+    // Who 0 with PRIO_PROCESS is the calling thread alone, on Linux. Lowering needs no
+    // privilege (the unit allows this one call of @resources).
+    boost::asio::post(pool_, [] {
+        if (::setpriority(PRIO_PROCESS, 0, kNice) != 0)
+            std::fprintf(stderr, "caracara-bridge: the dive worker stays at normal priority: %s\n", std::strerror(errno));
+    });
 }
 
 DiveWorker::~DiveWorker() {

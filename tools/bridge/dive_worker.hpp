@@ -4,8 +4,8 @@
 // most kMaxAnswers requests are in progress at once, from submit() until their answer is
 // written (the client holds a ticket till then), so their memory is bounded too (DiveRoutes
 // bounds each answer); past that, submit() says no and the client gets a 503.
-// The thread runs at a lower priority (nice +10), so it also yields the CPU to the I/O thread
-// and to caracarad on a busy vehicle.
+// The thread runs at nice 19, so it also yields the CPU to the I/O thread, caracarad and the
+// bus on a busy vehicle.
 #pragma once
 
 #include "tools/bridge/client_slots.hpp"
