@@ -6,7 +6,8 @@
 import { spawn } from "node:child_process";
 import { createInterface } from "node:readline";
 import {
-  DEFAULT_MT, ROOT, VEHICLE, X_AXIS, ZERO, busctl, connect, killEdges, poll, rearm, simSpeeds, sleep, vget, wireLog, wireNext,
+  DEFAULT_MT, ROOT, VEHICLE, X_AXIS, ZERO, busctl, connect, firstZeros, killEdges, poll, rearm, simSpeeds, sleep, vget,
+  wireNext,
 } from "./lib.mjs";
 
 export function stats(v) {
@@ -111,14 +112,7 @@ export async function closesDuringListing(url, listUrl, samples) {
       const since = wireNext();
       const closedAt = process.hrtime.bigint();
       c.ws.terminate(); // the tab's connection gone, as a closed tab's is
-      const zeros = await poll(() => {
-        const first = new Map();
-        for (const e of wireLog(since))
-          if (e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] === ZERO && driven.has(e.addr) &&
-              !first.has(e.addr))
-            first.set(e.addr, e.time_ns);
-        return first.size === driven.size ? [...first.values()] : null;
-      }, 5000, "zero orders to the four motors it drove");
+      const zeros = await poll(() => firstZeros(since, driven), 5000, "zero orders to the four motors it drove");
       out.push(Number(zeros.reduce((a, b) => (a > b ? a : b)) - closedAt) / 1e6);
     }
   } finally {
