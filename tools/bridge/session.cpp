@@ -26,9 +26,11 @@ namespace {
 constexpr const char* kSubprotocol = "foxglove.websocket.v1";
 constexpr uint8_t kMessageData = 0x01;
 // From the connection to its request read (a stalled or silent connection goes then), and
-// from the request to an HTTP answer written (a reader that never reads goes then).
+// from the request to an HTTP answer written (a reader that never reads goes then; a dive of
+// up to 32 MiB gets longer, for a slow tether).
 constexpr auto kRequestTimeout = std::chrono::seconds(3);
 constexpr auto kAnswerTimeout = std::chrono::seconds(60);
+constexpr auto kDiveAnswerTimeout = std::chrono::minutes(5);
 // A client being closed for what it did: its close frame gets this long to go out.
 constexpr auto kCloseTimeout = std::chrono::seconds(2);
 
@@ -142,7 +144,7 @@ void Session::reject(http::status status, std::string body) {
 }
 
 void Session::answer(std::shared_ptr<http::response<http::string_body>> res, std::shared_ptr<void> ticket) {
-    close_after(kAnswerTimeout);
+    close_after(ticket ? kDiveAnswerTimeout : kAnswerTimeout);
     http::async_write(ws_.next_layer(), *res, [self = shared_from_this(), res, ticket](boost::system::error_code, std::size_t) {
         boost::system::error_code ignored;
         self->ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
@@ -165,7 +167,7 @@ void Session::on_request(boost::system::error_code ec) {
         return reject(http::status::unauthorized, "caracara-bridge: a valid token is required");
     if (!upgrade) {
         // Listing and converting take their time: on the worker, never on this (the I/O) thread.
-        close_after(kAnswerTimeout);
+        close_after(kDiveAnswerTimeout);
         const bool queued = dives_.submit(std::make_shared<const http::request<http::string_body>>(request_),
                                           [self = shared_from_this()](StaticFiles::Response res, std::shared_ptr<void> ticket) {
                                               self->answer(std::make_shared<http::response<http::string_body>>(std::move(res)),
