@@ -30,7 +30,8 @@ def _shifted(records, dt):
 
 
 def long_dive(repeats=3):
-    src = open(SEED, "rb").read()
+    with open(SEED, "rb") as f:
+        src = f.read()
     header_end = 12 + struct.unpack_from("<H", src, 10)[0] + 4
     blocks, at = [], header_end
     while at < len(src):

@@ -1,7 +1,10 @@
 """caracara-bridge end to end: a private bus, caracara-sim, caracarad (tests/e2e/harness.py), the
 bridge on a Unix socket, a private sshd and a real `ssh -L PORT:SOCKET` forward, then the
 reference client's tests (bridge.test.mjs, node --test) through it; the socket's group rule;
-and a recorded dive exported to MCAP and read back by the reference reader (mcap_check.mjs).
+a recorded dive exported to MCAP and read back by the reference reader (mcap_check.mjs); the
+token on TCP; and the bridge's bounds (issue 35): a Kill and a close while another client lists
+a full dive directory, floods from a client that does not read (bounds.test.mjs, on a second
+bridge on TCP), and stalled tokenless connections beside the pilots.
 
 The npm packages are pinned in package-lock.json and installed with `npm ci`, cached under
 /var/cache/caracara-npm. Under CI (CI=true) a missing node, npm or sshd fails the test.
