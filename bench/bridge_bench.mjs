@@ -12,19 +12,18 @@
 //            tightest of 30 round trips (its half-width is printed as clock_uncertainty_us)
 //   load N S: N clients subscribed to every channel for S seconds (run.py reads the bridge's
 //            CPU and RSS meanwhile)
+//   listing: a Kill published by a client to the kill output's edge on the wire, with no listing
+//            and while another client (a process of its own) lists a full dive directory back
+//            to back, and a client's close to its zeros on the wire meanwhile (issue 35; the
+//            bridge at CARACARA_TCP_URL, tests/bridge/listing_load.mjs)
 import { spawn } from "node:child_process";
 import { createInterface } from "node:readline";
 import { BUS, DEFAULT_MT, MOTOR_MAX, X_AXIS, connect, poll, sleep, speedByte, wireLog, wireNext } from "../tests/bridge/lib.mjs";
+import { closesDuringListing, killsDuringListing, stats } from "../tests/bridge/listing_load.mjs";
 
 const url = process.env.CARACARA_WS_URL;
 const samples = Number(process.env.CARACARA_BENCH_SAMPLES ?? 200);
 const mode = process.argv[2];
-
-function stats(v) {
-  const s = [...v].sort((a, b) => a - b);
-  const pct = (q) => s[Math.min(Math.max(Math.ceil((q * s.length) / 100), 1), s.length) - 1];
-  return { n: s.length, min: s[0], p50: pct(50), p90: pct(90), p99: pct(99), max: s[s.length - 1] };
-}
 
 async function latency() {
   const c = await connect(url);
@@ -164,6 +163,13 @@ let result;
 if (mode === "latency") result = await latency();
 else if (mode === "motion") result = await motion();
 else if (mode === "cockpit") result = await cockpit();
-else if (mode === "load") result = await load(Number(process.argv[3]), Number(process.argv[4]));
-else throw new Error("mode: latency | motion | cockpit | load N SECONDS");
+else if (mode === "listing") {
+  const url = process.env.CARACARA_TCP_URL;
+  const listUrl = url.replace(/^ws:/, "http:").replace("/?", "/dives/?");
+  const k = await killsDuringListing(url, listUrl, samples, samples);
+  const c = await closesDuringListing(url, listUrl, 10);
+  result = { kill_during_listing_ms: k.kill_output_ms, kill_no_listing_ms: k.kill_output_no_listing_ms,
+             listing_ms: k.listing_ms, dives_listed: k.dives, close_during_listing_ms: c.close_to_zeros_ms };
+} else if (mode === "load") result = await load(Number(process.argv[3]), Number(process.argv[4]));
+else throw new Error("mode: latency | motion | cockpit | listing | load N SECONDS");
 console.log(JSON.stringify(result));

@@ -348,6 +348,25 @@ def phase_bridge(b, p, res):
         b.stop(tcp)
     else:
         log("   no /usr/bin/chromium: the cockpit row is left out (apt-get install chromium)")
+    # A Kill, and a client's close, while another client lists a full dive directory (issue 35):
+    # a bridge on loopback with a token, its dive directory at the recorder's default bound.
+    from ssh_bridge import free_port, port_listens
+    sys.path.insert(0, node_dir)
+    from full_dive_dir import fill
+    count, size = fill(os.path.join(b.dir, "full-dives"))
+    log(f"   {count} dives, {size / 1e6:.0f} MB, for the listing row")
+    port, token_file = free_port(), os.path.join(b.dir, "bridge-full.token")
+    token = os.urandom(16).hex()
+    with open(token_file, "w") as f:
+        f.write(token + "\n")
+    full = b.spawn([bridge_exe, "--listen", f"tcp:127.0.0.1:{port}", "--token-file", token_file, "--bus-address", b.bus,
+                    "--dives-dir", os.path.join(b.dir, "full-dives")], "caracara-bridge (full dives)")
+    b.wait_for(lambda: port_listens(port), 10, "the bridge's TCP port")
+    env["CARACARA_TCP_URL"] = f"ws://127.0.0.1:{port}/?token={token}"
+    b.start_daemon(b.daemon_config(50, kill_switch=True))  # with the kill output, whose edge is timed
+    b.rearm()
+    res["bridge"].update(run("listing"))
+    b.stop(full)
     b.stop_daemon()
     b.stop_sim()
 
@@ -789,6 +808,13 @@ def rows_from(res, p):
             row(f"8. bridge CPU, {k} client(s) subscribed to everything", v["cpu_percent"], None, None, "info", None,
                 "%")
             row(f"8. bridge RSS, {k} client(s) subscribed to everything", v["rss_kib"], None, None, "info", None, "KiB")
+        if "kill_during_listing_ms" in br:
+            kl, kn = br["kill_during_listing_ms"], br["kill_no_listing_ms"]
+            for q in ("p50", "p99"):
+                row(f"8. bridge: Kill to the kill output {q} while another client lists 256 MB of dives (vs no "
+                    f"listing)", kl[q], kn[q], kl[q] / kn[q], "info", None, "ms")
+            row("8. bridge: a client's close to zeros, max, while another client lists 256 MB of dives",
+                br["close_during_listing_ms"]["max"], None, None, "info", None, "ms")
     return rows
 
 

@@ -7,7 +7,7 @@ import assert from "node:assert/strict";
 import net from "node:net";
 import WebSocket from "ws";
 import {
-  DEFAULT_MT, ERR, MOTORS, MOTOR_MAX, PILOT_LOST_MS, X_AXIS, ZERO, connect, hold, killEdges, poll, rearm, simSpeeds,
+  DEFAULT_MT, ERR, MOTORS, MOTOR_MAX, PILOT_LOST_MS, X_AXIS, ZERO, connect, firstZeros, hold, killEdges, poll, rearm, simSpeeds,
   simThruster, sleep, speedByte, URL, vget, wireLog, wireNext,
 } from "./lib.mjs";
 
@@ -97,14 +97,7 @@ test("a published motion reaches the wire as the mixing says; a closed client ze
   const closedAt = process.hrtime.bigint(); // CLOCK_MONOTONIC, as the wire log's times
   await c.close();
   const driven = new Set(Object.keys(X_AXIS).map((i) => DEFAULT_MT[i] >> 1)); // 7-bit addresses
-  const zeroTimes = await poll(() => {
-    const firstZero = new Map();
-    for (const e of wireLog(since))
-      if (e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] === ZERO && driven.has(e.addr) &&
-          !firstZero.has(e.addr))
-        firstZero.set(e.addr, e.time_ns);
-    return firstZero.size === driven.size ? [...firstZero.values()] : null;
-  }, 5000, "zero orders to the four motors it drove");
+  const zeroTimes = await poll(() => firstZeros(since, driven), 5000, "zero orders to the four motors it drove");
   const worstMs = Number(zeroTimes.reduce((a, b) => (a > b ? a : b)) - closedAt) / 1e6;
   console.log(`# close to the last zero order: ${worstMs.toFixed(1)} ms`);
   assert.ok(worstMs <= 250, `zeroed ${worstMs} ms after the close (bound 250 ms, docs/topside.md)`);

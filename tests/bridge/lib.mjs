@@ -48,6 +48,16 @@ export function wireLog(since) {
   return entries.map((e) => ({ index: e[0], time_ns: BigInt(e[1]), bus: e[3], addr: e[4], read: e[5], data: e[6] }));
 }
 
+// The times of the first zero order to each of `addrs` (7-bit I2C addresses) since a wire log
+// index, once every one has had one; else null.
+export function firstZeros(since, addrs) {
+  const first = new Map();
+  for (const e of wireLog(since))
+    if (e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] === ZERO && addrs.has(e.addr) && !first.has(e.addr))
+      first.set(e.addr, e.time_ns);
+  return first.size === addrs.size ? [...first.values()] : null;
+}
+
 // The simulator's kill output line (tests/e2e/vehicle_checks.py KILL_OUT): its asserted edges.
 export const KILL_OUT = 27;
 export const killEdges = (since) =>

@@ -1,7 +1,10 @@
 """caracara-bridge end to end: a private bus, caracara-sim, caracarad (tests/e2e/harness.py), the
 bridge on a Unix socket, a private sshd and a real `ssh -L PORT:SOCKET` forward, then the
 reference client's tests (bridge.test.mjs, node --test) through it; the socket's group rule;
-and a recorded dive exported to MCAP and read back by the reference reader (mcap_check.mjs).
+a recorded dive exported to MCAP and read back by the reference reader (mcap_check.mjs); the
+token on TCP; and the bridge's bounds (issue 35): a Kill and a close while another client lists
+a full dive directory, floods from a client that does not read (bounds.test.mjs, on a second
+bridge on TCP), and stalled tokenless connections beside the pilots.
 
 The npm packages are pinned in package-lock.json and installed with `npm ci`, cached under
 /var/cache/caracara-npm. Under CI (CI=true) a missing node, npm or sshd fails the test.
@@ -20,7 +23,9 @@ SOURCE = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
 sys.path.insert(0, os.path.join(SOURCE, "bench"))
 
+import bounds  # noqa: E402
 import harness  # noqa: E402
+from full_dive_dir import fill  # noqa: E402
 from harness import BUILD_DIR, Rig, poll  # noqa: E402
 from ssh_bridge import free_port, port_listens, private_sshd  # noqa: E402
 
@@ -214,6 +219,22 @@ class BridgeTest(BridgeRig, unittest.TestCase):
             p.stdout.close()
             p.stderr.close()
             self.assertEqual(code, 0, err)
+        # SSH refuses the login (no key of nobody's is authorized): 4, as the help says; the
+        # host not reached (nothing listens on the port): 3.
+        with open(cfg, "a") as f:
+            f.write(f"Host refused\n  HostName 127.0.0.1\n  Port {self.sshd.port}\n  User nobody\n"
+                    f"  IdentityFile {self.sshd.dir}/client_key\n  IdentitiesOnly yes\n  UserKnownHostsFile /dev/null\n"
+                    "  StrictHostKeyChecking no\n  BatchMode yes\n"
+                    f"Host unreached\n  HostName 127.0.0.1\n  Port {free_port()}\n  BatchMode yes\n")
+        for host, want in (("refused", 4), ("unreached", 3)):
+            r = subprocess.run(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "caracaractl"), "-H", host, "bridge",
+                                "--port", str(free_port()), "--socket", self.socket, "--ssh-config", cfg],
+                               capture_output=True, text=True, timeout=60)
+            self.assertEqual(r.returncode, want, host + ": " + r.stderr)
+        self.assertIn("SSH refused the login", subprocess.run(
+            harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "caracaractl"), "-H", "refused", "bridge", "--port",
+                                str(free_port()), "--socket", self.socket, "--ssh-config", cfg],
+            capture_output=True, text=True, timeout=60).stderr)
 
     def test_2_socket_is_for_the_group_only(self):
         st = os.stat(self.socket)
@@ -283,6 +304,10 @@ class BridgeTest(BridgeRig, unittest.TestCase):
             self.assertIn("401", status(b"/?token=" + token.encode() + b"0"))
             self.assertIn("101", status(b"/?token=" + token.encode()))
             self.assertIn("101", status(b"/", b"Authorization: Bearer " + token.encode() + b"\r\n"))
+            # The scheme is case-insensitive (RFC 7235 2.1); the token is not.
+            self.assertIn("101", status(b"/", b"Authorization: bearer " + token.encode() + b"\r\n"))
+            self.assertIn("101", status(b"/", b"Authorization: BEARER " + token.encode() + b"\r\n"))
+            self.assertIn("401", status(b"/", b"Authorization: bearer " + token.upper().encode() + b"\r\n"))
 
             def plain(target):
                 with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
@@ -295,6 +320,101 @@ class BridgeTest(BridgeRig, unittest.TestCase):
         finally:
             p.terminate()
             self.assertEqual(p.wait(20), 0)
+
+    def tcp_bridge(self, dives_dir, log_name):
+        """A second bridge on TCP with a token, serving dives_dir; (process, port, token, log path)."""
+        port = free_port()
+        token = "fedcba9876543210fedcba9876543210"
+        token_file = os.path.join(self.rig.dir, "token-" + log_name)
+        with open(token_file, "w") as f:
+            f.write(token + "\n")
+        log_path = os.path.join(self.rig.dir, log_name)
+        with open(log_path, "ab") as log:
+            p = subprocess.Popen(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge"),
+                                  "--listen", "tcp:127.0.0.1:%d" % port, "--token-file", token_file,
+                                  "--bus-address", self.rig.address, "--dives-dir", dives_dir,
+                                  "--cockpit-dir", os.path.join(SOURCE, "tools", "cockpit")],
+                                 stdout=log, stderr=subprocess.STDOUT)
+        self.addCleanup(lambda: p.poll() is not None or (p.terminate(), p.wait(20)))
+        poll(lambda: self.listening(port) or p.poll() is not None, 10, message="the TCP listener")
+        self.assertIsNone(p.poll(), "the TCP bridge exited")
+        return p, port, token, log_path
+
+    def test_6_bounds_kill_during_listing_and_floods(self):
+        # A full dive directory (the recorder's default bound, 256 MB) for the bridge to list.
+        full = os.path.join(self.rig.dir, "full-dives")
+        count, size = fill(full)
+        print("# %d dives, %.0f MB" % (count, size / 1e6), file=sys.stderr)
+        p, port, token, log_path = self.tcp_bridge(full, "caracara-bridge-full.log")
+        self.node("bounds.test.mjs", CARACARA_TCP_URL="ws://127.0.0.1:%d/?token=%s" % (port, token),
+                  CARACARA_BRIDGE_PID=str(p.pid), CARACARA_BRIDGE_LOG=log_path,
+                  CARACARA_KILL_OUTPUT_LISTING_MS_MAX=str(bounds.BRIDGE_KILL_OUTPUT_DURING_LISTING_MS_MAX),
+                  CARACARA_CLIENT_LOSS_ZERO_MS_MAX=str(bounds.CLIENT_LOSS_ZERO_MS_MAX))
+        self.assertIsNone(p.poll(), "the bridge survived")
+
+    def test_7_stalled_tokenless_connections_never_lock_out_a_pilot(self):
+        p, port, token, _ = self.tcp_bridge(self.rig.dives_dir, "caracara-bridge-stalled.log")
+        upgrade = (b"GET /%s HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                   b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+                   b"Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n")
+
+        def connect(first_bytes=b""):
+            s = socket.create_connection(("127.0.0.1", port), timeout=10)
+            self.addCleanup(s.close)
+            if first_bytes:
+                s.sendall(first_bytes)
+            return s
+
+        def pilot():
+            s = connect(upgrade % (b"?token=" + token.encode()))
+            return s, s.recv(4096).split(b"\r\n")[0].decode()
+
+        # 16 tokenless connections that never finish their request (the max-clients default), and
+        # 16 that say nothing, held open; then the pilots with the token, all 16 of them.
+        stalled = [connect(b"GET / HTTP/1.1\r\nHost: x\r\n") for _ in range(16)] + [connect() for _ in range(16)]
+        t0 = time.monotonic()
+        pilots = [pilot() for _ in range(16)]
+        self.assertEqual([line for _, line in pilots], ["HTTP/1.1 101 Switching Protocols"] * 16)
+        # A 17th is refused with the reason: the slots are the pilots'.
+        s17, line = pilot()
+        self.assertIn("503", line)
+        # The stalled ones are closed after the request timeout (3 s), never the pilots.
+        for s in stalled:
+            s.settimeout(10)
+            try:
+                self.assertEqual(s.recv(4096), b"")
+            except ConnectionResetError:
+                pass
+        waited = time.monotonic() - t0
+        print("# stalled connections closed %.1f s after the pilots connected" % waited, file=sys.stderr)
+        self.assertLess(waited, 8)
+        for s, _ in pilots:
+            s.setblocking(False)
+            try:
+                self.assertNotEqual(s.recv(65536), b"", "a pilot's connection was closed")
+            except BlockingIOError:
+                pass  # open, nothing to read
+        # More connections without a request than the bridge keeps apart (64): the oldest go, and
+        # a pilot still gets in once a slot is free.
+        s17.close()
+        for s, _ in pilots[:1]:
+            s.close()
+        flood = [connect() for _ in range(100)]
+        time.sleep(0.5)  # well inside the request timeout: only the bound closed any
+
+        def is_closed(s):
+            s.setblocking(False)
+            try:
+                return s.recv(1) == b""
+            except BlockingIOError:
+                return False
+            except ConnectionResetError:
+                return True
+        self.assertEqual([is_closed(s) for s in flood[:30]], [True] * 30, "the oldest were not closed")
+        self.assertEqual([is_closed(s) for s in flood[-30:]], [False] * 30, "the newest were closed")
+        _, line = pilot()
+        self.assertIn("101", line)
+        self.assertIsNone(p.poll())
 
     def test_9_bridge_stops_cleanly(self):
         self.check_bridge_stops_cleanly()

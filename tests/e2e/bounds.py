@@ -42,3 +42,10 @@ FAILSAFE_LATENESS_MS_MAX = 500.0
 # A pilot's leaving to the last of its zero orders on the wire (docs/topside.md: the
 # client-loss bound, the same for a Foxglove tab that closes).
 CLIENT_LOSS_ZERO_MS_MAX = 250.0
+
+# A Kill published by one bridge client while another lists a full dive directory (256 MB, the
+# recorder's default bound): the publish to the kill output's edge, p99 (issue 35). Listing and
+# converting dives run on the bridge's DiveWorker thread, so the Kill does not wait behind them
+# (it waited 4.3 s when they ran on the I/O thread); a Kill from a client with nothing else
+# going on takes about 1 ms (bench 8). The issue sets the bound.
+BRIDGE_KILL_OUTPUT_DURING_LISTING_MS_MAX = 5.0

@@ -25,7 +25,7 @@ Generic::endpoint endpoint_of(const ListenConfig& l) {
 BridgeServer::BridgeServer(asio::io_context& io, const ListenConfig& listen, SessionConfig session)
     : io_(io), listen_(listen), session_(std::move(session)),
       telemetry_(io, session_.bus, [this](std::size_t c, uint64_t t, const Payload& p) { publish(c, t, p); }),
-      acceptor_(io), accept_retry_(io) {
+      slots_(listen_.max_clients), dives_(io, session_.dives_dir), acceptor_(io), accept_retry_(io) {
     const Generic::endpoint ep = endpoint_of(listen_);
     acceptor_.open(ep.protocol());
     if (!listen_.unix_path.empty()) {
@@ -49,9 +49,22 @@ void BridgeServer::start() {
     accept();
 }
 
-std::size_t BridgeServer::clients() {
+std::size_t BridgeServer::clients() const { return slots_.taken(); }
+
+void BridgeServer::make_room_for_a_request() {
     sessions_.remove_if([](const std::weak_ptr<Session>& s) { return s.expired(); });
-    return sessions_.size();
+    std::size_t waiting = 0;
+    std::shared_ptr<Session> oldest;
+    for (const auto& weak : sessions_)
+        if (auto s = weak.lock(); s && s->waiting_for_request()) {
+            oldest = oldest ? oldest : s;
+            ++waiting;
+        }
+    if (waiting < kMaxWaitingForRequest)
+        return;
+    // The oldest has had the longest to say something: it goes, never a client with a slot.
+    std::fprintf(stderr, "caracara-bridge: %zu connections without a request: closing the oldest\n", waiting);
+    oldest->drop();
 }
 
 void BridgeServer::accept() {
@@ -68,13 +81,10 @@ void BridgeServer::accept() {
             });
             return;
         }
-        if (clients() >= listen_.max_clients) {
-            std::fprintf(stderr, "caracara-bridge: refusing a client: %zu connected\n", listen_.max_clients);
-        } else {
-            auto s = std::make_shared<Session>(io_, std::move(socket), session_, telemetry_);
-            sessions_.push_back(s);
-            s->start();
-        }
+        make_room_for_a_request();
+        auto s = std::make_shared<Session>(io_, std::move(socket), session_, telemetry_, slots_, dives_);
+        sessions_.push_back(s);
+        s->start();
         accept();
     });
 }

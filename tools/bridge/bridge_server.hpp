@@ -1,8 +1,13 @@
 // The listening side of caracara-bridge: a Unix socket (the default, reached over SSH with
 // ssh -L) or, when configured, a TCP address (then every client must bring the token). Each
-// connection becomes a Session; the Telemetry's messages go to every session.
+// connection becomes a Session; the Telemetry's messages go to every session. A connection
+// takes a client slot only once its request and token are good (ClientSlots); before that it
+// has a few seconds (Session), and at most kMaxWaitingForRequest wait at once (a new one
+// closes the oldest), so stalled or tokenless connections never lock out a pilot.
 #pragma once
 
+#include "tools/bridge/client_slots.hpp"
+#include "tools/bridge/dive_worker.hpp"
 #include "tools/bridge/session.hpp"
 #include "tools/bridge/telemetry.hpp"
 
@@ -20,24 +25,29 @@ struct ListenConfig {
     std::string unix_path;        // the Unix socket (mode 0660), when not empty
     std::string tcp_host;         // or a TCP address and port
     uint16_t tcp_port = 0;
-    std::size_t max_clients = 16;
+    std::size_t max_clients = 16; // WebSocket clients (with their token) at once
 };
 
 class BridgeServer {
 public:
+    static constexpr std::size_t kMaxWaitingForRequest = 64;
+
     // Binds at once (throws std::system_error when it cannot).
     BridgeServer(boost::asio::io_context& io, const ListenConfig& listen, SessionConfig session);
     void start();
-    std::size_t clients();
+    std::size_t clients() const;
 
 private:
     void accept();
+    void make_room_for_a_request();
     void publish(std::size_t channel, uint64_t time_ns, const Payload& json);
 
     boost::asio::io_context& io_;
     ListenConfig listen_;
     SessionConfig session_;
     Telemetry telemetry_;
+    ClientSlots slots_;
+    DiveWorker dives_;
     boost::asio::basic_socket_acceptor<boost::asio::generic::stream_protocol> acceptor_;
     boost::asio::steady_timer accept_retry_; // after a failed accept (no descriptor left)
     std::list<std::weak_ptr<Session>> sessions_;

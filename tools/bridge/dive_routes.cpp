@@ -15,6 +15,12 @@ using nlohmann::json;
 namespace {
 
 constexpr std::size_t kPlotPoints = 2000; // the plot's samples at most (every Nth)
+// What one answer may hold, so the bridge's memory stays within its unit's MemoryMax= (a dive
+// can be as large as the whole directory's bound). A dive's MCAP is about 11 times the dive
+// (JSON messages): converting is for dives up to about 6 minutes; longer ones are converted
+// where they are read, with caracaractl export.
+constexpr uint64_t kMaxServedBytes = 32u << 20;
+constexpr uint64_t kMaxConvertedBytes = 4u << 20;
 
 std::string list_json(const std::vector<fg::DiveSummary>& dives) {
     json out = json::array();
@@ -78,6 +84,12 @@ StaticFiles::Response DiveRoutes::respond(const StaticFiles::Request& request) c
         std::vector<uint8_t> bytes;
         if (!found || (ext != ".cdive" && ext != ".mcap" && ext != ".json")) {
             not_found("no such dive");
+        } else if (found->size > (ext == ".mcap" ? kMaxConvertedBytes : kMaxServedBytes)) {
+            res.result(http::status::payload_too_large);
+            res.set(http::field::content_type, "text/plain; charset=utf-8");
+            res.body() = "this dive is too large to " + std::string(ext == ".mcap" ? "convert" : "send") +
+                         " here (" + std::to_string(found->size >> 20) + " MiB): copy " + found->name +
+                         " and run caracaractl export on it\n";
         } else if (!read_whole_file(found->path, bytes, error)) {
             not_found("cannot read the dive: " + error);
         } else if (ext == ".cdive") {

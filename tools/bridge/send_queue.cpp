@@ -2,8 +2,12 @@
 
 namespace caracara::bridge {
 
-void SendQueue::push(Frame f) {
-    if (f.droppable && messages_ >= max_messages_) {
+bool SendQueue::push(Frame f) {
+    if (!f.droppable) {
+        if (reply_bytes_ + f.bytes->size() > max_reply_bytes_)
+            return false;
+        reply_bytes_ += f.bytes->size();
+    } else if (messages_ >= max_messages_) {
         for (auto it = frames_.begin() + (writing_ ? 1 : 0); it != frames_.end(); ++it)
             if (it->droppable) {
                 frames_.erase(it);
@@ -14,6 +18,7 @@ void SendQueue::push(Frame f) {
     }
     messages_ += f.droppable ? 1 : 0;
     frames_.push_back(std::move(f));
+    return true;
 }
 
 const SendQueue::Frame& SendQueue::start_front() {
@@ -21,11 +26,24 @@ const SendQueue::Frame& SendQueue::start_front() {
     return frames_.front();
 }
 
+void SendQueue::forget(const Frame& f) {
+    if (f.droppable)
+        --messages_;
+    else
+        reply_bytes_ -= f.bytes->size();
+}
+
 void SendQueue::pop_front() {
     writing_ = false;
-    if (frames_.front().droppable)
-        --messages_;
+    forget(frames_.front());
     frames_.pop_front();
+}
+
+void SendQueue::clear_waiting() {
+    while (frames_.size() > (writing_ ? 1u : 0u)) {
+        forget(frames_.back());
+        frames_.pop_back();
+    }
 }
 
 } // namespace caracara::bridge

@@ -1,6 +1,7 @@
 #include "tools/bridge/session.hpp"
 
 #include "tools/bridge/dive_routes.hpp"
+#include "tools/bridge/dive_worker.hpp"
 #include "tools/bridge/static_files.hpp"
 
 #include "tools/foxglove/channels.hpp"
@@ -24,15 +25,24 @@ namespace {
 
 constexpr const char* kSubprotocol = "foxglove.websocket.v1";
 constexpr uint8_t kMessageData = 0x01;
+// From the connection to its request read (a stalled or silent connection goes then), and
+// from the request to an HTTP answer written (a reader that never reads goes then; a dive of
+// up to 32 MiB gets longer, for a slow tether).
+constexpr auto kRequestTimeout = std::chrono::seconds(3);
+constexpr auto kAnswerTimeout = std::chrono::seconds(60);
+constexpr auto kDiveAnswerTimeout = std::chrono::minutes(5);
+// A client being closed for what it did: its close frame gets this long to go out.
+constexpr auto kCloseTimeout = std::chrono::seconds(2);
 
-// The HTTP request's token: "Authorization: Bearer T" or "?token=T" (a browser's WebSocket
-// cannot set headers, so Foxglove's URL carries it).
+// The HTTP request's token: "Authorization: Bearer T" (the scheme in any case, RFC 7235 2.1)
+// or "?token=T" (a browser's WebSocket cannot set headers, so Foxglove's URL carries it).
 std::string_view view(beast::string_view s) { return {s.data(), s.size()}; }
 
 std::string token_of(const http::request<http::string_body>& req) {
+    constexpr std::string_view kScheme = "bearer ";
     const std::string_view auth = view(req[http::field::authorization]);
-    if (auth.starts_with("Bearer "))
-        return std::string(auth.substr(7));
+    if (auth.size() > kScheme.size() && boost::algorithm::iequals(auth.substr(0, kScheme.size()), kScheme))
+        return std::string(auth.substr(kScheme.size()));
     const std::string_view target = view(req.target());
     const auto q = target.find("token=");
     if (q == std::string_view::npos || (q > 0 && target[q - 1] != '?' && target[q - 1] != '&'))
@@ -94,21 +104,34 @@ std::string advertise() {
 
 } // namespace
 
-Session::Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry)
-    : io_(io), ws_(std::move(socket)), handshake_timer_(io), config_(config), telemetry_(telemetry),
-      protocol_(fg::channels().size()), queue_(config.max_queued) {}
+Session::Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry,
+                 ClientSlots& slots, DiveWorker& dives)
+    : io_(io), ws_(std::move(socket)), timer_(io), config_(config), telemetry_(telemetry), slots_(slots),
+      dives_(dives), protocol_(fg::channels().size()), queue_(config.max_queued, config.max_reply_bytes) {}
 
 void Session::start() {
-    handshake_timer_.expires_after(std::chrono::seconds(10));
-    handshake_timer_.async_wait([weak = weak_from_this()](boost::system::error_code ec) {
-        if (auto self = weak.lock(); self && !ec && !self->open_) {
-            boost::system::error_code ignored;
-            self->ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
-            self->ws_.next_layer().close(ignored);
-        }
-    });
+    close_after(kRequestTimeout);
     http::async_read(ws_.next_layer(), buffer_, request_,
                      [self = shared_from_this()](boost::system::error_code ec, std::size_t) { self->on_request(ec); });
+}
+
+void Session::close_after(std::chrono::steady_clock::duration d) {
+    timer_.expires_after(d);
+    timer_.async_wait([weak = weak_from_this()](boost::system::error_code ec) {
+        if (auto self = weak.lock(); self && !ec)
+            self->close_socket();
+    });
+}
+
+void Session::close_socket() {
+    boost::system::error_code ignored;
+    ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
+    ws_.next_layer().close(ignored);
+}
+
+void Session::drop() {
+    timer_.cancel();
+    close_socket();
 }
 
 void Session::reject(http::status status, std::string body) {
@@ -120,16 +143,19 @@ void Session::reject(http::status status, std::string body) {
     answer(std::move(res));
 }
 
-void Session::answer(std::shared_ptr<http::response<http::string_body>> res) {
-    http::async_write(ws_.next_layer(), *res, [self = shared_from_this(), res](boost::system::error_code, std::size_t) {
+void Session::answer(std::shared_ptr<http::response<http::string_body>> res, std::shared_ptr<void> ticket) {
+    close_after(ticket ? kDiveAnswerTimeout : kAnswerTimeout);
+    http::async_write(ws_.next_layer(), *res, [self = shared_from_this(), res, ticket](boost::system::error_code, std::size_t) {
         boost::system::error_code ignored;
         self->ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
     });
 }
 
 void Session::on_request(boost::system::error_code ec) {
+    got_request_ = true;
+    timer_.cancel();
     if (ec)
-        return; // not HTTP, or gone before the request
+        return close_socket(); // not HTTP, or gone before the request
     // A plain GET of the cockpit's files: the same for everyone, so without the token (the page
     // passes its own URL's token to its WebSocket and to /dives/; no vehicle data comes without it).
     const bool upgrade = websocket::is_upgrade(request_);
@@ -139,10 +165,24 @@ void Session::on_request(boost::system::error_code ec) {
             StaticFiles(config_.cockpit_dir).respond(request_)));
     if (!config_.token.empty() && !same(token_of(request_), config_.token))
         return reject(http::status::unauthorized, "caracara-bridge: a valid token is required");
-    if (!upgrade)
-        return answer(std::make_shared<http::response<http::string_body>>(DiveRoutes(config_.dives_dir).respond(request_)));
+    if (!upgrade) {
+        // Listing and converting take their time: on the worker, never on this (the I/O) thread.
+        close_after(kDiveAnswerTimeout);
+        const bool queued = dives_.submit(std::make_shared<const http::request<http::string_body>>(request_),
+                                          [self = shared_from_this()](StaticFiles::Response res, std::shared_ptr<void> ticket) {
+                                              self->answer(std::make_shared<http::response<http::string_body>>(std::move(res)),
+                                                           std::move(ticket));
+                                          });
+        if (!queued)
+            reject(http::status::service_unavailable, "caracara-bridge: too many dive requests in progress; try again");
+        return;
+    }
     if (!offers_subprotocol(request_))
         return reject(http::status::bad_request, std::string("caracara-bridge needs the subprotocol ") + kSubprotocol);
+    slot_ = slots_.claim();
+    if (!slot_)
+        return reject(http::status::service_unavailable,
+                      "caracara-bridge: " + std::to_string(slots_.max()) + " clients are connected already");
     try {
         link_ = std::make_unique<CommandLink>(
             io_, config_.bus,
@@ -159,6 +199,7 @@ void Session::on_request(boost::system::error_code ec) {
         res.set(http::field::server, "caracara-bridge");
     }));
     websocket::stream_base::timeout timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
+    timeouts.handshake_timeout = kRequestTimeout;
     timeouts.idle_timeout = std::chrono::seconds(10);
     timeouts.keep_alive_pings = true;
     ws_.set_option(timeouts);
@@ -170,7 +211,6 @@ void Session::on_accept(boost::system::error_code ec) {
     if (ec)
         return end("handshake failed");
     open_ = true;
-    handshake_timer_.cancel();
     send_text(server_info());
     send_text(advertise());
     read();
@@ -187,14 +227,19 @@ void Session::on_frame(boost::system::error_code ec) {
         return end("message too big");
     }
     if (ec)
-        return end("closed");
+        return end(nullptr);
     const auto data = buffer_.cdata();
     const auto* bytes = static_cast<const uint8_t*>(data.data());
     if (ws_.got_text())
         handle(protocol_.on_text({reinterpret_cast<const char*>(bytes), data.size()}));
     else
         handle(protocol_.on_binary({bytes, data.size()}));
-    if (!ended_)
+    if (ended_)
+        return;
+    // A client that sends and does not read its replies is read no further until it has.
+    if (queue_.reply_bytes() > config_.read_pause_bytes)
+        paused_ = true;
+    else
         read();
 }
 
@@ -234,7 +279,8 @@ void Session::send_text(std::string text) {
 }
 
 void Session::queue(Frame f) {
-    queue_.push(std::move(f));
+    if (!queue_.push(std::move(f)))
+        return end("its replies passed their bound (it sends and does not read)", true);
     if (!queue_.writing())
         write_next();
 }
@@ -247,21 +293,33 @@ void Session::write_next() {
     ws_.async_write(boost::asio::buffer(*f.bytes), [self = shared_from_this()](boost::system::error_code ec, std::size_t) {
         self->queue_.pop_front();
         if (ec)
-            return self->end("write failed");
+            return self->end("a write failed");
+        if (self->paused_ && !self->ended_ && self->queue_.reply_bytes() <= self->config_.read_pause_bytes) {
+            self->paused_ = false;
+            self->read();
+        }
         self->write_next();
     });
 }
 
-void Session::end(const char* why) {
+void Session::end(const char* why, bool tell_client) {
     if (ended_)
         return;
     ended_ = true;
-    (void)why;
     // The pilot's D-Bus connection goes now: caracarad zeroes what this client commanded.
     link_.reset();
-    handshake_timer_.cancel();
-    boost::system::error_code ignored;
-    ws_.next_layer().shutdown(Socket::shutdown_both, ignored);
+    if (why)
+        std::fprintf(stderr, "caracara-bridge: closing a client: %s\n", why);
+    if (!tell_client || !open_) {
+        timer_.cancel();
+        return close_socket();
+    }
+    // The close frame with the reason goes after the frame in flight, if the client reads it;
+    // if it does not, the socket is closed soon after anyway.
+    queue_.clear_waiting();
+    close_after(kCloseTimeout);
+    ws_.async_close(websocket::close_reason(websocket::close_code::policy_error, why),
+                    [self = shared_from_this()](boost::system::error_code) { self->close_socket(); });
 }
 
 } // namespace caracara::bridge

@@ -1,11 +1,13 @@
 #include "tools/caracaractl/bridge_forward.hpp"
 
 #include "tools/client/client.hpp"
+#include "tools/client/ssh_stderr.hpp"
 #include "tools/client/ssh_target.hpp"
 
 #include <arpa/inet.h>
 #include <cerrno>
 #include <charconv>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -101,6 +103,10 @@ int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vecto
     sigaddset(&mask, SIGCHLD);
     sigset_t old;
     sigprocmask(SIG_BLOCK, &mask, &old);
+    // ssh's words are copied through and kept: they tell a refused login (4) from a host not
+    // reached (3), as for every -H command (ssh exits 255 for both).
+    SshStderr ssh_stderr;
+    (void)ssh_stderr.capture(); // if it cannot, ssh writes to our stderr and a failure counts as 3
     const pid_t pid = ::fork();
     if (pid == 0) {
         sigprocmask(SIG_SETMASK, &old, nullptr);
@@ -112,6 +118,7 @@ int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vecto
         std::fprintf(stderr, "caracaractl: cannot run ssh: %s\n", std::strerror(errno));
         ::_exit(127);
     }
+    ssh_stderr.restore();
     if (pid < 0)
         throw Failure{kExitUnavailable, std::string("fork: ") + std::strerror(errno)};
 
@@ -119,6 +126,8 @@ int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vecto
     for (;;) {
         int status = 0;
         if (::waitpid(pid, &status, WNOHANG) == pid) {
+            if ((!announced || exit_of(status) != kExitOk) && SshStderr::refused(ssh_stderr.said(std::chrono::seconds(2))))
+                throw Failure{kExitDenied, "SSH refused the login to " + choice.address};
             if (!announced || exit_of(status) != kExitOk)
                 throw Failure{kExitUnavailable, "ssh to " + choice.address + " ended (status " +
                                                     std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : 255) +

@@ -1,0 +1,102 @@
+// caracara-bridge's bounds (issue 35), on a TCP bridge with its token whose dive directory is
+// full (test_bridge.py test_6 starts it): a Kill and a close are not held up by another
+// client's dive listing, and a client that sends without reading is paused, then closed with
+// the reason, with the bridge's memory bounded. Bounds from tests/e2e/bounds.py (passed in the
+// environment by test_bridge.py).
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import fs from "node:fs";
+import WebSocket from "ws";
+import { connect, poll, sleep } from "./lib.mjs";
+import { closesDuringListing, killsDuringListing } from "./listing_load.mjs";
+
+const URL = process.env.CARACARA_TCP_URL; // ws://127.0.0.1:PORT/?token=T
+const LIST_URL = URL.replace(/^ws:/, "http:").replace("/?", "/dives/?");
+const BRIDGE_PID = Number(process.env.CARACARA_BRIDGE_PID);
+const BRIDGE_LOG = process.env.CARACARA_BRIDGE_LOG;
+const KILL_MS_MAX = Number(process.env.CARACARA_KILL_OUTPUT_LISTING_MS_MAX);
+const ZERO_MS_MAX = Number(process.env.CARACARA_CLIENT_LOSS_ZERO_MS_MAX);
+const FRAME_MAX = 64 * 1024; // the bridge's largest client message (SessionConfig::max_message_bytes)
+
+const rssKib = () => Number(/VmRSS:\s+(\d+)/.exec(fs.readFileSync(`/proc/${BRIDGE_PID}/status`, "utf8"))[1]);
+
+test("a Kill published while another client lists a full dive directory reaches the kill output at once", async () => {
+  const r = await killsDuringListing(URL, LIST_URL, 200, 50); // p99 of 200: not one outlier's
+  console.log(`# ${JSON.stringify(r)}`);
+  assert.ok(r.dives >= 3000, `the directory lists ${r.dives} dives`);
+  assert.ok(r.kill_output_ms.p99 <= KILL_MS_MAX,
+            `Kill to the kill output p99 ${r.kill_output_ms.p99} ms during listings (bound ${KILL_MS_MAX} ms)`);
+});
+
+test("a client closed while another lists a full dive directory is zeroed within the client-loss bound", async () => {
+  const r = await closesDuringListing(URL, LIST_URL, 5);
+  console.log(`# ${JSON.stringify(r)}`);
+  assert.ok(r.close_to_zeros_ms.max <= ZERO_MS_MAX,
+            `zeroed ${r.close_to_zeros_ms.max} ms after the close (bound ${ZERO_MS_MAX} ms)`);
+});
+
+// A raw client (ws) that stops reading its socket once the bridge's greeting is in.
+async function deafClient() {
+  const ws = new WebSocket(URL, ["foxglove.websocket.v1"]);
+  const c = { ws, statuses: 0, closed: null };
+  ws.on("message", (data, binary) => { if (!binary && JSON.parse(data).op === "status") c.statuses += 1; });
+  ws.on("close", (code, reason) => { c.closed = { code, reason: reason.toString() }; });
+  let greeted = 0;
+  await new Promise((resolve, reject) => {
+    ws.on("message", (data, binary) => { if (!binary && ++greeted === 2) resolve(); }); // serverInfo, advertise
+    ws.on("error", reject);
+  });
+  ws._socket.pause(); // read nothing more: the bridge's writes back up
+  return c;
+}
+
+const unadvertise = (zeros, pad = 0) => {
+  const head = '{"op":"unadvertise","channelIds":[';
+  const tail = pad ? `],"pad":"${"x".repeat(pad)}"}` : "]}";
+  return head + "0,".repeat(zeros - 1) + "0" + tail;
+};
+
+test("a 64 KiB unadvertise of zeros from a client that never reads: closed with the reason, memory bounded", async () => {
+  const before = rssKib();
+  const c = await deafClient();
+  const zeros = Math.floor((FRAME_MAX - 40) / 2);
+  const flood = unadvertise(zeros);
+  assert.ok(flood.length <= FRAME_MAX);
+  for (let i = 0; i < 50; i++) c.ws.send(flood); // 3.2 MB, each frame ~32 k error replies (2.4 MB)
+  await poll(() => fs.readFileSync(BRIDGE_LOG, "utf8").includes("its replies passed their bound"), 10000,
+             "the bridge to log why it closes the client");
+  const grown = rssKib() - before;
+  console.log(`# the bridge's RSS: ${before} KiB before, +${grown} KiB with the flood`);
+  assert.ok(grown < 32 * 1024, `the bridge grew ${grown} KiB`);
+  c.ws._socket.resume();
+  await poll(() => c.closed, 10000, "the connection to close");
+  console.log(`# closed: ${JSON.stringify(c.closed)}`);
+  if (c.closed.code !== 1006) { // the close frame got out before the bridge's close timer
+    assert.equal(c.closed.code, 1008);
+    assert.match(c.closed.reason, /replies passed their bound/);
+  }
+  // The bridge serves on.
+  const other = await connect(URL);
+  await other.close();
+});
+
+test("a client that sends and does not read is read no further until it reads; no reply is lost", async () => {
+  const before = rssKib();
+  const c = await deafClient();
+  // Each frame: 1000 error replies (~75 KB, over the 64 KiB at which reading pauses, under the
+  // 256 KiB that closes), and 60 KB of padding: 24 MB, more than the socket buffers hold.
+  const frame = unadvertise(1000, 60000);
+  const frames = 400;
+  for (let i = 0; i < frames; i++) c.ws.send(frame);
+  await sleep(2000);
+  const buffered = c.ws.bufferedAmount;
+  const grown = rssKib() - before;
+  console.log(`# paused: ${buffered} bytes not taken by the bridge, its RSS +${grown} KiB`);
+  assert.ok(buffered > 0, "the bridge read on while its replies were not read");
+  assert.equal(c.closed, null, "closed, though its replies stayed within their bound");
+  assert.ok(grown < 32 * 1024, `the bridge grew ${grown} KiB`);
+  c.ws._socket.resume();
+  await poll(() => c.statuses === frames * 1000, 60000, "every reply");
+  assert.equal(c.ws.bufferedAmount, 0);
+  c.ws.close();
+});
