@@ -116,10 +116,14 @@ async function orderAfter(since, speed, t0) {
 }
 
 async function cockpit() {
-  const { launch, openCockpit, surge } = await import("../tests/bridge/chromium.mjs");
+  const { armPad, launch, openCockpit, surge } = await import("../tests/bridge/chromium.mjs");
   const chromium = await launch();
   try {
     const { page } = await openCockpit(chromium.browser, process.env.CARACARA_HTTP_URL);
+    // Armed on purpose (deadman released with the sticks centred, then pressed), then released:
+    // a release does not disarm, so each sample below is a press with the stick out.
+    await armPad(page);
+    await page.evaluate(() => { window.__pad.buttons[4] = { pressed: false, touched: false, value: 0 }; });
     let best = null;
     for (let i = 0; i < 30; i++) {
       const t1 = process.hrtime.bigint();

@@ -349,6 +349,7 @@ class BridgeTest(BridgeRig, unittest.TestCase):
         self.node("bounds.test.mjs", CARACARA_TCP_URL="ws://127.0.0.1:%d/?token=%s" % (port, token),
                   CARACARA_BRIDGE_PID=str(p.pid), CARACARA_BRIDGE_LOG=log_path,
                   CARACARA_KILL_OUTPUT_LISTING_MS_MAX=str(bounds.BRIDGE_KILL_OUTPUT_DURING_LISTING_MS_MAX),
+                  CARACARA_KILL_HELD_BY_LISTING_MS=str(bounds.BRIDGE_KILL_HELD_BY_LISTING_MS),
                   CARACARA_CLIENT_LOSS_ZERO_MS_MAX=str(bounds.CLIENT_LOSS_ZERO_MS_MAX))
         self.assertIsNone(p.poll(), "the bridge survived")
 

@@ -12,8 +12,8 @@
 namespace caracara::bridge {
 
 namespace fg = caracara::foxglove;
-using caracaractl::Props;
-using caracaractl::Value;
+using client::Props;
+using client::Value;
 using fg::ChannelKind;
 
 namespace {
@@ -113,7 +113,7 @@ bool Telemetry::connect() {
     watch_.reset();
     slots_.clear();
     controller_slot_.reset();
-    client_ = std::make_unique<caracaractl::Client>(choice_);
+    client_ = std::make_unique<client::Client>(choice_);
     try {
         sd_bus* bus = client_->bus();
         // Subscribe before loading, so no change falls between the two.
@@ -139,7 +139,7 @@ bool Telemetry::connect() {
             return false;
         slots_.emplace_back(slot);
         objects_ = client_->get_objects();
-    } catch (const caracaractl::Failure& f) {
+    } catch (const client::Failure& f) {
         std::fprintf(stderr, "caracara-bridge: caracarad not reachable (%s); retrying\n", f.message.c_str());
         slots_.clear();
         return false;
@@ -173,9 +173,9 @@ int Telemetry::on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_e
         const char* iface = nullptr;
         if (sd_bus_message_read(m, "s", &iface) < 0 || !iface)
             return 0;
-        const Props changed = caracaractl::to_props(caracaractl::read_value(m));
+        const Props changed = client::to_props(client::read_value(m));
         self->changed(sd_bus_message_get_path(m) ? sd_bus_message_get_path(m) : "", iface, changed);
-    } catch (const caracaractl::Failure&) {
+    } catch (const client::Failure&) {
         // A malformed signal changes nothing.
     }
     return 0;
@@ -227,7 +227,7 @@ void Telemetry::reload() {
         return; // reconnecting: connect() loads the objects
     try {
         objects_ = client_->get_objects();
-    } catch (const caracaractl::Failure& f) {
+    } catch (const client::Failure& f) {
         std::fprintf(stderr, "caracara-bridge: reloading caracarad's objects failed (%s)\n", f.message.c_str());
         return;
     }

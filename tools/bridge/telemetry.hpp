@@ -40,28 +40,28 @@ private:
     static int on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
     static int on_controller_pid(sd_bus_message* m, void* userdata, sd_bus_error* error);
     // When a surface failsafe's ascent began (surfacing_ms in the state), from the root's properties.
-    void follow_surfacing(const caracaractl::Props& root);
+    void follow_surfacing(const client::Props& root);
     // The controller in words: its process, asked of the bus daemon (controller_name in the state).
     void name_controller(const std::string& unique_name);
     void reload();
     void loaded(); // after the objects were (re)loaded
     bool connect();
     void retry();
-    void changed(const std::string& path, const std::string& iface, const caracaractl::Props& props);
+    void changed(const std::string& path, const std::string& iface, const client::Props& props);
     void mark(std::size_t channel);
     void flush();
     void build(std::size_t channel, uint64_t now);
     void log(int level, const std::string& name, const std::string& message);
-    const caracaractl::Props& props(const std::string& path, const char* iface) const;
+    const client::Props& props(const std::string& path, const char* iface) const;
 
     boost::asio::io_context& io_;
     caracara::dbus::BusChoice choice_;
     Publish publish_;
-    std::unique_ptr<caracaractl::Client> client_;
+    std::unique_ptr<client::Client> client_;
     std::vector<caracara::dbus::SlotPtr> slots_;
     std::unique_ptr<BusWatch> watch_;
     boost::asio::steady_timer retry_;
-    caracaractl::Objects objects_;
+    client::Objects objects_;
     std::set<std::size_t> dirty_;
     bool flush_posted_ = false;
     std::vector<Payload> latest_;

@@ -17,7 +17,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-namespace caracaractl {
+namespace caracara::ctl {
+
+using namespace caracara::client; // the vehicle's D-Bus client (tools/client)
 
 namespace {
 
@@ -153,4 +155,4 @@ int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vecto
     }
 }
 
-} // namespace caracaractl
+} // namespace caracara::ctl

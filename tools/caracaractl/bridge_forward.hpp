@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-namespace caracaractl {
+namespace caracara::ctl {
 
 int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vector<std::string>& args);
 const char* bridge_forward_help();
 
-} // namespace caracaractl
+} // namespace caracara::ctl

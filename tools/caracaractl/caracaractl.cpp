@@ -20,7 +20,8 @@
 #include <unistd.h>
 #include <vector>
 
-using namespace caracaractl;
+using namespace caracara::client;
+using namespace caracara::ctl;
 
 namespace {
 

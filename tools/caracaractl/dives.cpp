@@ -21,7 +21,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-namespace caracaractl {
+namespace caracara::ctl {
+
+using namespace caracara::client; // the vehicle's D-Bus client (tools/client)
 
 namespace dive = caracara::dive;
 
@@ -349,4 +351,4 @@ const char* dive_help() {
            "  (status 1, the problem and its byte offset named); --partial uses what came before it.\n";
 }
 
-} // namespace caracaractl
+} // namespace caracara::ctl

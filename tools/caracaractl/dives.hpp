@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace caracaractl {
+namespace caracara::ctl {
 
 // True for "dives", "export" and "plot".
 bool is_dive_command(const std::string& name);
@@ -15,4 +15,4 @@ int run_dive_command(const std::string& name, const std::vector<std::string>& ar
 // Their part of --help.
 const char* dive_help();
 
-} // namespace caracaractl
+} // namespace caracara::ctl

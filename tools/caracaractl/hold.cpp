@@ -10,7 +10,9 @@
 #include <optional>
 #include <unistd.h>
 
-namespace caracaractl {
+namespace caracara::ctl {
+
+using namespace caracara::client; // the vehicle's D-Bus client (tools/client)
 
 namespace {
 
@@ -203,4 +205,4 @@ int hold_command(Client& client, const char* member, const Client::Appender& app
     return kExitOk;
 }
 
-} // namespace caracaractl
+} // namespace caracara::ctl

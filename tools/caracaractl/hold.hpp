@@ -8,7 +8,9 @@
 #include <cstdint>
 #include <string>
 
-namespace caracaractl {
+namespace caracara::ctl {
+
+using namespace caracara::client; // the vehicle's D-Bus client (tools/client)
 
 // How long to hold: send once and leave (once), hold until SIGINT/SIGTERM (duration_usec 0),
 // or hold for duration_usec.
@@ -32,4 +34,4 @@ int hold_command(Client& client, const char* member, const Client::Appender& app
 // "3.0 s", "0.25 s", "90.0 s".
 std::string format_seconds(uint64_t usec);
 
-} // namespace caracaractl
+} // namespace caracara::ctl

@@ -8,7 +8,9 @@
 #include <map>
 #include <string>
 
-namespace caracaractl {
+namespace caracara::ctl {
+
+using namespace caracara::client; // the vehicle's D-Bus client (tools/client)
 
 namespace {
 
@@ -192,4 +194,4 @@ int run_monitor(Client& client, bool all) {
     return r;
 }
 
-} // namespace caracaractl
+} // namespace caracara::ctl

@@ -5,7 +5,9 @@
 
 #include <string_view>
 
-namespace caracaractl {
+namespace caracara::ctl {
+
+using namespace caracara::client; // the vehicle's D-Bus client (tools/client)
 
 // Prints the current state, then one timestamped line per change until SIGINT/SIGTERM (returns
 // 0) or caracarad leaves the bus (returns 1); throws Failure when it cannot start. Unless `all`,
@@ -16,4 +18,4 @@ int run_monitor(Client& client, bool all);
 // The monotonic counters the daemon republishes at the telemetry rate (Cycles, OrdersSent, ...).
 bool is_fast_counter(std::string_view iface, std::string_view property);
 
-} // namespace caracaractl
+} // namespace caracara::ctl

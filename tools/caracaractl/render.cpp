@@ -7,7 +7,9 @@
 #include <numbers>
 #include <vector>
 
-namespace caracaractl {
+namespace caracara::ctl {
+
+using namespace caracara::client; // the vehicle's D-Bus client (tools/client)
 
 namespace {
 
@@ -267,4 +269,4 @@ std::string summary_line(const Objects& objects) {
     return line;
 }
 
-} // namespace caracaractl
+} // namespace caracara::ctl

@@ -7,7 +7,9 @@
 #include <string>
 #include <string_view>
 
-namespace caracaractl {
+namespace caracara::ctl {
+
+using namespace caracara::client; // the vehicle's D-Bus client (tools/client)
 
 // printf into a std::string.
 std::string strf(const char* format, ...) __attribute__((format(printf, 1, 2)));
@@ -27,4 +29,4 @@ void print_status(std::ostream& out, const Objects& objects);
 // The monitor's first line: the key state of every object, after the timestamp.
 std::string summary_line(const Objects& objects);
 
-} // namespace caracaractl
+} // namespace caracara::ctl

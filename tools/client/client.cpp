@@ -4,7 +4,7 @@
 #include <csignal>
 #include <cstring>
 
-namespace caracaractl {
+namespace caracara::client {
 
 namespace {
 
@@ -239,4 +239,4 @@ Objects Client::get_objects() {
     return objects;
 }
 
-} // namespace caracaractl
+} // namespace caracara::client

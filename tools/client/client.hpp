@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-namespace caracaractl {
+namespace caracara::client {
 
 using caracara::dbus::kBusIface;
 using caracara::dbus::kBusPath;
@@ -117,4 +117,4 @@ Client::Appender append_args(const char* signature, A... args) {
     return [=](sd_bus_message* m) { return sd_bus_message_append(m, signature, args...); };
 }
 
-} // namespace caracaractl
+} // namespace caracara::client

@@ -9,7 +9,7 @@
 #include <thread>
 #include <unistd.h>
 
-namespace caracaractl {
+namespace caracara::client {
 
 // The copying thread's state. It blocks in read() until ssh and everything it started have
 // closed the pipe; a thread still blocked when caracaractl exits simply ends with it.
@@ -110,4 +110,4 @@ bool SshStderr::refused(const std::string& said) {
     return false;
 }
 
-} // namespace caracaractl
+} // namespace caracara::client

@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-namespace caracaractl {
+namespace caracara::client {
 
 class SshStderr {
 public:
@@ -37,4 +37,4 @@ private:
     int pipe_write_ = -1;
 };
 
-} // namespace caracaractl
+} // namespace caracara::client

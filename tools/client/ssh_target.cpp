@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
-namespace caracaractl {
+namespace caracara::client {
 
 namespace {
 
@@ -58,4 +58,4 @@ std::optional<SshTarget> parse_ssh_target(std::string_view value) {
     return t;
 }
 
-} // namespace caracaractl
+} // namespace caracara::client

@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-namespace caracaractl {
+namespace caracara::client {
 
 struct SshTarget {
     std::string user;   // "" when not given
@@ -20,4 +20,4 @@ struct SshTarget {
 
 std::optional<SshTarget> parse_ssh_target(std::string_view value);
 
-} // namespace caracaractl
+} // namespace caracara::client
