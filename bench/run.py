@@ -242,6 +242,25 @@ def callgrind_total(path):
     return total
 
 
+def callgrind_calls(path, names):
+    """How many times each function in `names` was called (the 'calls=' lines of the file; the
+    file names a function once in full, then by its number)."""
+    ids, counts, callee = {}, {n: 0 for n in names}, None
+    with open(path) as f:
+        for line in f:
+            m = re.match(r"c?fn=\((\d+)\)(?: (.*))?$", line.rstrip("\n"))
+            if m:
+                if m.group(2):
+                    ids[m.group(1)] = m.group(2)
+                callee = ids.get(m.group(1)) if line.startswith("cfn=") else None
+            elif line.startswith("calls=") and callee in counts:
+                counts[callee] += int(line.split()[0][6:])
+    return counts
+
+
+ALLOCATORS = ("malloc", "calloc", "realloc", "operator new(unsigned long)")
+
+
 def callgrind_inclusive(path, patterns):
     """Inclusive Ir of the functions whose names match `patterns` (callgrind_annotate)."""
     r = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100", path], capture_output=True,
@@ -514,39 +533,42 @@ def stress_argv():
 
 def phase_loaded(b, p, res):
     """The wire and kill phases and the kill floor with every core loaded by stress-ng at the normal
-    policy (as vision would load them), beside the same phases quiet in the same run."""
+    policy (as vision would load them), beside the same phases without the load, in the same run
+    and at the same priorities (LOADED_PRIORITIES): the load is the only difference."""
     if not shutil.which("stress-ng"):
         raise RuntimeError("stress-ng is not installed (scripts/deps.sh)")
-    # Quiet first, unless this run measured them already.
-    for name, fn in (("wire", phase_wire), ("faults", phase_faults), ("kill_floor", phase_kill_floor)):
-        if name not in res:
-            fn(b, p, res)
-    argv = stress_argv()
-    log(f"9. the same, loaded: {' '.join(argv)}")
-    stress = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                              start_new_session=True)
-    sub = {}
+    phases = (phase_wire, phase_faults, phase_kill_floor)
+    out = {"stress": stress_argv(), "priorities": dict(LOADED_PRIORITIES, **{"dbus-daemon": DBUS_DAEMON_PRIORITY})}
     subprocess.run(["chrt", "-a", "-f", "-p", str(DBUS_DAEMON_PRIORITY), str(b.dbusd.pid)], check=True)
     b.loaded = LOADED_PRIORITIES
+    stress = None
     try:
+        log("9. wire, kill and the kill floor without stress-ng, at the loaded phase's priorities")
+        out["quiet"] = {}
+        for fn in phases:
+            fn(b, p, out["quiet"])
+        log(f"9. the same, loaded: {' '.join(out['stress'])}")
+        stress = subprocess.Popen(out["stress"], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                  stderr=subprocess.DEVNULL, start_new_session=True)
         time.sleep(2)  # every stressor running
         if stress.poll() is not None:
             raise RuntimeError(f"stress-ng ended at once (status {stress.returncode})")
-        for fn in (phase_wire, phase_faults, phase_kill_floor):
-            fn(b, p, sub)
+        out["loaded"] = {}
+        for fn in phases:
+            fn(b, p, out["loaded"])
     finally:
         b.loaded = None
         subprocess.run(["chrt", "-a", "-o", "-p", "0", str(b.dbusd.pid)], check=False)
-        os.killpg(stress.pid, signal.SIGTERM)
-        try:
-            stress.wait(20)
-        except subprocess.TimeoutExpired:
-            os.killpg(stress.pid, signal.SIGKILL)
-            stress.wait()
-    sub.pop("kill_switch_available", None)
-    sub["stress"] = argv
-    sub["priorities"] = dict(LOADED_PRIORITIES, **{"dbus-daemon": DBUS_DAEMON_PRIORITY})
-    res["loaded"] = sub
+        if stress is not None:
+            os.killpg(stress.pid, signal.SIGTERM)
+            try:
+                stress.wait(20)
+            except subprocess.TimeoutExpired:
+                os.killpg(stress.pid, signal.SIGKILL)
+                stress.wait()
+    for half in ("quiet", "loaded"):
+        out[half].pop("kill_switch_available", None)
+    res["loaded"] = out
 
 
 def phase_loop(b, p, res):
@@ -645,7 +667,10 @@ def phase_cost(b, p, res):
         ticks = max(1, win["cycles"])
         return {"window_cycles": win["cycles"], "window_seconds": win["seconds"], "ir": ir,
                 "ir_per_tick": ir / ticks,
-                "inclusive_per_tick": {k: v / ticks for k, v in callgrind_inclusive(dump, CG_FUNCTIONS).items()}}
+                "inclusive_per_tick": {k: v / ticks for k, v in callgrind_inclusive(dump, CG_FUNCTIONS).items()},
+                # Allocations on the loop and the workers: the hot path's page faults and
+                # allocator time start here (docs/realtime.md).
+                "allocations_per_tick": {k: v / ticks for k, v in callgrind_calls(dump, ALLOCATORS).items()}}
 
     cg = cost["callgrind"] = {"stream_hz": p["stream_hz"]}
     cg["idle"] = window("idle")
@@ -832,6 +857,11 @@ def rows_from(res, p):
                 v = cg[key]["ir_per_tick"]
                 row(f"5. instructions per tick, 50 Hz, {label}", v, c["floor_ir_per_cycle"],
                     v / c["floor_ir_per_cycle"], f"<= {goal}", v <= goal, "Ir")
+        for key, label in (("idle", "no commands"), ("stream", f"{cg.get('stream_hz', 20)} Hz SetThrust stream")):
+            al = (cg.get(key) or {}).get("allocations_per_tick")
+            if al is not None:
+                row(f"5. allocations per tick (malloc, calloc, realloc, new), 50 Hz, {label}", sum(al.values()), None,
+                    None, "info", None, "")
         for key, fkey, label in (("cpu_idle", "floor_cpu_idle", "no commands"),
                                  ("cpu_stream", "floor_cpu_stream", f"{cg.get('stream_hz', 20)} Hz stream")):
             if c.get(key):
@@ -893,55 +923,41 @@ STATUS_READ_US = 740
 
 
 def loaded_rows(res, row):
-    """Row 9: the loaded phase beside the quiet phases of the same run."""
+    """Row 9: the loaded phase beside its quiet half (same run, same priorities)."""
     ld = res.get("loaded")
-    if not ld:
+    if not ld or "loaded" not in ld:
         return
+    qt, lo = ld["quiet"], ld["loaded"]
     for key, label in (("healthy", "healthy bus"), ("hung", "a thruster hung"), ("teensy_hung", "the Teensy hung")):
         for src, name in (("dbus", "Kill()"), ("switch", "kill switch edge")):
-            lk = ((ld.get("faults") or {}).get(key) or {}).get(src)
-            qk = ((res.get("faults") or {}).get(key) or {}).get(src)
+            lk = ((lo.get("faults") or {}).get(key) or {}).get(src)
+            qk = ((qt.get("faults") or {}).get(key) or {}).get(src)
             if not lk or not qk:
                 continue
             v, q = lk["kill_output_us"]["p99"], qk["kill_output_us"]["p99"]
-            row(f"9. loaded: {name} to kill output p99, {label} ({lk['missing']} missing), vs quiet", v, q, v / q,
+            row(f"9. {name} to kill output p99, {label}: loaded ({lk['missing']} missing) vs quiet", v, q, v / q,
                 "<= 1.5x quiet", v <= 1.5 * q and lk["missing"] == 0, "us")
-    lf = (ld.get("kill_floor") or {}).get("kill_output_us")
-    sw = (((ld.get("faults") or {}).get("healthy") or {}).get("switch") or {}).get("kill_output_us")
-    if lf:
-        row("9. loaded: kill switch floor program p99", lf["p99"], None, None, "info", None, "us")
-        if sw:
-            row("9. loaded: kill switch edge to kill output p99, healthy, vs the floor program", sw["p99"], lf["p99"],
-                sw["p99"] / lf["p99"], "<= 1.5x floor", sw["p99"] <= 1.5 * lf["p99"], "us")
-    for rate in ("50", "0"):
-        w = (ld.get("wire") or {}).get(rate)
-        if not w or "seam" not in w:
-            continue
-        label = "50 Hz" if rate == "50" else "rate 0"
-        seam = w["seam"]["burst_us"]["p99"]
-        row(f"9. loaded: seam floor p99 (8 orders), {label}", seam, None, None, "info", None, "us")
-        c = w["cmd"]["last_us"]["p99"]
-        row(f"9. loaded: command to wire p99, {label}", c, seam, c / seam, "<= seam p99 + 0.5 ms", c <= seam + 500,
-            "us")
-        for src, name in (("kill_dbus", "Kill()"), ("kill_switch", "kill switch edge")):
-            k = w.get(src)
-            if k:
-                v = k["all_zero_us"]["p99"]
-                row(f"9. loaded: {name} to last zero on the wire p99, {label}", v, seam, v / seam,
-                    "<= seam p99 + 740 us", v <= seam + STATUS_READ_US, "us")
-    # The same judgement quiet, against the quiet seam floor of the same run.
-    for rate in ("50", "0"):
-        w = (res.get("wire") or {}).get(rate)
-        if not w or "seam" not in w:
-            continue
-        label = "50 Hz" if rate == "50" else "rate 0"
-        seam = w["seam"]["burst_us"]["p99"]
-        for src, name in (("kill_dbus", "Kill()"), ("kill_switch", "kill switch edge")):
-            k = w.get(src)
-            if k:
-                v = k["all_zero_us"]["p99"]
-                row(f"9. quiet: {name} to last zero on the wire p99, {label}", v, seam, v / seam,
-                    "<= seam p99 + 740 us", v <= seam + STATUS_READ_US, "us")
+    for half, h in (("quiet", qt), ("loaded", lo)):
+        fl = (h.get("kill_floor") or {}).get("kill_output_us")
+        sw = (((h.get("faults") or {}).get("healthy") or {}).get("switch") or {}).get("kill_output_us")
+        if fl and sw:
+            row(f"9. {half}: kill switch edge to kill output p99, healthy, vs the floor program", sw["p99"],
+                fl["p99"], sw["p99"] / fl["p99"], "<= 1.5x floor", sw["p99"] <= 1.5 * fl["p99"], "us")
+        for rate in ("50", "0"):
+            w = (h.get("wire") or {}).get(rate)
+            if not w or "seam" not in w:
+                continue
+            label = "50 Hz" if rate == "50" else "rate 0"
+            seam = w["seam"]["burst_us"]["p99"]
+            c = w["cmd"]["last_us"]["p99"]
+            row(f"9. {half}: command to wire p99, {label}, vs seam floor p99", c, seam, c / seam,
+                "<= seam p99 + 0.5 ms", c <= seam + 500, "us")
+            for src, name in (("kill_dbus", "Kill()"), ("kill_switch", "kill switch edge")):
+                k = w.get(src)
+                if k:
+                    v = k["all_zero_us"]["p99"]
+                    row(f"9. {half}: {name} to last zero on the wire p99, {label}, vs seam floor p99", v, seam,
+                        v / seam, "<= seam p99 + 740 us", v <= seam + STATUS_READ_US, "us")
 
 
 def strip_raw(obj):
@@ -994,7 +1010,7 @@ def main():
     ap.add_argument("--rss-seconds", type=float, default=None, help="length of the RSS run (default 600, quick 20)")
     ap.add_argument("--only", default="dbus,wire,faults,kill_floor,loop,cost,ssh,bridge,loaded",
                     help="comma-separated phases: dbus,wire,faults,kill_floor,loop,cost,ssh,bridge,loaded "
-                         "(loaded: wire, faults and kill_floor again under stress-ng, beside the quiet ones)")
+                         "(loaded: wire, faults and kill_floor without and with stress-ng, at the same priorities)")
     ap.add_argument("--keep", action="store_true", help="keep the temporary directory (logs, callgrind files)")
     ap.add_argument("--raw", action="store_true", help="keep every latency sample in the JSON (large)")
     ap.add_argument("--rt", action="store_true",
