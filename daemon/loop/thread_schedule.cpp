@@ -25,6 +25,8 @@ namespace {
 
 const char* policy_name(SchedPolicy p) { return p == SchedPolicy::Fifo ? "SCHED_FIFO" : "SCHED_RR"; }
 
+constexpr std::size_t kThreadStackBytes = 512 * 1024;
+
 // Whether the process may lock more than RLIMIT_MEMLOCK (CAP_IPC_LOCK, bit 14 of CapEff).
 bool may_lock_any_amount() {
     std::ifstream f("/proc/self/status");
@@ -87,6 +89,16 @@ std::string ThreadSchedule::lock_memory() {
     if (rl.rlim_cur != RLIM_INFINITY && !may_lock_any_amount())
         return "RLIMIT_MEMLOCK is " + std::to_string(rl.rlim_cur / 1024) +
                " kB, not unlimited (caracarad.service's LimitMEMLOCK=infinity): past it every allocation would fail";
+    // Locked memory is resident memory: the threads made from now on get 512 KiB stacks instead
+    // of RLIMIT_STACK's 8 MiB, and every thread allocates from the one main heap instead of an
+    // arena of its own (64 MiB of address space each, locked as it is used).
+    pthread_attr_t attr;
+    if (pthread_attr_init(&attr) == 0) {
+        pthread_attr_setstacksize(&attr, kThreadStackBytes);
+        pthread_setattr_default_np(&attr);
+        pthread_attr_destroy(&attr);
+    }
+    mallopt(M_ARENA_MAX, 1);
     if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
         return std::string("mlockall: ") + errno_name(errno);
     // Freed heap stays mapped (and locked) rather than being given back and faulted in again.
