@@ -6,7 +6,7 @@
 //   caracara-bench rtt        --bus ADDR [--calls N] [--warmup N] [--settle-us US]
 //   caracara-bench cmd2wire   --bus ADDR [--samples N] [--phase-ms MS] [--seed S]
 //   caracara-bench kill2wire  --bus ADDR [--samples N] [--source dbus|switch] [--phase-ms MS]
-//   caracara-bench kill2output --bus ADDR [--samples N] [--source dbus|switch] [--phase-ms MS]
+//   caracara-bench kill2output --bus ADDR [--samples N] [--source dbus|switch] [--phase-ms MS] [--floor 1]
 //   caracara-bench cycles     --bus ADDR --seconds S
 //   caracara-bench stream     --bus ADDR --hz H --seconds S
 //   caracara-bench wait-ready --bus ADDR [--timeout-ms MS]   (arms a daemon that started killed)
@@ -230,6 +230,7 @@ struct Args {
     double settle_us = 2000;
     uint64_t seed = 1;
     std::string source = "dbus";
+    bool floor = false; // kill2output --source switch against caracara-bench-floor --kill-seconds
 };
 
 Args parse(int argc, char** argv) {
@@ -257,6 +258,7 @@ Args parse(int argc, char** argv) {
         else if (k == "--settle-us") a.settle_us = std::strtod(v, nullptr);
         else if (k == "--seed") a.seed = std::strtoull(v, nullptr, 10);
         else if (k == "--source") a.source = v;
+        else if (k == "--floor") a.floor = std::strtol(v, nullptr, 10) != 0;
         else {
             std::fprintf(stderr, "caracara-bench: unknown option %s\n", k.c_str());
             std::exit(2);
@@ -718,13 +720,18 @@ int cmd_kill2output(const Args& a) {
     for (long s = 0; s < a.samples; ++s) {
         if (by_switch)
             c.set_kill_switch(false);
-        if (c.state() == "killed")
-            c.vehicle_call("ClearKill");
-        if (!c.wait_ready(5'000'000'000ull)) {
-            std::fprintf(stderr, "caracara-bench: the vehicle does not become ready again\n");
-            return 1;
+        if (a.floor) {
+            // No vehicle: the floor program only follows the switch with the output.
+            sleep_ns(2'000'000);
+        } else {
+            if (c.state() == "killed")
+                c.vehicle_call("ClearKill");
+            if (!c.wait_ready(5'000'000'000ull)) {
+                std::fprintf(stderr, "caracara-bench: the vehicle does not become ready again\n");
+                return 1;
+            }
+            c.set_thrust((s % 2 == 0) ? kSetA : kSetB);
         }
-        c.set_thrust((s % 2 == 0) ? kSetA : kSetB);
         sleep_ns(static_cast<uint64_t>(rng.below(static_cast<uint64_t>(a.phase_ms * 1e6))));
         const uint64_t since = c.wire_next();
         const uint64_t t0 = mono_ns();

@@ -7,11 +7,18 @@
 //   caracara-bench-floor --socket PATH [--config FILE] --seconds S [--rate HZ [--burst-hz HZ]]
 //   caracara-bench-floor --socket PATH [--config FILE] --cycles N          (for callgrind)
 //   caracara-bench-floor --socket PATH [--config FILE] --burst N           (8 orders back to back)
+//   caracara-bench-floor --socket PATH --config FILE --kill-seconds S      (kill switch -> output)
+//
+// --kill-seconds: the floor of the kill switch's path: the kill switch edge read and the kill
+// output written through the same GPIO seam to the same simulator, nothing else, for S seconds
+// (caracara-bench kill2output --floor 1 times it). Prints "ready" once both lines are held.
 //
 // Prints one JSON object: cycles, seconds, rate_hz, cpu_s (CLOCK_PROCESS_CPUTIME_ID).
 #include "bench/bench_common.hpp"
 #include "core/config.hpp"
+#include "drivers/platform/hardware.hpp"
 #include "drivers/platform/i2c_dev.hpp"
+#include "drivers/platform/line_spec.hpp"
 #include "drivers/platform/sim/sim_device_io.hpp"
 #include "drivers/platform/spi_dev.hpp"
 #include "drivers/devices/teensy_link.hpp"
@@ -19,6 +26,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <poll.h>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,11 +55,49 @@ uint64_t cpu_ns() {
     return static_cast<uint64_t>(ts.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(ts.tv_nsec);
 }
 
+// The kill switch's floor: edge -> read -> kill output, as KillSwitch and SafetyLines do it.
+int kill_floor(const std::string& socket_path, const DaemonConfig& cfg, double seconds) {
+    if (!cfg.gpio.kill_switch || !cfg.gpio.kill_output) {
+        std::fprintf(stderr, "caracara-bench-floor: --kill-seconds needs gpio.kill_switch and gpio.kill_output\n");
+        return 2;
+    }
+    Hardware hw;
+    std::string err;
+    if (!make_hardware("sim:" + socket_path, hw, err)) {
+        std::fprintf(stderr, "caracara-bench-floor: %s\n", err.c_str());
+        return 1;
+    }
+    auto in = hw.gpio->request(line_spec(*cfg.gpio.kill_switch), GpioMode::InputEdges, 0, err);
+    auto out = in ? hw.gpio->request(line_spec(*cfg.gpio.kill_output), GpioMode::Output, 0, err) : nullptr;
+    if (!in || !out || in->event_fd() < 0) {
+        std::fprintf(stderr, "caracara-bench-floor: kill lines: %s\n", err.c_str());
+        return 1;
+    }
+    std::printf("ready\n");
+    std::fflush(stdout);
+    long edges = 0;
+    const uint64_t c0 = cpu_ns();
+    const uint64_t end = mono_ns() + static_cast<uint64_t>(seconds * 1e9);
+    for (uint64_t now = mono_ns(); now < end; now = mono_ns()) {
+        pollfd p{in->event_fd(), POLLIN, 0};
+        if (poll(&p, 1, static_cast<int>((end - now) / 1'000'000) + 1) <= 0)
+            continue;
+        if (in->drain_events() < 0)
+            return 1;
+        const int v = in->get();
+        if (v < 0 || out->set(v) < 0)
+            return 1;
+        ++edges;
+    }
+    std::printf("{\"edges\": %ld, \"cpu_s\": %.6f}\n", edges, static_cast<double>(cpu_ns() - c0) / 1e9);
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
     std::string socket_path, config_path;
-    double seconds = 0, rate = 0, burst_hz = 0;
+    double seconds = 0, rate = 0, burst_hz = 0, kill_seconds = 0;
     long cycles_wanted = 0, burst = 0;
     for (int i = 1; i < argc; ++i) {
         std::string k = argv[i];
@@ -67,6 +113,7 @@ int main(int argc, char** argv) {
         else if (k == "--cycles") cycles_wanted = std::strtol(v, nullptr, 10);
         else if (k == "--burst") burst = std::strtol(v, nullptr, 10);
         else if (k == "--burst-hz") burst_hz = std::strtod(v, nullptr);
+        else if (k == "--kill-seconds") kill_seconds = std::strtod(v, nullptr);
         else {
             std::fprintf(stderr, "caracara-bench-floor: unknown option %s\n", k.c_str());
             return 2;
@@ -78,6 +125,8 @@ int main(int argc, char** argv) {
         return 1;
     }
     const DaemonConfig& cfg = *cr.config;
+    if (kill_seconds > 0)
+        return kill_floor(socket_path, cfg, kill_seconds);
     SimDeviceIo io;
     if (int r = io.connect(socket_path); r < 0) {
         std::fprintf(stderr, "caracara-bench-floor: cannot connect to %s\n", socket_path.c_str());

@@ -14,6 +14,8 @@
 #include <initializer_list>
 #include <sstream>
 #include <toml++/toml.h>
+#include <type_traits>
+#include <utility>
 
 namespace caracara {
 
@@ -46,6 +48,23 @@ SafetyConfig safety_config(const DaemonConfig& config) {
 }
 
 namespace {
+
+// One of an enum's names (core/enum_names.hpp): "must be \"a\" or \"b\", got \"c\"" otherwise.
+template <typename E>
+void choice(Checker& c, const toml::table& t, const std::string& p, std::string_view key, E& out) {
+    std::string v;
+    if (!c.string(t, p, key, v))
+        return;
+    if (const std::optional<E> parsed = parse_name<E>(v)) {
+        out = *parsed;
+        return;
+    }
+    std::string names;
+    const auto& table = EnumNames<E>::table;
+    for (std::size_t i = 0; i < table.size(); ++i)
+        names += (i == 0 ? "\"" : i + 1 == table.size() ? " or \"" : ", \"") + std::string(table[i].name) + "\"";
+    c.fail(p + std::string(key), "must be " + names + ", got \"" + v + "\"", t.get(key));
+}
 
 void parse_i2c(Checker& c, const toml::table& t, I2cSettings& out) {
     const std::string p = "i2c.";
@@ -84,14 +103,7 @@ void parse_control(Checker& c, const toml::table& t, ControlSettings& out) {
     c.integer(t, p, "arming_delay_ms", 0, 60000, out.arming_delay_ms);
     c.boolean(t, p, "arm_at_start", out.arm_at_start);
     c.string(t, p, "profile", out.profile);
-    std::string policy;
-    if (c.string(t, p, "budget_policy", policy)) {
-        if (const std::optional<BudgetPolicy> parsed = parse_name<BudgetPolicy>(policy))
-            out.budget_policy = *parsed;
-        else
-            c.fail(p + "budget_policy", "must be \"scale\" or \"reject\", got \"" + policy + "\"",
-                   t.get("budget_policy"));
-    }
+    choice(c, t, p, "budget_policy", out.budget_policy);
 }
 
 void parse_profiles(Checker& c, const toml::table& t, std::vector<ThrustProfile>& out) {
@@ -203,6 +215,34 @@ void parse_recorder(Checker& c, const toml::table& t, RecorderSettings& out) {
     c.integer(t, p, "max_total_mb", 1, 1048576, out.max_total_mb);
 }
 
+void parse_realtime(Checker& c, const toml::table& t, RealtimeSettings& out) {
+    const std::string p = "realtime.";
+    c.only_keys(t, p, {"enabled", "policy", "loop_priority", "bus_priority", "teensy_priority", "lock_memory"});
+    c.boolean(t, p, "enabled", out.enabled);
+    c.boolean(t, p, "lock_memory", out.lock_memory);
+    choice(c, t, p, "policy", out.policy);
+    // 1..49: below PREEMPT_RT's interrupt threads (50) and the kernel's own 99.
+    const char* range = "between 1 and 49 (below the kernel's interrupt threads at 50)";
+    // Absent keys keep their (valid) defaults; only a refused value skips the order check.
+    auto priority = [&](std::string_view key, uint32_t& v) {
+        return c.integer(t, p, key, 1, 49, v, range) || !t.get(key);
+    };
+    const bool loop_ok = priority("loop_priority", out.loop_priority);
+    const bool bus_ok = priority("bus_priority", out.bus_priority);
+    const bool teensy_ok = priority("teensy_priority", out.teensy_priority);
+    // The loop carries the kill: a worker at or above it could hold the CPU the kill needs.
+    if (loop_ok && bus_ok && out.bus_priority >= out.loop_priority)
+        c.fail(p + "bus_priority",
+               "must be below realtime.loop_priority (" + std::to_string(out.loop_priority) +
+                   "): a kill on the loop preempts the wire",
+               t.get("bus_priority"));
+    if (loop_ok && teensy_ok && out.teensy_priority >= out.loop_priority)
+        c.fail(p + "teensy_priority",
+               "must be below realtime.loop_priority (" + std::to_string(out.loop_priority) +
+                   "): a kill on the loop preempts the Teensy's frames",
+               t.get("teensy_priority"));
+}
+
 } // namespace
 
 ConfigResult parse_config_string(std::string_view text, std::string_view source) {
@@ -225,7 +265,7 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     DaemonConfig cfg;
     // [sim] belongs to caracara-sim, which reads the same file; it is not checked here.
     c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "recorder", "failsafe",
-                       "sim"});
+                       "realtime", "sim"});
     if (const toml::table* t = c.table(root, "", "i2c"))
         parse_i2c(c, *t, cfg.i2c);
     if (const toml::table* t = c.table(root, "", "spi"))
@@ -245,6 +285,8 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
         parse_recorder(c, *t, cfg.recorder);
     if (const toml::table* t = c.table(root, "", "failsafe"))
         parse_failsafe(c, *t, cfg.failsafe);
+    if (const toml::table* t = c.table(root, "", "realtime"))
+        parse_realtime(c, *t, cfg.realtime);
     c.table(root, "", "sim");
     if (!cfg.profiles.empty() && !find_profile(cfg, cfg.control.profile)) {
         c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + profile_names(cfg),

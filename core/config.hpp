@@ -9,6 +9,7 @@
 #pragma once
 
 #include "core/budget.hpp"
+#include "core/enum_names.hpp"
 #include "core/failsafe.hpp"
 #include "core/mixing.hpp"
 #include "core/safety.hpp"
@@ -96,6 +97,28 @@ struct RecorderSettings {
     uint32_t max_total_mb = 256;  // about 7 hours of dives at 50 Hz
 };
 
+// Real-time scheduling for the daemon's own threads (docs/realtime.md). The loop carries the
+// kill switch's edge and the kill output, so it runs above the workers: a kill preempts the
+// wire. All below 50, the priority of PREEMPT_RT's threaded interrupts, so the I2C, SPI and
+// GPIO interrupt threads the daemon waits on are never starved by the daemon itself.
+enum class SchedPolicy { Fifo, RoundRobin };
+template <>
+struct EnumNames<SchedPolicy> {
+    static constexpr std::array<EnumName<SchedPolicy>, 2> table{{
+        {SchedPolicy::Fifo, "fifo"},
+        {SchedPolicy::RoundRobin, "rr"},
+    }};
+};
+
+struct RealtimeSettings {
+    bool enabled = true;                  // false: every thread at the normal policy
+    SchedPolicy policy = SchedPolicy::Fifo;
+    uint32_t loop_priority = 40;          // the event loop: kill switch edge, kill output, ticks
+    uint32_t bus_priority = 38;           // the bus worker: the I2C transfers
+    uint32_t teensy_priority = 36;        // the Teensy worker: the SPI frames
+    bool lock_memory = true;              // mlockall: no page fault on the hot path
+};
+
 // The default vehicle: eight SeaBotix controllers at MT 0x52, 0x56, 0x58, 0x5A, 0x5C,
 // 0x5E, 0x60, 0x62 (distinct even addresses, all on the main bus).
 std::array<ThrusterConfig, kMotorCount> default_thrusters();
@@ -110,6 +133,7 @@ struct DaemonConfig {
     RecoverySettings recovery;
     RecorderSettings recorder;
     FailsafeSettings failsafe;
+    RealtimeSettings realtime;
     std::vector<ThrustProfile> profiles{{"water", 1.0}};
 };
 

@@ -1,6 +1,7 @@
 // caracarad: the Caracara vehicle daemon. One sd-event loop; see docs/architecture.md.
 #include "core/config.hpp"
 #include "daemon/loop/log.hpp"
+#include "daemon/loop/thread_schedule.hpp"
 #include "daemon/vehicle_daemon.hpp"
 #include "dbus/bus_input_probe.hpp"
 #include "dbus/vehicle_service.hpp"
@@ -145,6 +146,14 @@ int main(int argc, char** argv) {
     // daemon writing to its terminal) would freeze it with the thrusters running.
     for (int sig : {SIGPIPE, SIGTSTP, SIGTTIN, SIGTTOU})
         signal(sig, SIG_IGN);
+
+    // Locked before the daemon's threads are made, so that their stacks are locked too.
+    if (cr.config->realtime.lock_memory) {
+        if (std::string e = ThreadSchedule::lock_memory(); !e.empty())
+            log_warning("realtime: memory not locked: %s", e.c_str());
+        else
+            log_info("realtime: memory locked");
+    }
 
     // Made before the daemon so that it outlives it: the daemon's lines tell it their kill output.
     EmergencyStop estop;

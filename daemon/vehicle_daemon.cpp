@@ -1,6 +1,7 @@
 #include "daemon/vehicle_daemon.hpp"
 
 #include "daemon/loop/log.hpp"
+#include "daemon/loop/thread_schedule.hpp"
 #include "drivers/platform/io_error.hpp"
 
 namespace caracara {
@@ -48,6 +49,10 @@ std::optional<FailsafeReading> VehicleDaemon::reading(std::size_t i) const {
 std::string VehicleDaemon::start() {
     if (int r = bus_.open(); r < 0)
         return "cannot open I2C bus " + config_.i2c.device + ": " + errno_name(-r);
+    // Each thread inherits the schedule of this one when it is made (ThreadSchedule).
+    const RealtimeSettings& rt = config_.realtime;
+    ThreadSchedule schedule(rt);
+    schedule.realtime(rt.bus_priority);
     if (std::string e = bus_.start(event_, kWorkPriority, [this](const BusJob& j) { loop_.bus_done(j); }); !e.empty())
         return e;
     // Zero before anything else: a previous instance may have died with orders standing.
@@ -59,11 +64,14 @@ std::string VehicleDaemon::start() {
         log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
                     errno_name(-r).c_str());
     teensy_.stop_motion(); // the wheels too may have been left running by an earlier instance
+    schedule.realtime(rt.teensy_priority);
     if (std::string e = teensy_.start(kWorkPriority); !e.empty())
         return e;
     if (std::string e = vehicle_.start(event_); !e.empty())
         return e;
     bus_.health().set_gate(&vehicle_); // a thruster that stopped answering kills the vehicle
+    // The dive writer's file writes can wait: never ahead of the loop or the wire.
+    schedule.normal();
     if (config_.recorder.enabled) {
         dive_writer_ = std::make_unique<DiveWriter>(config_.recorder.directory,
                                                     uint64_t(config_.recorder.max_total_mb) << 20);
@@ -72,6 +80,12 @@ std::string VehicleDaemon::start() {
         events_.attach_recorder(recorder_.get());
         recorder_->start();
     }
+    // The loop: the kill switch's edge, the kill output, every tick.
+    schedule.realtime(rt.loop_priority);
+    if (rt.enabled && !schedule.refused())
+        log_notice("realtime: %s, loop at %u, bus worker at %u, Teensy worker at %u, dive writer at the normal policy",
+                   rt.policy == SchedPolicy::Fifo ? "SCHED_FIFO" : "SCHED_RR", rt.loop_priority, rt.bus_priority,
+                   rt.teensy_priority);
     if (std::string e = loop_.start(); !e.empty())
         return e;
     if (std::string e = failsafes_.start(); !e.empty())

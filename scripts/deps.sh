@@ -2,12 +2,13 @@
 # Installs the packages caracarad needs to build, test and run, on Debian 12 or 13 (Raspberry Pi
 # OS bookworm or trixie). Idempotent.
 set -euo pipefail
+# stress-ng: the loaded bench (bench/run.py phase loaded).
 # Catch2: "catch2" on Debian 12 (2.13); on Debian 13 "libcatch2-dev" (3.x; "catch2" is only a
 # transitional name there). libgpiod-dev is 1.6 on 12 and 2.2 on 13, the build takes either.
 catch2=libcatch2-dev
 [ "$(. /etc/os-release && echo "${VERSION_CODENAME:-}")" = bookworm ] && catch2=catch2
 pkgs=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev "$catch2" libtomlplusplus-dev
-      dbus python3 python3-dbus python3-gi systemd debootstrap systemd-container valgrind
+      dbus python3 python3-dbus python3-gi systemd debootstrap systemd-container valgrind stress-ng
       clang libclang-rt-dev python3-matplotlib ccache libboost-dev nlohmann-json3-dev openssh-client)
 # Node.js and npm for the bridge's tests (tests/bridge: the Foxglove and MCAP reference
 # implementations): Debian's only when no node with npm is there, since Debian's npm conflicts

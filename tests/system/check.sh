@@ -206,6 +206,16 @@ check "the daemon runs as user caracara" [ "$(stat -c %U /proc/"$pid")" = caraca
 check "the daemon has no capabilities (CapEff 0)" grep -q '^CapEff:[[:space:]]*0000000000000000$' /proc/"$pid"/status
 check "the daemon runs with NoNewPrivs and a seccomp filter" \
   bash -c 'grep -q "^NoNewPrivs:[[:space:]]*1$" "$1" && grep -q "^Seccomp:[[:space:]]*2$" "$1"' _ /proc/"$pid"/status
+# [realtime] (docs/realtime.md): under the unit's LimitRTPRIO=, LimitMEMLOCK= and seccomp filter the
+# loop runs at SCHED_FIFO 40 with its memory locked; where the container refuses, the daemon's one
+# warning says so (and it runs, as the checks above show).
+info "REALTIME: $(chrt -p "$pid" 2>&1 | tr '\n' ' ') $(grep '^VmLck' /proc/"$pid"/status)"
+check "the loop at SCHED_FIFO 40, or the daemon's realtime refusal in the journal" \
+  bash -c '{ chrt -p "$1" | grep -q SCHED_FIFO && chrt -p "$1" | grep -q "priority: 40$"; } ||
+           journalctl -b -u caracarad --no-pager | grep -q "realtime: the kernel refused"' _ "$pid"
+check "the daemon's memory locked (VmLck), or its reason in the journal" \
+  bash -c '! grep -q "^VmLck:[[:space:]]*0 kB" /proc/"$1"/status ||
+           journalctl -b -u caracarad --no-pager | grep -q "realtime: memory not locked"' _ "$pid"
 owner_uid=$(busctl status $V 2>/dev/null | sed -n 's/^UID=//p')
 check "the bus name is owned by the caracara user (uid $owner_uid)" [ "$owner_uid" = "$(id -u caracara)" ]
 check "the journal has the daemon's notice at priority notice" \

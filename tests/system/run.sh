@@ -73,11 +73,12 @@ cannot_run() {
 # upgrade, a refused non-member, its exposure), the failsafes (+3), the cockpit (+2: its page
 # and the dive list on the socket) and pilot-lost (+8: the kill after the persistence and the
 # re-arm, after the busctl pilot of check.sh and after each of topside.sh's three pilots that
-# leave) and the bridge's own user (+3: its user in the group, the name it may not own,
-# MemoryMax). The install count is the debs count less check-debs.sh's 34 plus check.sh's two
-# installation checks, as it was counted by hand; CI runs --debs.
-checks_planned_debs=178
-checks_planned_install=146
+# leave), the bridge's own user (+3: its user in the group, the name it may not own,
+# MemoryMax) and real-time scheduling (+2: the loop's policy, its memory locked). The install
+# count is the debs count less check-debs.sh's 34 plus check.sh's two installation checks, as it
+# was counted by hand; CI runs --debs.
+checks_planned_debs=180
+checks_planned_install=148
 
 if [ "$(id -u)" -ne 0 ]; then
   cannot_run "needs root (debootstrap, systemd-nspawn)"

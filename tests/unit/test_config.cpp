@@ -371,6 +371,32 @@ TEST_CASE("[recovery] values are validated, naming the key") {
     check_error("[recovery]\nenabled = true\n", "recovery.enabled: bus recovery needs gpio.scl and gpio.sda");
 }
 
+TEST_CASE("[realtime] values are validated, naming the key; the loop stays above the workers") {
+    const ConfigResult d = parse_config_string("");
+    REQUIRE(d.ok());
+    CHECK(d.config->realtime.enabled);
+    CHECK(d.config->realtime.loop_priority > d.config->realtime.bus_priority);
+    CHECK(d.config->realtime.loop_priority > d.config->realtime.teensy_priority);
+    const ConfigResult r = parse_config_string("[realtime]\npolicy = \"rr\"\nloop_priority = 20\nbus_priority = 10\n"
+                                               "teensy_priority = 5\nlock_memory = false\nenabled = false\n");
+    REQUIRE(r.ok());
+    CHECK(r.config->realtime.policy == SchedPolicy::RoundRobin);
+    CHECK(r.config->realtime.loop_priority == 20);
+    CHECK(r.config->realtime.bus_priority == 10);
+    CHECK(r.config->realtime.teensy_priority == 5);
+    CHECK_FALSE(r.config->realtime.lock_memory);
+    CHECK_FALSE(r.config->realtime.enabled);
+    check_error("[realtime]\npolicy = \"deadline\"\n", "realtime.policy: must be \"fifo\" or \"rr\", got \"deadline\"");
+    check_error("[realtime]\nloop_priority = 50\n",
+                "realtime.loop_priority: must be between 1 and 49 (below the kernel's interrupt threads at 50), got 50");
+    check_error("[realtime]\nbus_priority = 0\n", "realtime.bus_priority: must be between 1 and 49");
+    check_error("[realtime]\nbus_priority = 40\n",
+                "realtime.bus_priority: must be below realtime.loop_priority (40): a kill on the loop preempts the wire");
+    check_error("[realtime]\nloop_priority = 10\n", "realtime.teensy_priority: must be below realtime.loop_priority (10)");
+    check_error("[realtime]\nlock_memory = 1\n", "realtime.lock_memory: must be true or false");
+    check_error("[realtime]\nniceness = 1\n", "realtime.niceness");
+}
+
 TEST_CASE("every problem in a file is reported at once, prefixed with the source") {
     const ConfigResult r =
         parse_config_string("[control]\nloop_rate_hz = 5000\nbudget_policy = \"x\"\n[i2c]\nretries = 99\n", "vehicle.toml");

@@ -3,6 +3,7 @@
 // compiler (an enumerator prints by name in __PRETTY_FUNCTION__, any other value as a cast), so a
 // value added to an enum without a name in its table fails here.
 #include "core/budget.hpp"
+#include "core/config.hpp"
 #include "core/dive_format.hpp"
 #include "core/failsafe.hpp"
 #include "core/mixing.hpp"
@@ -95,6 +96,7 @@ TEST_CASE("every enum's values have one name each, and each name reads back") {
     check_names<Status>("Status");
     check_names<Variant>("Variant");
     check_names<BusState>("BusState");
+    check_names<SchedPolicy>("SchedPolicy");
     check_names<IoError>("IoError");
     check_names<CodecError>("CodecError");
     check_names<Fault>("Fault");

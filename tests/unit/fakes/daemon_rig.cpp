@@ -12,7 +12,9 @@ namespace {
 DaemonConfig parse(const std::string& control, const std::string& sections) {
     const std::string arm = control.find("arm_at_start") == std::string::npos ? "arm_at_start = true\n" : "";
     ConfigResult r = parse_config_string("[control]\n" + arm + "arming_delay_ms = 0\n" + control +
-                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n" + sections,
+                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n" +
+                                             // The test runner's own thread is the loop here: not at a real-time policy.
+                                             "[realtime]\nenabled = false\n" + sections,
                                          "the test rig");
     if (!r.ok())
         throw std::runtime_error(r.error());
