@@ -39,7 +39,6 @@ TeensyConnection::TeensyConnection(sd_event* event, DeviceIo& io, const SpiSetti
 int TeensyConnection::open() {
     const int r = spi_.open();
     open_ = tm_.online = r >= 0;
-    last_heard_ns_ = monotonic_ns(); // the silence counts from here
     if (r < 0) {
         // Fitted: the vehicle stays killed (the failsafes look at the conditions as they start).
         if (fitted_) {
@@ -90,7 +89,7 @@ int TeensyConnection::on_reopen(sd_event_source*, uint64_t, void* userdata) {
                              }
                              log_notice("Teensy SPI %s is back", self->spi_.path().c_str());
                              self->open_ = true;
-                             self->last_heard_ns_ = monotonic_ns();
+                             self->asked_ns_ = 0; // the silence counts from its first frame
                              // Whatever the wheels were doing before, they stop now (as at every start).
                              if (self->on_back_)
                                  self->on_back_();
@@ -122,7 +121,7 @@ void TeensyConnection::lose(TeensyLoss why) {
 }
 
 void TeensyConnection::heard(uint64_t now) {
-    last_heard_ns_ = now;
+    asked_ns_ = 0;
     answered_ = true;
     if (!open_)
         return;
@@ -146,7 +145,7 @@ std::string TeensyConnection::start(int64_t priority) {
     if (int r = sd_event_add_time(event_, &s, CLOCK_MONOTONIC, 0, 1000, on_silence, this); r < 0)
         return "sd_event_add_time: " + errno_name(-r);
     silence_timer_.reset(s);
-    arm_silence_timer(last_heard_ns_ + silence_ns_);
+    arm_silence_timer(monotonic_ns() + silence_ns_);
     return {};
 }
 
@@ -168,16 +167,21 @@ int TeensyConnection::on_silence(sd_event_source*, uint64_t, void* userdata) {
         self->arm_silence_timer(now + self->silence_ns_);
         return 0;
     }
-    if (now - self->last_heard_ns_ < self->silence_ns_) {
-        self->arm_silence_timer(self->last_heard_ns_ + self->silence_ns_);
+    if (self->asked_ns_ == 0 || now - self->asked_ns_ < self->silence_ns_) {
+        self->arm_silence_timer((self->asked_ns_ ? self->asked_ns_ : now) + self->silence_ns_);
         return 0;
     }
-    // Silent: a hung frame (busy for ever, no answer), or only errors and garbage since the last
-    // valid frame.
+    // Silent: asked for this long and no valid frame (busy for ever, no answer, errors, garbage,
+    // a frame held on the wire).
     log_error("Teensy on SPI %s answered no valid frame for %llu ms: failsafe teensy-link-lost",
-              self->spi_.path().c_str(), static_cast<unsigned long long>((now - self->last_heard_ns_) / 1'000'000));
+              self->spi_.path().c_str(), static_cast<unsigned long long>((now - self->asked_ns_) / 1'000'000));
     self->lose(TeensyLoss::Silent);
     return 0;
+}
+
+void TeensyConnection::mark_asked() {
+    if (asked_ns_ == 0)
+        asked_ns_ = monotonic_ns();
 }
 
 void TeensyConnection::poll() {
@@ -190,6 +194,7 @@ void TeensyConnection::poll() {
     ++poll_index_;
     poll_.sensor = sensors ? (poll_index_ / slots) % sensors : 0;
     poll_out_ = true;
+    mark_asked();
     // Captures `this` only: no allocation per poll.
     worker_.submit(
         [this] {
@@ -225,6 +230,7 @@ void TeensyConnection::poll_done() {
 void TeensyConnection::command(std::function<teensy::TeensyError()> frame, std::string what, Completion done) {
     auto e = std::make_shared<teensy::TeensyError>(teensy::TeensyError::None);
     auto err = std::make_shared<int>(0);
+    mark_asked();
     worker_.submit(
         [this, frame = std::move(frame), e, err] {
             *e = frame();

@@ -3,8 +3,8 @@
 // distances one frame per cycle; hands a command's frame over and gives its Result back later.
 // The link is lost (told to its CommandGate: the failsafes kill, as teensy-link-lost) when the
 // device goes away (ENODEV: asked for again once a second), when a fitted Teensy is absent at
-// start, or when no valid frame came back for [spi] silence_ms (busy for ever, no answer,
-// garbage); it is back at the next valid frame. The commands themselves are TeensyPort's, the Turn handshake TeensyTurn's.
+// start, or when no valid frame came back for [spi] silence_ms of asking (busy for ever, no
+// answer, garbage); it is back at the next valid frame. The commands themselves are TeensyPort's, the Turn handshake TeensyTurn's.
 #pragma once
 
 #include "core/config.hpp"
@@ -92,6 +92,7 @@ private:
     void lose_link();
     // The link lost for `why` (the kill, at once), unless it already is.
     void lose(TeensyLoss why);
+    void mark_asked(); // a frame handed to the worker
     // A valid frame came back (`now`): a lost link is back.
     void heard(uint64_t now);
     void schedule_reopen();
@@ -106,7 +107,10 @@ private:
     bool fitted_;           // [spi] fitted
     bool answered_ = false; // loop thread: a valid frame came once (a Teensy not fitted is then relied on)
     uint64_t silence_ns_;
-    uint64_t last_heard_ns_ = 0; // loop thread: the last valid frame, or the open
+    // Loop thread: when the first frame since the last valid one was handed over (0: none). The
+    // silence counts only while the Teensy is asked: a poll held back behind a hung I2C bus
+    // (the Teensy's slot comes after the cycle's transfers) is no silence of the Teensy's.
+    uint64_t asked_ns_ = 0;
     TeensyTelemetry tm_;
     unsigned poll_index_ = 0;
     bool poll_out_ = false;
