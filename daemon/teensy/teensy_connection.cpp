@@ -179,6 +179,12 @@ int TeensyConnection::on_silence(sd_event_source*, uint64_t, void* userdata) {
     return 0;
 }
 
+int TeensyConnection::io_errno(teensy::TeensyError e) const {
+    // Only a failed transfer has an errno of its own: the SPI device keeps its last one, which
+    // after a garbage answer would be a stale ENODEV from a device that has since come back.
+    return e == teensy::TeensyError::Io ? spi_.last_errno() : 0;
+}
+
 void TeensyConnection::mark_asked() {
     if (asked_ns_ == 0)
         asked_ns_ = monotonic_ns();
@@ -198,16 +204,18 @@ void TeensyConnection::poll() {
     // Captures `this` only: no allocation per poll.
     worker_.submit(
         [this] {
+            teensy::TeensyError e = teensy::TeensyError::None;
             if (poll_.slot < 3) {
                 auto r = link_.get_orientation(static_cast<int>(poll_.slot));
-                poll_.ok = r.ok();
+                e = r.error;
                 poll_.value = r.value;
             } else {
                 auto r = link_.get_distance(static_cast<int>(poll_.sensor));
-                poll_.ok = r.ok();
+                e = r.error;
                 poll_.value = r.value;
             }
-            poll_.err = poll_.ok ? 0 : spi_.last_errno();
+            poll_.ok = e == teensy::TeensyError::None;
+            poll_.err = io_errno(e);
         },
         [this] { poll_done(); }, false);
 }
@@ -234,7 +242,7 @@ void TeensyConnection::command(std::function<teensy::TeensyError()> frame, std::
     worker_.submit(
         [this, frame = std::move(frame), e, err] {
             *e = frame();
-            *err = *e == teensy::TeensyError::None ? 0 : spi_.last_errno();
+            *err = io_errno(*e);
         },
         [this, e, err, what = std::move(what), done = std::move(done)] {
             const Result r = teensy_result(*e, what);

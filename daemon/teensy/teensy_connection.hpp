@@ -93,6 +93,7 @@ private:
     // The link lost for `why` (the kill, at once), unless it already is.
     void lose(TeensyLoss why);
     void mark_asked(); // a frame handed to the worker
+    int io_errno(teensy::TeensyError e) const; // the worker's: the failed transfer's errno, or 0
     // A valid frame came back (`now`): a lost link is back.
     void heard(uint64_t now);
     void schedule_reopen();
