@@ -3,8 +3,8 @@ valid frame for [spi] silence_ms (no answer at all, every frame held, garbage) w
 thrusters run is teensy-link-lost: the kill output's edge and a zero order to every thruster
 in the simulator's wire log within silence_ms and TEENSY_SILENCE_LATENESS_MS_MAX, no non-zero
 order after the edge, ClearKill refused (FailsafeActive) while it is silent and accepted once
-it answers again. A Teensy the configuration says is fitted but absent at start keeps the
-vehicle killed (failsafe teensy-link-lost, LinkLoss "absent", a journal line naming it) until
+it answers again. One silent from the start is killed the same way. A Teensy the
+configuration says is fitted but absent at start keeps the vehicle killed (failsafe teensy-link-lost, LinkLoss "absent", a journal line naming it) until
 it is there; one not fitted is no failsafe."""
 import re
 import time
@@ -142,6 +142,34 @@ class TeensyAbsentAtStartTest(unittest.TestCase):
              message="the Teensy there did not clear the failsafe")
         self.assertEqual(link_loss(rig), "none")
         poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10, message="ClearKill refused with the Teensy there")
+        rig.wait_state("ready")
+
+
+class TeensySilentAtStartTest(unittest.TestCase):
+    """The Teensy's node is there at start but nothing answers on it (simulator fault
+    no-answer), with arm_at_start: killed by teensy-link-lost (LinkLoss "silent") within the
+    silence, until it answers."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.rig = Rig(control={"arming_delay_ms": 0, "arm_at_start": True})
+        cls.addClassCleanup(cls.rig.stop_checked)
+        cls.rig.start(daemon=False)
+
+    def test_silent_at_start_is_killed_until_it_answers(self):
+        rig = self.rig
+        rig.sim_teensy_call("InjectFault", "no-answer", 1000000, signature="su")
+        since = rig.wire_next()
+        rig.start_daemon()
+        rig.wait_state("killed", 10)
+        self.assertEqual(rig.vget("KillSource"), "failsafe")
+        self.assertIn(LINK_LOST, failsafes(rig))
+        self.assertEqual(link_loss(rig), "silent")
+        self.assertTrue(kill_edges(rig.wire_log(since)[1]) or rig.sim_get("KillOutput"), "the kill output is not asserted")
+        self.assertEqual(error_name(rig.vcall, "ClearKill"), ERR + "FailsafeActive")
+        rig.sim_teensy_call("ClearFaults")
+        poll(lambda: LINK_LOST not in failsafes(rig), 10, message="the Teensy answering did not clear the failsafe")
+        poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10, message="ClearKill refused with the Teensy answering")
         rig.wait_state("ready")
 
 
