@@ -485,7 +485,10 @@ def phase_faults(b, p, res):
     # The thruster answers each transfer after 0.9 s, just inside it: the bus is held that long
     # per transfer, yet the thruster stays reachable (three timeouts in a row would kill the
     # vehicle as unreachable, and the kill-and-clear cycle measured here could not re-arm).
-    cfg = b.daemon_config(50, kill_switch=ks, extra="[i2c]\ntimeout_ms = 1000\n")
+    # spi.silence_ms a minute: the Teensy held 0.5 s per frame is measured here as a slow link
+    # that must not hold the loop, not as the silent Teensy the failsafe kills for (e2e
+    # test_teensy_silence).
+    cfg = b.daemon_config(50, kill_switch=ks, extra="[i2c]\ntimeout_ms = 1000\n[spi]\nsilence_ms = 60000\n")
     b.start_daemon(cfg)
     n = max(4, p["kill_samples"] // 4)
     out = {}

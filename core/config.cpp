@@ -79,7 +79,7 @@ void parse_spi(Checker& c, const toml::table& t, SpiSettings& out) {
     const std::string p = "spi.";
     c.only_keys(t, p,
                 {"device", "speed_hz", "per_byte_delay_us", "busy_retries", "busy_delay_us", "servos",
-                 "distance_sensors"});
+                 "distance_sensors", "fitted", "silence_ms"});
     c.path(t, p, "device", out.device);
     c.integer(t, p, "speed_hz", 1000, 50000000, out.spi.speed_hz);
     c.integer(t, p, "per_byte_delay_us", 0, 10000, out.spi.byte_delay_us);
@@ -89,6 +89,33 @@ void parse_spi(Checker& c, const toml::table& t, SpiSettings& out) {
     c.integer(t, p, "servos", 0, 256, out.teensy.limits.servo_count, "between 0 and 256 (ids are uint8)");
     c.integer(t, p, "distance_sensors", 0, 256, out.teensy.limits.distance_sensor_count,
               "between 0 and 256 (ids are uint8)");
+    c.boolean(t, p, "fitted", out.fitted);
+    c.integer(t, p, "silence_ms", 10, 60000, out.silence_ms);
+}
+
+// What an answering Teensy may take before its valid frame is in: two poll periods (one to send,
+// one to take the answer) and a frame's busy resends.
+uint64_t teensy_answer_ms(const DaemonConfig& cfg) {
+    const uint64_t period_us = cfg.control.loop_rate_hz ? 1'000'000 / cfg.control.loop_rate_hz : 0;
+    const uint64_t busy_us = uint64_t(cfg.spi.teensy.retry.max_busy_retries) * cfg.spi.teensy.retry.busy_delay_us;
+    return (2 * period_us + busy_us + 999) / 1000;
+}
+
+// A silence_ms written shorter than that would kill a Teensy that answers as it should; unset,
+// it is ten poll periods (200 ms at 50 Hz), at least 200 ms and twice that time.
+void check_teensy_silence(Checker& c, const toml::table& root, DaemonConfig& cfg) {
+    const uint64_t need_ms = teensy_answer_ms(cfg);
+    if (!root["spi"]["silence_ms"]) {
+        const uint64_t periods_ms = cfg.control.loop_rate_hz ? 10'000 / cfg.control.loop_rate_hz : 0;
+        cfg.spi.silence_ms = static_cast<uint32_t>(std::max<uint64_t>({200, periods_ms, 2 * need_ms}));
+        return;
+    }
+    if (uint64_t(cfg.spi.silence_ms) <= need_ms)
+        c.fail("spi.silence_ms",
+               std::string(kTeensySilenceError) + ": " + std::to_string(cfg.spi.silence_ms) +
+                   " ms is within what an answering Teensy may take (two loop periods and the busy resends: " +
+                   std::to_string(need_ms) + " ms)",
+               root["spi"]["silence_ms"].node());
 }
 
 void parse_control(Checker& c, const toml::table& t, ControlSettings& out) {
@@ -292,6 +319,9 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
         c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + profile_names(cfg),
                root["control"]["profile"].node());
     }
+
+    if (c.errors.empty())
+        check_teensy_silence(c, root, cfg);
 
     // Only when neither line is given: one without the other is already reported.
     if (cfg.recovery.enabled && !root["gpio"]["scl"] && !root["gpio"]["sda"])

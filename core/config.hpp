@@ -40,7 +40,16 @@ struct SpiSettings {
     std::string device = "/dev/spidev0.0";
     SpiConfig spi;              // speed_hz, byte_delay_us (per_byte_delay_us in the file)
     TeensyLinkConfig teensy;    // busy retries/delay, servo and distance sensor counts
+    // The vehicle has a Teensy: one absent at start, or never answering, is teensy-link-lost
+    // (a kill). false: an absent Teensy is no failsafe until it has answered once.
+    bool fitted = true;
+    // No valid frame for this long is teensy-link-lost. Unset: ten poll periods (one poll per
+    // loop cycle: 200 ms at 50 Hz), at least 200 ms, so a loaded host's late cycle is no kill.
+    uint32_t silence_ms = 200;
 };
+
+// The name of the error a silence_ms shorter than the link can answer in gets, in its message.
+inline constexpr std::string_view kTeensySilenceError = "TeensySilenceTooShort";
 
 struct GpioLineSettings {
     std::string chip = "gpiochip0";

@@ -60,7 +60,7 @@ std::string VehicleDaemon::start() {
     bus_.wait_idle();
     if (std::string e = lines_.open(vehicle_.kill_output_asserted(), &vehicle_); !e.empty())
         return e;
-    if (int r = teensy_.open(); r < 0)
+    if (int r = teensy_.open(); r < 0 && !config_.spi.fitted)
         log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
                     errno_name(-r).c_str());
     teensy_.stop_motion(); // the wheels too may have been left running by an earlier instance

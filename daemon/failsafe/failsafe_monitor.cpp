@@ -24,6 +24,8 @@ std::string FailsafeMonitor::start() {
         return "sd_event_add_time_relative: " + errno_name(-r);
     timer_.reset(s);
     sd_event_source_set_enabled(s, SD_EVENT_ON);
+    // What already holds (a fitted Teensy absent at start) kills now, not at the first reading.
+    conditions_changed();
     return {};
 }
 

@@ -1,5 +1,6 @@
 #include "daemon/teensy/teensy_connection.hpp"
 
+#include "core/clock.hpp"
 #include "daemon/loop/log.hpp"
 #include "drivers/platform/io_error.hpp"
 
@@ -12,6 +13,16 @@ namespace {
 constexpr uint64_t kReopenUs = 1'000'000;
 } // namespace
 
+std::string_view teensy_loss_name(TeensyLoss l) {
+    switch (l) {
+    case TeensyLoss::None: return "none";
+    case TeensyLoss::Gone: return "gone";
+    case TeensyLoss::Absent: return "absent";
+    case TeensyLoss::Silent: return "silent";
+    }
+    return "none";
+}
+
 Result teensy_result(teensy::TeensyError e, std::string_view what) {
     if (e == teensy::TeensyError::None)
         return {};
@@ -19,7 +30,8 @@ Result teensy_result(teensy::TeensyError e, std::string_view what) {
 }
 
 TeensyConnection::TeensyConnection(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate)
-    : event_(event), gate_(gate), spi_(io, settings.device, settings.spi), link_(spi_, settings.teensy), worker_(link_) {
+    : event_(event), gate_(gate), spi_(io, settings.device, settings.spi), link_(spi_, settings.teensy), worker_(link_),
+      fitted_(settings.fitted), silence_ns_(ms_to_ns(settings.silence_ms)) {
     tm_.distances.assign(static_cast<size_t>(settings.teensy.limits.distance_sensor_count), 0);
     tm_.servos.assign(static_cast<size_t>(settings.teensy.limits.servo_count), 0);
 }
@@ -27,14 +39,23 @@ TeensyConnection::TeensyConnection(sd_event* event, DeviceIo& io, const SpiSetti
 int TeensyConnection::open() {
     const int r = spi_.open();
     open_ = tm_.online = r >= 0;
-    if (r < 0)
+    if (r < 0) {
+        // Fitted: the vehicle stays killed (the failsafes look at the conditions as they start).
+        if (fitted_) {
+            loss_ = TeensyLoss::Absent;
+            log_error("Teensy is fitted ([spi] fitted) but SPI %s is absent at start (%s): failsafe "
+                      "teensy-link-lost; asking for it again once a second",
+                      spi_.path().c_str(), errno_name(-r).c_str());
+        }
         schedule_reopen(); // a Teensy that comes later is picked up
+    }
     return r;
 }
 
 void TeensyConnection::close() {
     worker_.stop(); // after the frame on the wire; what was queued (a Stop of the way out) still runs
     reopen_timer_.reset();
+    silence_timer_.reset();
     spi_.close();
     open_ = false;
 }
@@ -68,14 +89,11 @@ int TeensyConnection::on_reopen(sd_event_source*, uint64_t, void* userdata) {
                              }
                              log_notice("Teensy SPI %s is back", self->spi_.path().c_str());
                              self->open_ = true;
+                             self->asked_ns_ = 0; // the silence counts from its first frame
                              // Whatever the wheels were doing before, they stop now (as at every start).
                              if (self->on_back_)
                                  self->on_back_();
-                             self->tm_.online = true;
-                             if (self->lost_) {
-                                 self->lost_ = false;
-                                 self->gate_.link_changed(); // teensy-link-lost clears
-                             }
+                             // Online, and teensy-link-lost cleared, at its first valid frame.
                          });
     return 0;
 }
@@ -86,13 +104,90 @@ void TeensyConnection::lose_link() {
     log_error("Teensy SPI %s went away (%s): failsafe teensy-link-lost; asking for it again once a second",
               spi_.path().c_str(), errno_name(ENODEV).c_str());
     open_ = false;
-    lost_ = true;
     worker_.submit([this] { spi_.close(); }, nullptr);
+    loss_ = TeensyLoss::None; // gone, whatever it was before
+    lose(TeensyLoss::Gone);
+    schedule_reopen();
+}
+
+void TeensyConnection::lose(TeensyLoss why) {
+    tm_.online = false;
+    if (loss_ != TeensyLoss::None)
+        return;
+    loss_ = why;
     if (on_lost_)
         on_lost_();
-    tm_.online = false;
     gate_.link_changed(); // the kill, at once
-    schedule_reopen();
+}
+
+void TeensyConnection::heard(uint64_t now) {
+    asked_ns_ = 0;
+    answered_ = true;
+    if (!open_)
+        return;
+    tm_.online = true;
+    if (loss_ == TeensyLoss::None)
+        return;
+    log_notice("Teensy answers again (it was %s): teensy-link-lost clears",
+               std::string(teensy_loss_name(loss_)).c_str());
+    loss_ = TeensyLoss::None;
+    arm_silence_timer(now + silence_ns_);
+    // Whatever the wheels were doing before, they stop now: the kill's Stop may not have got through.
+    if (on_back_)
+        on_back_();
+    gate_.link_changed(); // teensy-link-lost clears
+}
+
+std::string TeensyConnection::start(int64_t priority) {
+    if (std::string e = worker_.start(event_, priority); !e.empty())
+        return e;
+    sd_event_source* s = nullptr;
+    if (int r = sd_event_add_time(event_, &s, CLOCK_MONOTONIC, 0, 1000, on_silence, this); r < 0)
+        return "sd_event_add_time: " + errno_name(-r);
+    silence_timer_.reset(s);
+    arm_silence_timer(monotonic_ns() + silence_ns_);
+    return {};
+}
+
+void TeensyConnection::arm_silence_timer(uint64_t at_ns) {
+    if (!silence_timer_)
+        return;
+    sd_event_source_set_time(silence_timer_.get(), at_ns / 1000);
+    sd_event_source_set_enabled(silence_timer_.get(), SD_EVENT_ONESHOT);
+}
+
+int TeensyConnection::on_silence(sd_event_source*, uint64_t, void* userdata) {
+    auto* self = static_cast<TeensyConnection*>(userdata);
+    self->worker_.collect(); // a valid frame already in counts
+    const uint64_t now = monotonic_ns();
+    if (self->loss_ != TeensyLoss::None)
+        return 0; // armed again at its next valid frame
+    // A Teensy not fitted that never answered, or a node not open, is not relied on.
+    if (!self->open_ || !(self->fitted_ || self->answered_)) {
+        self->arm_silence_timer(now + self->silence_ns_);
+        return 0;
+    }
+    if (self->asked_ns_ == 0 || now - self->asked_ns_ < self->silence_ns_) {
+        self->arm_silence_timer((self->asked_ns_ ? self->asked_ns_ : now) + self->silence_ns_);
+        return 0;
+    }
+    // Silent: asked for this long and no valid frame (busy for ever, no answer, errors, garbage,
+    // a frame held on the wire).
+    log_error("Teensy on SPI %s answered no valid frame for %llu ms: failsafe teensy-link-lost",
+              self->spi_.path().c_str(), static_cast<unsigned long long>((now - self->asked_ns_) / 1'000'000));
+    self->lose(TeensyLoss::Silent);
+    return 0;
+}
+
+int TeensyConnection::io_errno(teensy::TeensyError e) const {
+    // Only a failed transfer has an errno of its own: the SPI device keeps its last one, which
+    // after a garbage answer would be a stale ENODEV from a device that has since come back.
+    return e == teensy::TeensyError::Io ? spi_.last_errno() : 0;
+}
+
+void TeensyConnection::mark_asked() {
+    if (asked_ns_ == 0)
+        asked_ns_ = monotonic_ns();
 }
 
 void TeensyConnection::poll() {
@@ -105,19 +200,22 @@ void TeensyConnection::poll() {
     ++poll_index_;
     poll_.sensor = sensors ? (poll_index_ / slots) % sensors : 0;
     poll_out_ = true;
+    mark_asked();
     // Captures `this` only: no allocation per poll.
     worker_.submit(
         [this] {
+            teensy::TeensyError e = teensy::TeensyError::None;
             if (poll_.slot < 3) {
                 auto r = link_.get_orientation(static_cast<int>(poll_.slot));
-                poll_.ok = r.ok();
+                e = r.error;
                 poll_.value = r.value;
             } else {
                 auto r = link_.get_distance(static_cast<int>(poll_.sensor));
-                poll_.ok = r.ok();
+                e = r.error;
                 poll_.value = r.value;
             }
-            poll_.err = poll_.ok ? 0 : spi_.last_errno();
+            poll_.ok = e == teensy::TeensyError::None;
+            poll_.err = io_errno(e);
         },
         [this] { poll_done(); }, false);
 }
@@ -129,24 +227,28 @@ void TeensyConnection::poll_done() {
             tm_.orientation[poll_.slot] = poll_.value;
         else
             tm_.distances[poll_.sensor] = static_cast<uint16_t>(poll_.value);
-    }
-    if (open_)
-        tm_.online = poll_.ok;
-    if (!poll_.ok && poll_.err == ENODEV)
+        heard(monotonic_ns());
+    } else if (poll_.err == ENODEV) {
         lose_link();
+    } else {
+        tm_.online = false;
+    }
 }
 
 void TeensyConnection::command(std::function<teensy::TeensyError()> frame, std::string what, Completion done) {
     auto e = std::make_shared<teensy::TeensyError>(teensy::TeensyError::None);
     auto err = std::make_shared<int>(0);
+    mark_asked();
     worker_.submit(
         [this, frame = std::move(frame), e, err] {
             *e = frame();
-            *err = *e == teensy::TeensyError::None ? 0 : spi_.last_errno();
+            *err = io_errno(*e);
         },
         [this, e, err, what = std::move(what), done = std::move(done)] {
             const Result r = teensy_result(*e, what);
-            if (!r.ok() && *err == ENODEV)
+            if (r.ok())
+                heard(monotonic_ns());
+            else if (*err == ENODEV)
                 lose_link();
             if (done)
                 done(r);

@@ -1,8 +1,10 @@
 // The connection to the Teensy over SPI: the node, the link and the TeensyWorker whose thread
 // carries every frame, so a slow or hung Teensy never holds the loop. Polls orientation and
-// distances one frame per cycle; hands a command's frame over and gives its Result back later;
-// a device that goes away (ENODEV) is told to its CommandGate (the failsafes kill, as
-// teensy-link-lost) and is asked for again once a second. The commands themselves are TeensyPort's, the Turn handshake TeensyTurn's.
+// distances one frame per cycle; hands a command's frame over and gives its Result back later.
+// The link is lost (told to its CommandGate: the failsafes kill, as teensy-link-lost) when the
+// device goes away (ENODEV: asked for again once a second), when a fitted Teensy is absent at
+// start, or when no valid frame came back for [spi] silence_ms of asking (busy for ever, no
+// answer, garbage); it is back at the next valid frame. The commands themselves are TeensyPort's, the Turn handshake TeensyTurn's.
 #pragma once
 
 #include "core/config.hpp"
@@ -33,6 +35,11 @@ struct TeensyTelemetry {
     bool turning = false;
 };
 
+// Why the link is lost: the SPI device went away (ENODEV), a fitted Teensy was absent at start,
+// or no valid frame for silence_ms.
+enum class TeensyLoss : uint8_t { None, Gone, Absent, Silent };
+std::string_view teensy_loss_name(TeensyLoss l); // "none", "gone", "absent", "silent"
+
 // The link's error as a Result naming the frame (`what`).
 Result teensy_result(teensy::TeensyError e, std::string_view what);
 
@@ -47,11 +54,13 @@ public:
     }
 
     int open(); // 0 or -errno, on the caller's thread (before start); a missing Teensy is not fatal
-    std::string start(int64_t priority) { return worker_.start(event_, priority); }
+    std::string start(int64_t priority); // the worker and the silence timer
     void close(); // after the worker's job on the wire (what was queued still runs)
     bool is_open() const { return open_; }
-    // The link went away (ENODEV) and is not back yet; a Teensy that was never there is not lost.
-    bool link_lost() const { return lost_; }
+    // The link is lost (gone, absent though fitted, or silent) and no valid frame came since. A
+    // Teensy not fitted that never answered is not lost.
+    bool link_lost() const { return loss_ != TeensyLoss::None; }
+    TeensyLoss loss() const { return loss_; }
 
     // One frame: the three orientation axes, then one distance sensor, in turn; handed to the
     // worker unless the last one is still out (a slow Teensy is polled as fast as it answers).
@@ -74,10 +83,19 @@ private:
         int err = 0;
     };
     static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
+    // At silence_ms after the last valid frame: the link is lost, unless a frame came since.
+    static int on_silence(sd_event_source*, uint64_t usec, void* userdata);
+    void arm_silence_timer(uint64_t at_ns); // monotonic ns
     void poll_done();
     // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, told to the
     // gate (the wheels cannot be stopped: the failsafes kill), and asked for again once a second.
     void lose_link();
+    // The link lost for `why` (the kill, at once), unless it already is.
+    void lose(TeensyLoss why);
+    void mark_asked(); // a frame handed to the worker
+    int io_errno(teensy::TeensyError e) const; // the worker's: the failed transfer's errno, or 0
+    // A valid frame came back (`now`): a lost link is back.
+    void heard(uint64_t now);
     void schedule_reopen();
 
     sd_event* event_;
@@ -86,12 +104,20 @@ private:
     TeensyLink link_; // the worker's while it runs
     TeensyWorker worker_;
     bool open_ = false; // loop thread: the SPI node is open (as far as the loop knows)
-    bool lost_ = false; // loop thread: it went away, and is not back
+    TeensyLoss loss_ = TeensyLoss::None; // loop thread
+    bool fitted_;           // [spi] fitted
+    bool answered_ = false; // loop thread: a valid frame came once (a Teensy not fitted is then relied on)
+    uint64_t silence_ns_;
+    // Loop thread: when the first frame since the last valid one was handed over (0: none). The
+    // silence counts only while the Teensy is asked: a poll held back behind a hung I2C bus
+    // (the Teensy's slot comes after the cycle's transfers) is no silence of the Teensy's.
+    uint64_t asked_ns_ = 0;
     TeensyTelemetry tm_;
     unsigned poll_index_ = 0;
     bool poll_out_ = false;
     PollResult poll_; // the worker's while a poll is out
     SourcePtr reopen_timer_;
+    SourcePtr silence_timer_;
     std::function<void()> on_lost_;
     std::function<void()> on_back_;
 };

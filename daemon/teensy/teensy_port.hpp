@@ -33,7 +33,8 @@ public:
     std::string start(int64_t priority) { return connection_.start(priority); }
     void close(); // after the worker's job on the wire (what was queued still runs)
     bool is_open() const { return connection_.is_open(); }
-    bool link_lost() const { return connection_.link_lost(); } // went away, not back yet
+    bool link_lost() const { return connection_.link_lost(); } // gone, absent or silent; no valid frame since
+    TeensyLoss loss() const { return connection_.loss(); }
 
     void poll() { connection_.poll(); }
     // Kill, power-off, start and exit: Stop halts the wheels and ends a running turn.

@@ -15,6 +15,14 @@ HUNG_KILL_OUTPUT_MS_MAX = 20.0
 # bound is far inside one held frame, which is what a call waiting behind the Teensy would take.
 HUNG_TEENSY_DBUS_MS_MAX = 500.0
 
+# A Teensy that falls silent (no answer, every frame held, garbage, busy for ever) while the
+# thrusters run: its silence timer fires at [spi] silence_ms after the last valid frame, the
+# failsafe kills at once (kill output first, then the zeros). The kill output's edge and the
+# last thruster's zero come within silence_ms and this (e2e TeensySilenceTest): one poll period
+# (20 ms) for the last valid frame to be taken, the zeros behind one transfer (~1 ms each), and
+# a loaded CI machine's late wake-ups; the same 250 ms as the client-loss bound.
+TEENSY_SILENCE_LATENESS_MS_MAX = 250.0
+
 # After a device vanished (the simulator gone: GPIO chip, adapter, SPI), the daemon idles:
 # at most 2 % of one core, measured over 10 s (issue 20), and its log grows by a bounded number
 # of lines (one line per source when it goes, none per reopen attempt; 10 leaves room for the

@@ -146,11 +146,14 @@ TEENSY_HANG_MS = 2000
 
 class HungTeensyTest(unittest.TestCase):
     """The Teensy answers each SPI frame 2 s late (simulator fault SetHang): its frames are
-    carried off the event loop, so a kill, a kill switch edge and D-Bus do not wait for one."""
+    carried off the event loop, so a kill, a kill switch edge and D-Bus do not wait for one.
+    Its silence is no failsafe here ([spi] silence_ms a minute): what a silent Teensy does is
+    test_teensy_silence's."""
 
     @classmethod
     def setUpClass(cls):
-        cls.rig = Rig(control={"arming_delay_ms": 0, "command_timeout_ms": 60000})
+        cls.rig = Rig(control={"arming_delay_ms": 0, "command_timeout_ms": 60000},
+                      extra_config={"spi": {"silence_ms": 60000}})
         cls.rig.start()
 
     @classmethod

@@ -579,8 +579,8 @@ def injected(name):
 
 def clear_faults():
     inject(i2c_fail_count=0, i2c_func_fail_count=0, i2c_probe_fail_count=0, spi_fail_count=0,
-           spi_setup_fail_count=0, gpio_fail_count=0, gpio_fail_skip=0, i2c_fail_addr=-1, gpio_fail_offset=-1,
-           gpio_fail_op=0, gpio_fail_errno=errno.EIO)
+           spi_setup_fail_count=0, spi_silent_count=0, gpio_fail_count=0, gpio_fail_skip=0, i2c_fail_addr=-1,
+           gpio_fail_offset=-1, gpio_fail_op=0, gpio_fail_errno=errno.EIO)
 
 
 def log_since(rig, mark):
@@ -640,9 +640,42 @@ def bind_driver(driver, bound):
         f.write(driver)
 
 
+def sc_spi_silent(rig):
+    """The Teensy stops answering on SPI while the thrusters run (the module completes every
+    message with MISO low, spi_silent_count): after [spi] silence_ms (200 ms) the teensy-link-lost
+    failsafe kills (source "failsafe", the Teensy's LinkLoss "silent"), the kill output asserted and
+    every thruster zeroed on the wire; ClearKill refused while it is silent; answering again, the
+    failsafe clears and ClearKill re-arms."""
+    poll(lambda: bool(tget(rig, "Online")), 15, message="Teensy not online")
+    rig.thrust([1600] * MOTORS)
+    rig.wait_sim_speeds([speed_byte(1600)] * MOTORS, 20)
+    since = rig.wire_next()
+    silent = 1000000
+    inject(spi_silent_count=silent)
+    try:
+        rig.wait_state("killed", 10)
+        check(injected("spi_silent_count") < silent, "no SPI message answered silently")
+        check(rig.vget("KillSource") == "failsafe", "KillSource %r" % rig.vget("KillSource"))
+        check(str(tget(rig, "LinkLoss")) == "silent", "LinkLoss %r" % tget(rig, "LinkLoss"))
+        check(("teensy-link-lost", "kill", -1) in [(str(c), str(a), int(t)) for c, a, t in rig.vget("Failsafes")],
+              "teensy-link-lost not among the failsafes")
+        wait_wire(rig, since, lambda e: e.bus == "gpio" and e.addr == 27 and list(e.data) == [1], 5,
+                  "no kill output edge (line 27 high) in the wire log")
+        rig.wait_sim_zero(5)
+        time.sleep(0.5)
+        check(error_name(rig.vcall, "ClearKill") == ERR + "FailsafeActive", "ClearKill not refused while silent")
+        check(rig.state() == "killed", "state %s while silent" % rig.state())
+    finally:
+        inject(spi_silent_count=0)
+    poll(lambda: str(tget(rig, "LinkLoss")) == "none", 15, message="the Teensy answering did not clear LinkLoss")
+    poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10, message="ClearKill refused with the Teensy back")
+    rig.wait_state("ready", 20)
+
+
 def sc_spi_refused(rig):
-    """SPI messages the module refuses (EIO): the Teensy reads offline as long as they are
-    refused, no kill, and online again after. Then the SPI controller's driver unbound under the open spidev (spidev
+    """SPI messages the module refuses (EIO): the Teensy reads offline, and once no valid frame
+    came for [spi] silence_ms the teensy-link-lost failsafe kills, ClearKill refused until
+    the messages go through again. Then the SPI controller's driver unbound under the open spidev (spidev
     answers ESHUTDOWN): the Teensy is gone, the vehicle killed by the teensy-link-lost failsafe (source
     "failsafe") and ClearKill refused until it is back; bound again,
     the first reopen is refused (the controller refuses the mode: SPI_IOC_WR_MODE), the next
@@ -651,15 +684,20 @@ def sc_spi_refused(rig):
     refusals = 1000000
     inject(spi_fail_errno=errno.EIO, spi_fail_count=refusals)
     try:
-        # Every message refused: the Teensy reads offline, and stays so; no kill for EIO.
+        # Every message refused: the Teensy reads offline, silent: killed by the failsafe.
         poll(lambda: not tget(rig, "Online"), 15, message="refused SPI messages left the Teensy online")
         check(injected("spi_fail_count") < refusals, "no SPI message refused")
-        time.sleep(1.0)
+        rig.wait_state("killed", 10)
+        check(rig.vget("KillSource") == "failsafe", "KillSource %r" % rig.vget("KillSource"))
+        check(str(tget(rig, "LinkLoss")) == "silent", "LinkLoss %r" % tget(rig, "LinkLoss"))
+        time.sleep(0.5)
         check(not tget(rig, "Online"), "the Teensy reads online while every message is refused")
-        check(rig.state() == "ready", "an SPI EIO killed: %s (%s)" % (rig.state(), rig.vget("KillSource")))
+        check(error_name(rig.vcall, "ClearKill") == ERR + "FailsafeActive", "ClearKill not refused while refused")
     finally:
         inject(spi_fail_count=0)
     poll(lambda: bool(tget(rig, "Online")), 15, message="Teensy not back online after EIO")
+    poll(lambda: error_name(rig.vcall, "ClearKill") is None, 10, message="ClearKill refused after EIO")
+    rig.wait_state("ready", 20)
     mark = len(rig.log("caracarad"))
     bound = True
     try:
@@ -1003,6 +1041,7 @@ SCENARIOS = [
     ("bus_hang_recovered_with_rebind", sc_bus_hang),
     ("i2c_timeout_arbitration_short_transfer", sc_i2c_kernel_errors),
     ("spi_message_and_mode_refused", sc_spi_refused),
+    ("spi_teensy_silent_kills", sc_spi_silent),
     ("bus_clear_gpio_faults_and_failed_bind", sc_bus_clear_faults),
     ("adapter_never_binds_bus_lost", sc_adapter_never_binds),
     ("adapter_lost_without_recovery_reopened", sc_adapter_lost_without_recovery),

@@ -56,6 +56,8 @@ TEST_CASE("an empty file gives the documented defaults") {
     CHECK(c.spi.device == "/dev/spidev0.0");
     CHECK(c.spi.spi.speed_hz == 500000);
     CHECK(c.spi.spi.byte_delay_us == 0);
+    CHECK(c.spi.fitted);              // the vehicle has a Teensy: absent at start is a kill
+    CHECK(c.spi.silence_ms == 200u);  // ten polls at 50 Hz
     const std::array<uint8_t, 8> mts{0x52, 0x56, 0x58, 0x5A, 0x5C, 0x5E, 0x60, 0x62};
     for (std::size_t i = 0; i < kMotorCount; ++i) {
         INFO("thruster " << i);
@@ -264,6 +266,33 @@ TEST_CASE("[i2c] and [spi] values are validated, naming the key") {
     check_error("[spi]\nbusy_delay_us = -1\n", "spi.busy_delay_us: must be between 0 and 1000000, got -1");
     check_error("[spi]\nservos = 300\n", "spi.servos: must be between 0 and 256 (ids are uint8), got 300");
     check_error("[spi]\ndistance_sensors = -1\n", "spi.distance_sensors: must be between 0 and 256");
+    check_error("[spi]\nfitted = 1\n", "spi.fitted: must be true or false");
+    check_error("[spi]\nsilence_ms = 5\n", "spi.silence_ms: must be between 10 and 60000, got 5");
+    check_error("[spi]\nsilence_ms = 600000\n", "spi.silence_ms: must be between 10 and 60000, got 600000");
+}
+
+TEST_CASE("[spi] silence_ms must outlast what an answering Teensy takes: two loop periods and the busy resends") {
+    // 50 Hz: 40 ms of polling; 10 busy resends of 200 us: 2 ms.
+    check_error("[spi]\nsilence_ms = 42\n",
+                "spi.silence_ms: TeensySilenceTooShort: 42 ms is within what an answering Teensy may take (two loop "
+                "periods and the busy resends: 42 ms)");
+    CHECK(parse_config_string("[spi]\nsilence_ms = 43\n").ok());
+    // A slower loop and longer busy resends need a longer silence.
+    check_error("[control]\nloop_rate_hz = 10\n[spi]\nsilence_ms = 150\n", "TeensySilenceTooShort");
+    check_error("[spi]\nbusy_retries = 100\nbusy_delay_us = 10000\nsilence_ms = 200\n",
+                "TeensySilenceTooShort: 200 ms");
+    // Unset, it follows the loop and the busy resends: ten periods, at least 200 ms and twice
+    // what an answer may take.
+    CHECK(parse_config_string("[control]\nloop_rate_hz = 1\n").config->spi.silence_ms == 10000u);
+    CHECK(parse_config_string("[control]\nloop_rate_hz = 0\n").config->spi.silence_ms == 200u);
+    CHECK(parse_config_string("[spi]\nbusy_retries = 100\nbusy_delay_us = 10000\n").config->spi.silence_ms ==
+          2080u);
+    // A file refused for it changes nothing: no config comes out.
+    CHECK_FALSE(parse_config_string("[spi]\nsilence_ms = 20\n").config);
+    const ConfigResult r = parse_config_string("[spi]\nfitted = false\nsilence_ms = 500\n");
+    REQUIRE(r.ok());
+    CHECK_FALSE(r.config->spi.fitted);
+    CHECK(r.config->spi.silence_ms == 500u);
 }
 
 TEST_CASE("[[thruster]] values are validated, naming the thruster and key") {

@@ -287,3 +287,29 @@ TEST_CASE("a thruster that stops answering kills the vehicle (source device); th
     REQUIRE(rig.run_until([&] { return !rig.daemon().bus().health().first_unreachable(); }));
     CHECK(rig.vehicle().clear_kill().ok());
 }
+
+TEST_CASE("a fitted Teensy absent at start keeps the vehicle killed by teensy-link-lost; ClearKill refused") {
+    // The fakes have no SPI node: the Teensy the [spi] table says is fitted is absent.
+    DaemonRig rig("loop_rate_hz = 50\n", "[spi]\nfitted = true\n");
+    // Killed as the failsafes start, before any loop cycle: never ready, not even armed at start.
+    CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
+    CHECK(rig.vehicle().kill_source_name() == "failsafe");
+    CHECK(rig.daemon().teensy().loss() == TeensyLoss::Absent);
+    rig.run_for(300);
+    REQUIRE(rig.daemon().failsafes().active().size() == 1);
+    CHECK(rig.daemon().failsafes().active()[0].condition == FailsafeCondition::TeensyLinkLost);
+    const Result r = rig.vehicle().clear_kill();
+    CHECK(r.status == Status::FailsafeActive);
+    CHECK_THAT(r.message, Catch::Contains("teensy-link-lost"));
+    CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
+    check_kill_output_first(rig.wire().events());
+}
+
+TEST_CASE("a Teensy not fitted and absent is no failsafe") {
+    DaemonRig rig("loop_rate_hz = 50\n", "[spi]\nfitted = false\nsilence_ms = 50\n");
+    rig.run_until_ready();
+    rig.run_for(200); // several silences long
+    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+    CHECK(rig.daemon().failsafes().active().empty());
+    CHECK(rig.daemon().teensy().loss() == TeensyLoss::None);
+}

@@ -20,6 +20,8 @@
  *     (one message fewer than asked, as a controller that stopped early reports it).
  *   - i2c_func_fail_count: I2C_FUNCS answers without I2C_FUNC_I2C.
  *   - i2c_probe_errno, i2c_probe_fail_count: binding the adapter's driver fails.
+ *   - spi_silent_count: an SPI message completes without reaching the server, MISO reading
+ *     all zeros (a Teensy that stopped answering: nothing drives the line).
  *   - spi_fail_errno, spi_fail_count: an SPI message refused; spi_setup_fail_count: the
  *     controller refuses a mode/word size/speed (spidev's SPI_IOC_WR_* ioctls; never the
  *     setup of the probe's own device).
@@ -86,6 +88,8 @@ static int spi_fail_count;
 module_param(spi_fail_count, int, 0644);
 static int spi_setup_fail_count;
 module_param(spi_setup_fail_count, int, 0644);
+static int spi_silent_count;
+module_param(spi_silent_count, int, 0644);
 static int gpio_fail_errno = EIO;
 module_param(gpio_fail_errno, int, 0644);
 static int gpio_fail_offset = -1;
@@ -445,6 +449,16 @@ static int ccb_spi_transfer_one_message(struct spi_controller *ctlr, struct spi_
 
 	if (ccb_take_fault(&spi_fail_count, true)) {
 		ret = -abs(spi_fail_errno);
+		goto done;
+	}
+	if (ccb_take_fault(&spi_silent_count, true)) {
+		/* A silent slave: the controller clocks the message, MISO reads low. */
+		list_for_each_entry(t, &m->transfers, transfer_list) {
+			if (t->rx_buf)
+				memset(t->rx_buf, 0, t->len);
+			m->actual_length += t->len;
+		}
+		ret = 0;
 		goto done;
 	}
 	list_for_each_entry(t, &m->transfers, transfer_list) {

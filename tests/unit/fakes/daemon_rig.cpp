@@ -11,10 +11,16 @@ namespace caracara::test {
 namespace {
 DaemonConfig parse(const std::string& control, const std::string& sections) {
     const std::string arm = control.find("arm_at_start") == std::string::npos ? "arm_at_start = true\n" : "";
+    // The fakes have no Teensy: not fitted, unless the test's own [spi] says it is.
+    const std::string spi = sections.find("[spi]") == std::string::npos ? "[spi]\nfitted = false\n" : "";
     ConfigResult r = parse_config_string("[control]\n" + arm + "arming_delay_ms = 0\n" + control +
-                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n" +
+                                             FakeGpio::config_section() + "[recorder]
+enabled = false
+" + spi +
                                              // The test runner's own thread is the loop here: not at a real-time policy.
-                                             "[realtime]\nenabled = false\n" + sections,
+                                             "[realtime]
+enabled = false
+" + sections,
                                          "the test rig");
     if (!r.ok())
         throw std::runtime_error(r.error());
