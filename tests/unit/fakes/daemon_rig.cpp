@@ -14,13 +14,9 @@ DaemonConfig parse(const std::string& control, const std::string& sections) {
     // The fakes have no Teensy: not fitted, unless the test's own [spi] says it is.
     const std::string spi = sections.find("[spi]") == std::string::npos ? "[spi]\nfitted = false\n" : "";
     ConfigResult r = parse_config_string("[control]\n" + arm + "arming_delay_ms = 0\n" + control +
-                                             FakeGpio::config_section() + "[recorder]
-enabled = false
-" + spi +
+                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n" + spi +
                                              // The test runner's own thread is the loop here: not at a real-time policy.
-                                             "[realtime]
-enabled = false
-" + sections,
+                                             "[realtime]\nenabled = false\n" + sections,
                                          "the test rig");
     if (!r.ok())
         throw std::runtime_error(r.error());
