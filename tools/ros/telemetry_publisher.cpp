@@ -183,7 +183,9 @@ void TelemetryPublisher::changed(const std::string& path, const std::string& ifa
     } else if (path == caracara::dbus::kTeensyPath) {
         if (changes.contains("Orientation"))
             d |= kImu;
-        if (changes.contains("Distances"))
+        // A reading per Teensy poll (each announces its Frames count), changed or not: a range
+        // sensor's subscribers expect a steady stream, not only the changes.
+        if (changes.contains("Distances") || changes.contains("Frames"))
             d |= kRanges;
     }
     mark(d);
@@ -213,6 +215,7 @@ int TelemetryPublisher::on_flush(sd_event_source*, void* userdata) {
         sd_event_now(self->event_, CLOCK_MONOTONIC, &now);
         const bool level_changed = self->levels() != self->last_levels_;
         if (level_changed || now >= self->diagnostics_last_us_ + kDiagnosticsPeriodUs) {
+            self->diagnostics_timer_.reset();
             self->write_diagnostics();
             self->diagnostics_last_us_ = now;
         } else if (!self->diagnostics_timer_) {
