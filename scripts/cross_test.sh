@@ -17,7 +17,7 @@ dir=${1:-$top/build-arm64}
 sudo=""
 [ "$(id -u)" -eq 0 ] || sudo="sudo"
 pkgs=(crossbuild-essential-arm64 qemu-user-static pkgconf:arm64 libsystemd-dev:arm64 libgpiod-dev:arm64
-      libtomlplusplus-dev:arm64 libboost-dev:arm64)
+      libtomlplusplus-dev:arm64 libboost-dev:arm64 cyclonedds-dev:arm64)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

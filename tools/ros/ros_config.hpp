@@ -17,7 +17,8 @@ struct RosConfig {
     uint32_t domain_id = 0;           // ROS_DOMAIN_ID, else 0; the file's domain_id wins
     RangeLayout range_layout = RangeLayout::Humble;
     bool commands = false;            // Wrench and per-thruster commands; kill is always taken
-    std::string interface;            // the one network interface DDS uses ("" = Cyclone's choice)
+    // The one network interface DDS uses: loopback until the config names the tether ("" = Cyclone picks).
+    std::string interface = "lo";
     std::string world_frame = "odom";
     std::string base_frame = "base_link";
     float range_min_m = 0.0f, range_max_m = 65.535f, range_fov_rad = 0.0f;
