@@ -326,6 +326,19 @@ class PublishedTest(RosTestCase):
         self.assertNotIn("pilot", rig.log("caracara-ros"))
 
 
+class JazzyRangeTest(RosTestCase):
+    """range_layout = "jazzy": sensor_msgs/Range with Jazzy's variance, read by a peer built from
+    Jazzy's definitions (a Humble-layout sample would be 4 bytes short for it)."""
+    DISTRO = "jazzy"
+
+    def test_range_in_jazzy_layout(self):
+        samples, _, writers = self.listen(2, {"rt/caracara/range/0": "sensor_msgs/Range"})
+        self.assertEqual(writers["rt/caracara/range/0"]["type"], "sensor_msgs::msg::dds_::Range_")
+        r = samples["rt/caracara/range/0"][-1][1]
+        self.assertEqual(r["variance"], 0.0)
+        self.assertAlmostEqual(r["range"], int(self.rig.sim_teensy("Distances")[0]) / 1000, delta=0.002)
+
+
 class CommandsTest(RosTestCase):
     COMMANDS = True
 

@@ -51,11 +51,9 @@ std::string thruster_name(unsigned i) { return "thruster_" + std::to_string(i); 
 // Jazzy's Range under the ROS type name (its IDL module is "jazzy" only so that both layouts
 // compile into one program); no XTypes type information, as for a type without one.
 dds_topic_descriptor_t jazzy_range_descriptor() {
-    dds_topic_descriptor_t d = jazzy_sensor_msgs_msg_dds__Range__desc;
-    d.m_typename = "sensor_msgs::msg::dds_::Range_";
-    d.type_information = {nullptr, 0};
-    d.type_mapping = {nullptr, 0};
-    return d;
+    const dds_topic_descriptor_t& d = jazzy_sensor_msgs_msg_dds__Range__desc;
+    return {d.m_size, d.m_align, d.m_flagset & ~DDS_TOPIC_XTYPES_METADATA, d.m_nkeys, "sensor_msgs::msg::dds_::Range_",
+            d.m_keys, d.m_nops, d.m_ops, d.m_meta, {nullptr, 0}, {nullptr, 0}, d.restrict_data_representation};
 }
 
 } // namespace
