@@ -1,7 +1,7 @@
 #include "tools/ros/telemetry_publisher.hpp"
 
-#include "core/motor.hpp"
 #include "drivers/protocol/seabotix.hpp"
+#include "tools/ros/ros_conventions.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -17,7 +17,7 @@ namespace {
 
 const std::string kRoot = caracara::dbus::kRootPath;
 const std::string kThrusterPrefix = kRoot + "/thruster/";
-constexpr unsigned kThrusters = 8;
+constexpr unsigned kThrusters = kThrusterJoints;
 constexpr uint64_t kDiagnosticsPeriodUs = 1'000'000; // rqt_robot_monitor's expectation: about 1 Hz
 
 const Value kNone;
@@ -43,10 +43,8 @@ int thruster_of(const std::string& path) {
 // The thruster's reported SPEED byte as a fraction of full thrust (-1..1), 0 when unknown.
 double actual_fraction(const Props& p) {
     const auto m = caracara::speed_to_motor(static_cast<uint8_t>(get(p, "ActualSpeed").unsigned_integer()));
-    return m ? static_cast<double>(*m) / caracara::kMotorMax : 0.0;
+    return m ? motor_fraction(*m) : 0.0;
 }
-
-std::string thruster_name(unsigned i) { return "thruster_" + std::to_string(i); }
 
 // Jazzy's Range under the ROS type name (its IDL module is "jazzy" only so that both layouts
 // compile into one program); no XTypes type information, as for a type without one.
@@ -239,7 +237,7 @@ void TelemetryPublisher::write_state() {
     const std::string state = get(p, "State").s, source = get(p, "KillSource").s;
     if (state_written_ && state == last_state_ && source == last_source_)
         return; // latched topics carry changes only
-    std_msgs_msg_dds__Bool_ killed{state == "killed" || state == "powered-off"};
+    std_msgs_msg_dds__Bool_ killed{state_is_killed(state)};
     dds_write(killed_, &killed);
     std_msgs_msg_dds__String_ s{c_str(state)};
     dds_write(state_, &s);
@@ -254,12 +252,8 @@ void TelemetryPublisher::write_imu_and_tf() {
     const Value& o = get(props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Orientation");
     if (o.items.size() != 3)
         return;
-    // The Teensy's yaw, pitch, roll (Z, Y, X Euler angles in radians) as a quaternion.
-    const double cy = std::cos(o.items[0].number() / 2), sy = std::sin(o.items[0].number() / 2);
-    const double cp = std::cos(o.items[1].number() / 2), sp = std::sin(o.items[1].number() / 2);
-    const double cr = std::cos(o.items[2].number() / 2), sr = std::sin(o.items[2].number() / 2);
-    const geometry_msgs_msg_dds__Quaternion_ q{sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
-                                               cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy};
+    const Quaternion r = quaternion_from_ypr(o.items[0].number(), o.items[1].number(), o.items[2].number());
+    const geometry_msgs_msg_dds__Quaternion_ q{r.x, r.y, r.z, r.w};
     sensor_msgs_msg_dds__Imu_ imu{};
     imu.header = header(config_.base_frame);
     imu.orientation = q;
@@ -283,10 +277,10 @@ void TelemetryPublisher::write_joints() {
     std::vector<double> actual, current, ordered;
     for (unsigned i = 0; i < kThrusters; ++i) {
         const Props& p = props(kThrusterPrefix + std::to_string(i), caracara::dbus::kThrusterIface);
-        names.push_back(thruster_name(i));
+        names.push_back(thruster_joint_name(i));
         actual.push_back(actual_fraction(p));
         current.push_back(get(p, "Current").number());
-        ordered.push_back(static_cast<double>(get(p, "OrderedValue").integer()) / caracara::kMotorMax);
+        ordered.push_back(motor_fraction(static_cast<int32_t>(get(p, "OrderedValue").integer())));
     }
     for (auto& n : names)
         name_ptrs.push_back(c_str(n));
@@ -307,8 +301,8 @@ void TelemetryPublisher::write_ranges() {
         ranges_.push_back(dds_.writer(config_.range_layout == RangeLayout::Jazzy ? &jazzy_range_ : &sensor_msgs_msg_dds__Range__desc,
                                       ros_topic(config_, "range/" + std::to_string(i)), Profile::Default));
     for (std::size_t i = 0; i < d.items.size(); ++i) {
-        const std::string frame = "range_" + std::to_string(i);
-        const float metres = static_cast<float>(d.items[i].unsigned_integer()) / 1000.0f; // reported in mm
+        const std::string frame = range_frame(i);
+        const float metres = range_metres(static_cast<uint32_t>(d.items[i].unsigned_integer()));
         // radiation_type ULTRASOUND (0): the Teensy does not say which kind of sensor it reads.
         if (config_.range_layout == RangeLayout::Jazzy) {
             jazzy_sensor_msgs_msg_dds__Range_ r{header(frame), 0, config_.range_fov_rad, config_.range_min_m,
@@ -358,7 +352,7 @@ void TelemetryPublisher::write_diagnostics() {
         std::string faults;
         for (const Value& f : get(p, "Faults").items)
             faults += (faults.empty() ? "" : ",") + f.s;
-        st.push_back({lv[i], "caracara: " + thruster_name(i),
+        st.push_back({lv[i], "caracara: " + thruster_joint_name(i),
                       lv[i] == 2 ? "unreachable" : faults.empty() ? "ok" : "faults: " + faults,
                       "seabotix@0x" + [&] { char b[8]; std::snprintf(b, sizeof b, "%02x", static_cast<unsigned>(get(p, "Address").unsigned_integer())); return std::string(b); }(),
                       {{"ordered value", std::to_string(get(p, "OrderedValue").integer())},
