@@ -8,6 +8,7 @@ the real caracara-sim and caracarad on a private bus (tests/e2e/harness.py); wha
 from the simulator's wire log. Under CI (CI=true) a missing tool fails the test.
 """
 
+import contextlib
 import hashlib
 import json
 import math
@@ -207,14 +208,25 @@ class RosTestCase(VehicleTestCase):
                 writers[o["writer"]] = o
         return samples, participants, writers
 
-    def publish(self, topic, type_, msg, count=1, hz=20.0, hold=False):
+    def publish(self, topic, type_, msg, count=1, hz=20.0):
         hex_ = self.codec.encode(type_, msg, self.DISTRO)
-        argv = [self.peer, "publish", topic, type_, hex_, str(count), str(hz)] + (["hold"] if hold else [])
-        if hold:
-            return subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        r = subprocess.run(argv, capture_output=True, text=True, timeout=60)
+        r = subprocess.run([self.peer, "publish", topic, type_, hex_, str(count), str(hz)], capture_output=True,
+                           text=True, timeout=60)
         self.assertEqual(r.returncode, 0, r.stderr)
         return r
+
+    @contextlib.contextmanager
+    def driving(self, topic, type_, msg):
+        """The peer publishing `msg` at 50 Hz (as a pilot's stack would) until the block ends,
+        then SIGKILLed: a writer that goes away without a word."""
+        hex_ = self.codec.encode(type_, msg, self.DISTRO)
+        p = subprocess.Popen([self.peer, "publish", topic, type_, hex_, "1000000", "50", "hold"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            yield p
+        finally:
+            p.send_signal(signal.SIGKILL)
+            p.wait(10)
 
 
 class BytesTest(unittest.TestCase):
@@ -416,28 +428,16 @@ class CommandsTest(RosTestCase):
                 rig.wait_sim_zero()
                 w = {"force": {"x": 0, "y": 0, "z": 0}, "torque": {"x": 0, "y": 0, "z": 0}}
                 w[part][comp] = 0.4
-                p = self.publish("rt/caracara/cmd_wrench", "geometry_msgs/Wrench", w, count=1000, hz=50, hold=True)
-                try:
+                with self.driving("rt/caracara/cmd_wrench", "geometry_msgs/Wrench", w):
                     rig.wait_sim_speeds(expected)
-                finally:
-                    p.kill()
-                    p.wait(10)
-                    p.stdout.close()
-                    p.stderr.close()
                 rig.wait_sim_zero()
 
     def test_per_thruster_values(self):
         rig = self.rig
         data = [0.5, -0.5, 0, 0, 0.2, 0, 0, -0.2]  # whole motor values: 4425, 1770
-        p = self.publish("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
-                         {"layout": {"dim": [], "data_offset": 0}, "data": data}, count=1000, hz=50, hold=True)
-        try:
+        with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
+                          {"layout": {"dim": [], "data_offset": 0}, "data": data}):
             rig.wait_sim_speeds([speed_byte(round(v * MOTOR_MAX)) for v in data])
-        finally:
-            p.kill()
-            p.wait(10)
-            p.stdout.close()
-            p.stderr.close()
         rig.wait_sim_zero()
 
     def test_bad_messages_refused_by_name(self):
@@ -465,17 +465,11 @@ class CommandsTest(RosTestCase):
     def test_peer_killed_zeros_within_the_client_loss_bound(self):
         rig = self.rig
         data = [0.3] * 2 + [0] * 6
-        p = self.publish("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
-                         {"layout": {"dim": [], "data_offset": 0}, "data": data}, count=100000, hz=50, hold=True)
-        try:
+        with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
+                          {"layout": {"dim": [], "data_offset": 0}, "data": data}):
             rig.wait_sim_speeds([speed_byte(round(v * MOTOR_MAX)) for v in data])
             since = rig.wire_next()
-        finally:
-            killed_at = time.monotonic_ns()
-            p.send_signal(signal.SIGKILL)
-            p.wait(10)
-            p.stdout.close()
-            p.stderr.close()
+            killed_at = time.monotonic_ns()  # the block's end SIGKILLs the peer
         rig.wait_sim_zero()
         log = rig.wire_log(since)[1]
         # The first order of zero to each thruster that was moving: the last of them is when the

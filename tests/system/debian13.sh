@@ -161,8 +161,8 @@ echo "== build (scripts/build.sh, CARACARA_WERROR=ON)"
 "$SRC/scripts/build.sh" "$BUILD" -DCARACARA_WERROR=ON
 grep -E '^(GPIODCXX_VERSION|Catch2_DIR|TOMLPP_VERSION|SYSTEMD_VERSION)' "$BUILD/CMakeCache.txt" | sed 's/^/   /'
 # Nor bridge: its npm packages come from the registry; the host's suites run it.
-echo "== ctest (all but the tests labelled system, kernel or bridge)"
-CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel|bridge'
+echo "== ctest (all but the tests labelled system, kernel, bridge or ros)"
+CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel|bridge|ros'
 echo "== Debian packages (scripts/package.sh, nocheck: the suite just ran)"
 DEB_BUILD_OPTIONS=nocheck "$SRC/scripts/package.sh" native "$DEBS"
 SCRIPT

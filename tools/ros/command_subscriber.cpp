@@ -15,6 +15,21 @@ namespace caracara::ros {
 namespace {
 
 constexpr int kBatch = 16;
+// Takes all that `reader` holds, a batch at a time, and hands each valid sample with its writer to `use`.
+template <typename T, typename Use>
+void take_each(dds_entity_t reader, Use use) {
+    for (dds_return_t n = kBatch; n == kBatch;) {
+        void* samples[kBatch] = {};
+        dds_sample_info_t info[kBatch];
+        n = dds_take(reader, samples, info, kBatch, kBatch);
+        for (dds_return_t i = 0; i < n; ++i)
+            if (info[i].valid_data)
+                use(*static_cast<const T*>(samples[i]), info[i].publication_handle);
+        if (n > 0)
+            dds_return_loan(reader, samples, n);
+    }
+}
+
 std::string writer_name(dds_instance_handle_t h) {
     char b[24];
     std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h));
@@ -83,14 +98,8 @@ void CommandSubscriber::drain() {
 }
 
 void CommandSubscriber::take_kills() {
-    void* samples[kBatch] = {};
-    dds_sample_info_t info[kBatch];
-    const dds_return_t n = dds_take(kill_reader_, samples, info, kBatch, kBatch);
     bool any = false;
-    for (dds_return_t i = 0; i < n; ++i)
-        any = any || info[i].valid_data;
-    if (n > 0)
-        dds_return_loan(kill_reader_, samples, n);
+    take_each<std_msgs_msg_dds__Empty_>(kill_reader_, [&](const auto&, dds_instance_handle_t) { any = true; });
     if (any) {
         std::fprintf(stderr, "caracara-ros: kill from DDS\n");
         kill_();
@@ -113,50 +122,34 @@ Pilot* CommandSubscriber::pilot(dds_instance_handle_t writer) {
 }
 
 void CommandSubscriber::take_wrenches() {
-    void* samples[kBatch] = {};
-    dds_sample_info_t info[kBatch];
-    const dds_return_t n = dds_take(wrench_reader_, samples, info, kBatch, kBatch);
-    for (dds_return_t i = 0; i < n; ++i) {
-        if (!info[i].valid_data)
-            continue;
-        const auto* w = static_cast<const geometry_msgs_msg_dds__Wrench_*>(samples[i]);
+    take_each<geometry_msgs_msg_dds__Wrench_>(wrench_reader_, [&](const auto& w, dds_instance_handle_t writer) {
         // force x, y, z -> surge, sway, heave; torque z, y, x -> yaw, pitch, roll (SetMotion's
         // order). Range and NaN are the daemon's to refuse, by name.
-        if (Pilot* p = pilot(info[i].publication_handle))
-            p->set_motion({w->force.x, w->force.y, w->force.z, w->torque.z, w->torque.y, w->torque.x});
-    }
-    if (n > 0)
-        dds_return_loan(wrench_reader_, samples, n);
+        if (Pilot* p = pilot(writer))
+            p->set_motion({w.force.x, w.force.y, w.force.z, w.torque.z, w.torque.y, w.torque.x});
+    });
 }
 
 void CommandSubscriber::take_thrusts() {
-    void* samples[kBatch] = {};
-    dds_sample_info_t info[kBatch];
-    const dds_return_t n = dds_take(thrust_reader_, samples, info, kBatch, kBatch);
-    for (dds_return_t i = 0; i < n; ++i) {
-        if (!info[i].valid_data)
-            continue;
-        const auto* a = static_cast<const std_msgs_msg_dds__Float64MultiArray_*>(samples[i]);
+    take_each<std_msgs_msg_dds__Float64MultiArray_>(thrust_reader_, [&](const auto& a, dds_instance_handle_t writer) {
         // Each value -1..1 of full thrust becomes the motor value round(v * kMotorMax); the daemon
-        // refuses a wrong count or a value out of range by name. NaN has no motor value: refused here.
+        // refuses a wrong count or a value out of range by name (a value past +-2 is sent as
+        // +-2 * kMotorMax, out of range all the same). NaN has no motor value: refused here.
         std::vector<int32_t> values;
-        bool nan = false;
-        for (uint32_t k = 0; k < a->data._length; ++k) {
-            const double v = a->data._buffer[k];
-            nan = nan || !std::isfinite(v);
-            values.push_back(std::isfinite(v) && std::fabs(v) < 2.0 ? static_cast<int32_t>(std::lround(v * caracara::kMotorMax))
-                                                                    : (v > 0 ? 2 * caracara::kMotorMax : -2 * caracara::kMotorMax));
+        for (uint32_t k = 0; k < a.data._length; ++k) {
+            const double v = a.data._buffer[k];
+            if (!std::isfinite(v)) {
+                std::fprintf(stderr, "caracara-ros: cmd_thrust from writer %s refused: "
+                                     "org.caracara.Vehicle1.Error.InvalidValue: value %u is not a number\n",
+                             writer_name(writer).c_str(), k);
+                return;
+            }
+            values.push_back(std::fabs(v) < 2.0 ? static_cast<int32_t>(std::lround(v * caracara::kMotorMax))
+                                                : (v > 0 ? 2 : -2) * caracara::kMotorMax);
         }
-        if (nan) {
-            std::fprintf(stderr, "caracara-ros: cmd_thrust from writer %s refused: org.caracara.Vehicle1.Error.InvalidValue: "
-                                 "a value is not a number\n", writer_name(info[i].publication_handle).c_str());
-            continue;
-        }
-        if (Pilot* p = pilot(info[i].publication_handle))
+        if (Pilot* p = pilot(writer))
             p->set_thrust(values);
-    }
-    if (n > 0)
-        dds_return_loan(thrust_reader_, samples, n);
+    });
 }
 
 void CommandSubscriber::drop_unmatched() {
