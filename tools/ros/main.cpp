@@ -37,10 +37,16 @@ int on_signal(sd_event_source* s, const signalfd_siginfo*, void*) {
     return sd_event_exit(sd_event_source_get_event(s), 0);
 }
 
-void kill_over(sd_bus* bus) {
+// Kill() on the reading connection, sent at once. Without one (caracarad restarting, the
+// connection being made again) on a connection of its own, so a kill is never dropped.
+void kill_over(sd_bus* bus, const caracara::dbus::BusChoice& choice) {
+    caracara::dbus::BusPtr own;
     if (!bus) {
-        std::fprintf(stderr, "caracara-ros: kill not sent: not connected to caracarad\n");
-        return;
+        if (const int r = caracara::dbus::open_bus(choice, "caracara-ros-kill", own); r < 0) {
+            std::fprintf(stderr, "caracara-ros: kill not sent: cannot reach the bus: %s\n", std::strerror(-r));
+            return;
+        }
+        bus = own.get();
     }
     sd_bus_message* m = nullptr;
     if (sd_bus_message_new_method_call(bus, &m, caracara::dbus::kBusName, caracara::dbus::kRootPath,
@@ -51,7 +57,7 @@ void kill_over(sd_bus* bus) {
     sd_bus_message_unref(m);
     if (r < 0)
         std::fprintf(stderr, "caracara-ros: kill not sent: %s\n", std::strerror(-r));
-    sd_bus_flush(bus); // now, not at the next turn of the loop
+    sd_bus_flush(bus); // now, not at the next turn of the loop; on its own connection, before it closes
 }
 
 } // namespace
@@ -105,7 +111,7 @@ int main(int argc, char** argv) {
     try {
         caracara::ros::DdsParticipant dds(config);
         caracara::ros::TelemetryPublisher telemetry(event.get(), dds, config);
-        caracara::ros::CommandSubscriber commands(event.get(), dds, config, [&] { kill_over(telemetry.bus()); });
+        caracara::ros::CommandSubscriber commands(event.get(), dds, config, [&] { kill_over(telemetry.bus(), config.bus); });
         telemetry.start();
         std::fprintf(stderr, "caracara-ros: domain %u, namespace %s, commands %s\n", config.domain_id,
                      config.ros_namespace.empty() ? "/" : config.ros_namespace.c_str(), config.commands ? "on" : "off");
