@@ -27,7 +27,7 @@ sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
 
 import harness  # noqa: E402
 from bounds import CLIENT_LOSS_ZERO_MS_MAX  # noqa: E402
-from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, poll, speed_byte  # noqa: E402
+from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, angle_diff, poll, speed_byte  # noqa: E402
 from test_failsafes import kill_edges, orders  # noqa: E402
 
 NPM_CACHE = "/var/cache/caracara-npm"
@@ -190,14 +190,20 @@ class RosTestCase(VehicleTestCase):
         if code != 0:
             raise AssertionError("caracara-ros exited with %s on SIGTERM:\n%s" % (code, cls.rig.log("caracara-ros")))
 
-    def listen(self, seconds, topics=PUBLISHED):
-        """The peer's view for `seconds`: (samples by topic, decoded, with time), participants, writers."""
+    def listen(self, seconds, topics=PUBLISHED, during=None):
+        """The peer's view for `seconds`: (samples by topic, decoded, with time), participants,
+        writers. `during` is called every 20 ms while the peer listens."""
         args = ["%s=%s" % (t, ty) for t, ty in topics.items()]
-        r = subprocess.run([self.peer, "listen", str(seconds)] + args, capture_output=True, text=True,
-                           timeout=seconds + 30)
-        self.assertEqual(r.returncode, 0, r.stderr)
+        p = subprocess.Popen([self.peer, "listen", str(seconds)] + args, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+        if during:
+            while p.poll() is None:
+                during()
+                time.sleep(0.02)
+        out, err = p.communicate(timeout=seconds + 30)
+        self.assertEqual(p.returncode, 0, err)
         samples, participants, writers = {}, [], {}
-        for line in r.stdout.splitlines():
+        for line in out.splitlines():
             o = json.loads(line)
             if "topic" in o:
                 msg = self.codec.decode(topics[o["topic"]], o["cdr"], self.DISTRO)
@@ -328,7 +334,11 @@ class PublishedTest(RosTestCase):
         values = [4425, -4425, 0, 0, 0, 0, 0, 0]
         rig.thrust(values)
         rig.wait_sim_speeds([speed_byte(v) for v in values])
-        samples, _, _ = self.listen(3)
+        # The simulator's attitude through the window (the body turns under this thrust), to
+        # compare each Imu sample with the simulator's attitude at its stamp.
+        attitude = []
+        samples, _, _ = self.listen(3, during=lambda: attitude.append(
+            (time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")])))
         for topic in PUBLISHED:
             self.assertIn(topic, samples, "nothing received on " + topic)
         last = {t: s[-1][1] for t, s in samples.items()}
@@ -344,14 +354,18 @@ class PublishedTest(RosTestCase):
         ordered = last["rt/caracara/thrusters/ordered"]["velocity"]
         self.assertEqual([round(v * MOTOR_MAX) for v in ordered], rig.motor_values())
         # Imu and /tf: the simulator's yaw, pitch, roll as a quaternion; REP 145's unknown fields.
-        yaw, pitch, roll = [float(x) for x in rig.sim_teensy("Orientation")]
+        self.assertGreater(len(attitude), 10)
+        for _, imu in samples["rt/caracara/imu"]:
+            stamp = imu["header"]["stamp"]["sec"] * 10 ** 9 + imu["header"]["stamp"]["nanosec"]
+            yaw, pitch, roll = min(attitude, key=lambda a: abs(a[0] - stamp))[1]
+            q = imu["orientation"]
+            self.assertLess(abs(angle_diff(math.atan2(2 * (q["w"] * q["z"] + q["x"] * q["y"]),
+                                                      1 - 2 * (q["y"] ** 2 + q["z"] ** 2)), yaw)), 0.02)
+            self.assertAlmostEqual(math.asin(max(-1, min(1, 2 * (q["w"] * q["y"] - q["z"] * q["x"])))), pitch,
+                                   delta=0.02)
+            self.assertAlmostEqual(math.atan2(2 * (q["w"] * q["x"] + q["y"] * q["z"]),
+                                              1 - 2 * (q["x"] ** 2 + q["y"] ** 2)), roll, delta=0.02)
         imu = last["rt/caracara/imu"]
-        q = imu["orientation"]
-        self.assertAlmostEqual(math.atan2(2 * (q["w"] * q["z"] + q["x"] * q["y"]),
-                                          1 - 2 * (q["y"] ** 2 + q["z"] ** 2)), yaw, delta=0.05)
-        self.assertAlmostEqual(math.asin(max(-1, min(1, 2 * (q["w"] * q["y"] - q["z"] * q["x"])))), pitch, delta=0.05)
-        self.assertAlmostEqual(math.atan2(2 * (q["w"] * q["x"] + q["y"] * q["z"]),
-                                          1 - 2 * (q["x"] ** 2 + q["y"] ** 2)), roll, delta=0.05)
         self.assertEqual(imu["angular_velocity_covariance"][0], -1)
         self.assertEqual(imu["linear_acceleration_covariance"][0], -1)
         tf = last["rt/tf"]["transforms"][0]
