@@ -27,6 +27,7 @@ const Value& get(const Props& p, const char* name) {
 }
 char* c_str(const std::string& s) { return const_cast<char*>(s.c_str()); }
 
+// The header's frame_id points into `frame`, which must outlive the message's write.
 std_msgs_msg_dds__Header_ header(const std::string& frame) {
     timespec t{};
     clock_gettime(CLOCK_REALTIME, &t);
@@ -393,7 +394,8 @@ void TelemetryPublisher::write_diagnostics() {
                        {n, n, kvs[i].data(), false}});
     }
     const auto n = static_cast<uint32_t>(out.size());
-    diagnostic_msgs_msg_dds__DiagnosticArray_ a{header(""), {n, n, out.data(), false}};
+    static const std::string kNoFrame; // diagnostics have no frame; header() keeps a pointer into it
+    diagnostic_msgs_msg_dds__DiagnosticArray_ a{header(kNoFrame), {n, n, out.data(), false}};
     dds_write(diagnostics_, &a);
     if (lv != last_levels_)
         for (std::size_t i = 0; i < lv.size() && i < st.size(); ++i)
