@@ -194,13 +194,17 @@ class RosTestCase(VehicleTestCase):
         """The peer's view for `seconds`: (samples by topic, decoded, with time), participants,
         writers. `during` is called every 20 ms while the peer listens."""
         args = ["%s=%s" % (t, ty) for t, ty in topics.items()]
-        p = subprocess.Popen([self.peer, "listen", str(seconds)] + args, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True)
-        if during:
+        # Into files, not pipes: nothing reads a pipe while `during` runs, and a full one would
+        # stop the peer.
+        with tempfile.TemporaryFile("w+") as out_f, tempfile.TemporaryFile("w+") as err_f:
+            p = subprocess.Popen([self.peer, "listen", str(seconds)] + args, stdout=out_f, stderr=err_f, text=True)
             while p.poll() is None:
-                during()
+                if during:
+                    during()
                 time.sleep(0.02)
-        out, err = p.communicate(timeout=seconds + 30)
+            out_f.seek(0)
+            err_f.seek(0)
+            out, err = out_f.read(), err_f.read()
         self.assertEqual(p.returncode, 0, err)
         samples, participants, writers = {}, [], {}
         for line in out.splitlines():
