@@ -94,7 +94,7 @@ grep -E '^[0-9]+% tests passed|^Total Test time' "$log" || true
 say "built in $(($(date +%s) - t1)) s"
 changes=caracarad_${version}_$arch.changes
 # Only this build's packages for this architecture in OUTDIR (run.sh --debs takes the newest).
-rm -f "$out"/caracara{d,-sim}{,-dbgsym}_*_"$arch".deb "$out"/caracarad_*_"$arch".{changes,buildinfo}
+rm -f "$out"/caracara{d,-sim,-ros}{,-dbgsym}_*_"$arch".deb "$out"/caracarad_*_"$arch".{changes,buildinfo}
 for f in "$work"/*_"$version"_"$arch".*; do
   mv -f "$f" "$out/"
 done

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The one version: CMake's project(VERSION), given as the first argument, is what
-caracarad, caracaractl, caracara-sim and caracara-bridge --version print, what the
+caracarad, caracaractl, caracara-sim, caracara-bridge and caracara-ros --version print, what the
 manual pages' .TH lines carry, the newest released debian/changelog entry and the newest
 CHANGELOG.md section.
 
@@ -17,14 +17,15 @@ emulator = shlex.split(os.environ.get("CARACARA_TEST_EMULATOR", ""))
 problems = []
 
 for program, path in (("caracarad", "daemon/caracarad"), ("caracaractl", "tools/caracaractl"),
-                      ("caracara-sim", "sim/caracara-sim"), ("caracara-bridge", "tools/bridge/caracara-bridge")):
+                      ("caracara-sim", "sim/caracara-sim"), ("caracara-bridge", "tools/bridge/caracara-bridge"),
+                      ("caracara-ros", "tools/ros/caracara-ros")):
     r = subprocess.run(emulator + [os.path.join(build, path), "--version"], capture_output=True,
                        text=True, timeout=60)
     want = f"{program} {version}\n"
     if r.returncode != 0 or r.stdout != want:
         problems.append(f"{program} --version: exit {r.returncode}, {r.stdout!r} (want {want!r})")
 
-for page in ("caracarad.8", "caracaractl.1", "caracara-sim.1", "caracara-bridge.1"):
+for page in ("caracarad.8", "caracaractl.1", "caracara-sim.1", "caracara-bridge.1", "caracara-ros.1"):
     with open(os.path.join(build, "docs/man", page)) as f:
         th = f.readline()
     if f'"caracarad {version}"' not in th:

@@ -37,9 +37,9 @@ build_timeout_s=${CARACARA_DEBIAN13_BUILD_TIMEOUT:-1500}
 # tools, and what the kernel test's guest runs in this root: insmod, i2c-tools.
 packages=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev libcatch2-dev
           libtomlplusplus-dev libboost-dev nlohmann-json3-dev dbus python3 python3-dbus python3-gi python3-matplotlib
-          systemd dpkg-dev debhelper lintian kmod i2c-tools openssh-client ccache)
+          systemd dpkg-dev debhelper lintian kmod i2c-tools openssh-client ccache cyclonedds-dev cyclonedds-tools)
 # Bump when the way the cached root is made changes.
-recipe=2
+recipe=3
 
 say() { echo "debian13: $*"; }
 die() { echo "debian13: FAIL: $*" >&2; exit 1; }
@@ -161,8 +161,8 @@ echo "== build (scripts/build.sh, CARACARA_WERROR=ON)"
 "$SRC/scripts/build.sh" "$BUILD" -DCARACARA_WERROR=ON
 grep -E '^(GPIODCXX_VERSION|Catch2_DIR|TOMLPP_VERSION|SYSTEMD_VERSION)' "$BUILD/CMakeCache.txt" | sed 's/^/   /'
 # Nor bridge: its npm packages come from the registry; the host's suites run it.
-echo "== ctest (all but the tests labelled system, kernel or bridge)"
-CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel|bridge'
+echo "== ctest (all but the tests labelled system, kernel, bridge or ros)"
+CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel|bridge|ros'
 echo "== Debian packages (scripts/package.sh, nocheck: the suite just ran)"
 DEB_BUILD_OPTIONS=nocheck "$SRC/scripts/package.sh" native "$DEBS"
 SCRIPT

@@ -7,6 +7,7 @@
 #include "tools/caracaractl/render.hpp"
 #include "tools/client/client.hpp"
 #include "tools/foxglove/dive_mcap.hpp"
+#include "tools/foxglove/dive_ros_mcap.hpp"
 #include "tools/foxglove/dive_summary.hpp"
 
 #include <cerrno>
@@ -41,6 +42,7 @@ struct DiveOptions {
     bool events = false;
     bool partial = false;
     bool mcap = false;          // export --format mcap
+    bool cdr = false;           // --encoding cdr: the ROS 2 topics for rosbag2 (docs/ros2.md)
     std::vector<std::string> positional;
 };
 
@@ -67,6 +69,12 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
                 usage("--format takes csv or mcap, not '" + f + "'");
             o.mcap = f == "mcap";
         }
+        else if (a == "--encoding" && name == "export") {
+            const std::string e = value("--encoding");
+            if (e != "json" && e != "cdr")
+                usage("--encoding takes json or cdr, not '" + e + "'");
+            o.cdr = e == "cdr";
+        }
         else if (a == "--partial" && name != "dives")
             o.partial = true;
         else if (a.starts_with("--"))
@@ -76,6 +84,8 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
     }
     if (name == "export" && o.mcap && o.events)
         usage("--events applies to --format csv (in MCAP the events are the /events channel)");
+    if (name == "export" && !o.mcap && o.cdr)
+        usage("--encoding applies to --format mcap");
     if (name == "export" && !o.mcap && !o.out.empty())
         usage("--out applies to --format mcap");
     const std::size_t want = name == "dives" ? 0 : 1;
@@ -230,11 +240,12 @@ int cmd_dives(const DiveOptions& o) {
     return kExitOk;
 }
 
-// The dive as MCAP on the live bridge's channels, to --out or to stdout when it is no terminal.
-int export_mcap(const dive::Dive& d, const std::string& out) {
+// The dive as MCAP on the live bridge's channels (JSON) or caracara-ros's topics (CDR), to --out
+// or to stdout when it is no terminal.
+int export_mcap(const dive::Dive& d, const std::string& out, bool cdr) {
     if (out.empty() && ::isatty(STDOUT_FILENO))
         usage("MCAP is binary: give --out FILE or redirect the output");
-    const std::vector<uint8_t> bytes = caracara::foxglove::dive_to_mcap(d);
+    const std::vector<uint8_t> bytes = cdr ? caracara::foxglove::dive_to_ros_mcap(d) : caracara::foxglove::dive_to_mcap(d);
     std::ofstream file;
     if (!out.empty()) {
         file.open(out, std::ios::binary | std::ios::trunc);
@@ -252,7 +263,7 @@ int export_mcap(const dive::Dive& d, const std::string& out) {
 int cmd_export(const DiveOptions& o) {
     const dive::Dive d = load(resolve(o), o.partial);
     if (o.mcap)
-        return export_mcap(d, o.out);
+        return export_mcap(d, o.out, o.cdr);
     if (o.events)
         write_events(std::cout, d);
     else
@@ -347,6 +358,9 @@ const char* dive_help() {
            "  export DIVE --format mcap [--out FILE] [--dir DIR] [--partial]\n"
            "                                   Write the dive as MCAP on the channels of\n"
            "                                   caracara-bridge, for Foxglove (docs/foxglove.md)\n"
+           "  export DIVE --format mcap --encoding cdr [--out FILE] [--dir DIR] [--partial]\n"
+           "                                   Write it as caracara-ros's ROS 2 topics (CDR, ros2msg\n"
+           "                                   schemas) for rosbag2: ros2 bag play (docs/ros2.md)\n"
            "  DIVE is a path, a file name in DIR, or \"last\". A truncated or corrupt file is refused\n"
            "  (status 1, the problem and its byte offset named); --partial uses what came before it.\n";
 }

@@ -1,0 +1,508 @@
+"""caracara-ros against a second DDS vendor: a Fast DDS peer (peer.cpp) whose types fastddsgen
+generated from the ROS 2 message definitions as published (@foxglove/rosmsg-msgs-common), never
+from the project's IDL; CDR bytes checked against @foxglove/rosmsg2-serialization (cdr.mjs).
+
+Runs in a private network namespace (ros.cmake starts it under `unshare --net`): the loopback
+interface with multicast on, and nothing else, so no packet leaves the machine. The vehicle is
+the real caracara-sim and caracarad on a private bus (tests/e2e/harness.py); what moved is read
+from the simulator's wire log. Under CI (CI=true) a missing tool fails the test.
+"""
+
+import contextlib
+import hashlib
+import json
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
+
+import harness  # noqa: E402
+from bounds import CLIENT_LOSS_ZERO_MS_MAX  # noqa: E402
+from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, angle_diff, poll, speed_byte  # noqa: E402
+from test_failsafes import kill_edges, orders  # noqa: E402
+
+NPM_CACHE = "/var/cache/caracara-npm"
+CI = os.environ.get("CI") == "true"
+# Every type caracara-ros speaks, with the topic it is on.
+TYPES = ["sensor_msgs/Imu", "sensor_msgs/JointState", "sensor_msgs/Range", "diagnostic_msgs/DiagnosticArray",
+         "std_msgs/Bool", "std_msgs/String", "std_msgs/Empty", "std_msgs/Float64MultiArray", "geometry_msgs/Wrench",
+         "tf2_msgs/TFMessage"]
+PUBLISHED = {"rt/caracara/imu": "sensor_msgs/Imu", "rt/caracara/joint_states": "sensor_msgs/JointState",
+             "rt/caracara/thrusters/ordered": "sensor_msgs/JointState", "rt/caracara/range/0": "sensor_msgs/Range",
+             "rt/diagnostics": "diagnostic_msgs/DiagnosticArray", "rt/caracara/killed": "std_msgs/Bool",
+             "rt/caracara/state": "std_msgs/String", "rt/caracara/kill_source": "std_msgs/String",
+             "rt/tf": "tf2_msgs/TFMessage"}
+MOTOR_MAX = 8850
+
+
+def missing(what):
+    if CI:
+        raise AssertionError("cannot run under CI: " + what)
+    raise unittest.SkipTest(what)
+
+
+def npm_ci():
+    if not shutil.which("node") or not shutil.which("npm"):
+        missing("node and npm are needed (scripts/deps.sh)")
+    stamp = os.path.join(HERE, "node_modules", ".package-lock.json")
+    lock = os.path.join(HERE, "package-lock.json")
+    if os.path.exists(stamp) and os.path.getmtime(stamp) >= os.path.getmtime(lock):
+        return
+    subprocess.run(["npm", "ci", "--cache", NPM_CACHE, "--no-audit", "--no-fund", "--prefer-offline"], cwd=HERE,
+                   check=True, stdout=subprocess.DEVNULL)
+
+
+def build_peer(distro):
+    """The Fast DDS peer for one distro's definitions, built once per source (in the build tree)."""
+    for tool in ("fastddsgen", "g++"):
+        if not shutil.which(tool):
+            missing(tool + " is needed (scripts/deps.sh: fastddsgen, libfastrtps-dev)")
+    if not os.path.exists("/usr/include/fastdds/dds/domain/DomainParticipant.hpp"):
+        missing("libfastrtps-dev is needed (scripts/deps.sh)")
+    npm_ci()
+    idl = subprocess.run(["node", "msg_to_idl.mjs", distro] + TYPES, cwd=HERE, check=True, capture_output=True,
+                         text=True).stdout
+    with open(os.path.join(HERE, "peer.cpp")) as f:
+        src = f.read()
+    key = hashlib.sha256((idl + src).encode()).hexdigest()[:16]
+    out = os.path.join(BUILD_DIR, "tests", "ros", "peer-%s-%s" % (distro, key))
+    exe = os.path.join(out, "peer")
+    if os.path.exists(exe):
+        return exe
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "ros_h.idl"), "w") as f:
+        f.write(idl)
+    subprocess.run(["fastddsgen", "-replace", "-d", out, os.path.join(out, "ros_h.idl")], check=True,
+                   stdout=subprocess.DEVNULL)
+    subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, os.path.join(HERE, "peer.cpp"),
+                    os.path.join(out, "ros_h.cxx"), os.path.join(out, "ros_hPubSubTypes.cxx"),
+                    "-lfastrtps", "-lfastcdr", "-o", exe + ".tmp"], check=True)
+    os.rename(exe + ".tmp", exe)
+    return exe
+
+
+class Codec:
+    """cdr.mjs: @foxglove/rosmsg2-serialization, one request a line."""
+
+    def __init__(self):
+        self.p = subprocess.Popen(["node", "cdr.mjs"], cwd=HERE, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                  text=True)
+
+    def ask(self, req):
+        self.p.stdin.write(json.dumps(req) + "\n")
+        self.p.stdin.flush()
+        return json.loads(self.p.stdout.readline(), parse_constant=lambda c: float(c))
+
+    def encode(self, type_, msg, distro="humble"):
+        return self.ask({"op": "encode", "distro": distro, "type": type_, "msg": msg})["hex"]
+
+    def decode(self, type_, hex_, distro="humble"):
+        return self.ask({"op": "decode", "distro": distro, "type": type_, "hex": hex_})["msg"]
+
+    def close(self):
+        self.p.stdin.close()
+        self.p.wait(10)
+        self.p.stdout.close()
+
+
+def network_is_private():
+    """Inside the namespace ros.cmake made: only the loopback interface, multicast on, routed."""
+    links = subprocess.run(["ip", "-o", "link"], capture_output=True, text=True, check=True).stdout.splitlines()
+    names = [line.split(":")[1].strip() for line in links]
+    if names != ["lo"]:
+        if CI:
+            raise AssertionError("not in a private network namespace (interfaces %s)" % names)
+        raise unittest.SkipTest("run through ctest (ros.cmake starts it under unshare --net)")
+    subprocess.run(["ip", "link", "set", "lo", "up", "multicast", "on"], check=True)
+    subprocess.run(["ip", "route", "replace", "224.0.0.0/4", "dev", "lo"], check=True)
+
+
+def fixed_sample(type_):
+    """A fixed sample of each type, every field set to something other than its default."""
+    h = {"stamp": {"sec": 1700000000, "nanosec": 123456789}, "frame_id": "base_link"}
+    q = {"x": 0.1, "y": -0.2, "z": 0.3, "w": 0.9}
+    v = {"x": 1.5, "y": -2.5, "z": 3.25}
+    return {
+        "sensor_msgs/Imu": {"header": h, "orientation": q, "orientation_covariance": [0.0] * 9,
+                            "angular_velocity": v, "angular_velocity_covariance": [-1.0] + [0.0] * 8,
+                            "linear_acceleration": v, "linear_acceleration_covariance": [-1.0] + [0.0] * 8},
+        "sensor_msgs/JointState": {"header": h, "name": ["thruster_%d" % i for i in range(8)], "position": [],
+                                   "velocity": [i / 8 - 0.5 for i in range(8)], "effort": [0.25 * i for i in range(8)]},
+        "sensor_msgs/Range": {"header": h, "radiation_type": 0, "field_of_view": 0.5, "min_range": 0.0,
+                              "max_range": 65.535, "range": 1.25, "variance": 0.0},
+        "diagnostic_msgs/DiagnosticArray": {"header": h, "status": [
+            {"level": 1, "name": "caracara: thruster_0", "message": "faults: overcurrent", "hardware_id": "seabotix@0x52",
+             "values": [{"key": "current A", "value": "2.5"}]},
+            {"level": 0, "name": "caracara: teensy", "message": "online", "hardware_id": "teensy", "values": []}]},
+        "std_msgs/Bool": {"data": True},
+        "std_msgs/String": {"data": "killed"},
+        "std_msgs/Empty": {},
+        "std_msgs/Float64MultiArray": {"layout": {"dim": [{"label": "thrusters", "size": 8, "stride": 8}],
+                                                  "data_offset": 0}, "data": [0.125 * i - 0.5 for i in range(8)]},
+        "geometry_msgs/Wrench": {"force": v, "torque": {"x": -0.25, "y": 0.5, "z": -0.75}},
+        "tf2_msgs/TFMessage": {"transforms": [{"header": h, "child_frame_id": "base_link",
+                                               "transform": {"translation": v, "rotation": q}}]},
+    }[type_]
+
+
+def nonzero_orders(log):
+    """The thruster orders of the log that are not zero."""
+    return [e for e, _, speed in orders(log) if speed != ZERO]
+
+
+class RosTestCase(VehicleTestCase):
+    """One rig, one caracara-ros (commands as COMMANDS says) per class."""
+    COMMANDS = False
+    DISTRO = "humble"
+    EXTRA_CONFIG = {"failsafe": {"pilot-lost": {"action": "kill", "persistence_ms": 60000}}}
+
+    @classmethod
+    def setUpClass(cls):
+        network_is_private()
+        cls.peer = build_peer(cls.DISTRO)
+        super().setUpClass()
+        cls.codec = Codec()
+        cls.addClassCleanup(cls.codec.close)
+        conf = os.path.join(cls.rig.dir, "ros.toml")
+        with open(conf, "w") as f:
+            f.write('[ros]\nnamespace = "/caracara"\ncommands = %s\nrange_layout = "%s"\n[network]\ninterface = "lo"\n'
+                    % ("true" if cls.COMMANDS else "false", cls.DISTRO))
+        cls.ros = cls.rig._spawn("caracara-ros", harness.EMULATOR + [
+            os.path.join(BUILD_DIR, "tools", "ros", "caracara-ros"), "--bus-address", cls.rig.address, "--config", conf])
+        cls.addClassCleanup(cls.stop_ros)
+        poll(lambda: "commands" in cls.rig.log("caracara-ros") or cls.ros.poll() is not None, 20,
+             message="caracara-ros did not start")
+        if cls.ros.poll() is not None:
+            raise AssertionError("caracara-ros exited: " + cls.rig.log("caracara-ros"))
+
+    @classmethod
+    def stop_ros(cls):
+        code = cls.rig.terminate("caracara-ros")
+        if code != 0:
+            raise AssertionError("caracara-ros exited with %s on SIGTERM:\n%s" % (code, cls.rig.log("caracara-ros")))
+
+    def listen(self, seconds, topics=PUBLISHED, during=None):
+        """The peer's view for `seconds`: (samples by topic, decoded, with time), participants,
+        writers. `during` is called every 20 ms while the peer listens."""
+        args = ["%s=%s" % (t, ty) for t, ty in topics.items()]
+        # Into files, not pipes: nothing reads a pipe while `during` runs, and a full one would
+        # stop the peer.
+        with tempfile.TemporaryFile("w+") as out_f, tempfile.TemporaryFile("w+") as err_f:
+            p = subprocess.Popen([self.peer, "listen", str(seconds)] + args, stdout=out_f, stderr=err_f, text=True)
+            while p.poll() is None:
+                if during:
+                    during()
+                time.sleep(0.02)
+            out_f.seek(0)
+            err_f.seek(0)
+            out, err = out_f.read(), err_f.read()
+        self.assertEqual(p.returncode, 0, err)
+        samples, participants, writers = {}, [], {}
+        for line in out.splitlines():
+            o = json.loads(line)
+            if "topic" in o:
+                msg = self.codec.decode(topics[o["topic"]], o["cdr"], self.DISTRO)
+                samples.setdefault(o["topic"], []).append((o["t_ns"], msg))
+            elif "participant" in o:
+                participants.append(o)
+            elif "writer" in o:
+                writers[o["writer"]] = o
+        return samples, participants, writers
+
+    def publish(self, topic, type_, msg, count=1, hz=20.0):
+        hex_ = self.codec.encode(type_, msg, self.DISTRO)
+        r = subprocess.run([self.peer, "publish", topic, type_, hex_, str(count), str(hz)], capture_output=True,
+                           text=True, timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        return r
+
+    @contextlib.contextmanager
+    def driving(self, topic, type_, msg):
+        """The peer publishing `msg` at 50 Hz (as a pilot's stack would) until the block ends,
+        then SIGKILLed: a writer that goes away without a word."""
+        hex_ = self.codec.encode(type_, msg, self.DISTRO)
+        p = subprocess.Popen([self.peer, "publish", topic, type_, hex_, "1000000", "50", "hold"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            yield p
+        finally:
+            p.send_signal(signal.SIGKILL)
+            p.wait(10)
+
+
+class BytesTest(unittest.TestCase):
+    """Fast CDR (the peer's generated types) and rosmsg2-serialization give the same bytes for a
+    fixed sample of every type, for Humble's and Jazzy's definitions."""
+
+    def test_every_type_same_bytes(self):
+        for distro in ("humble", "jazzy"):
+            peer = build_peer(distro)
+            codec = Codec()
+            try:
+                for t in TYPES:
+                    with self.subTest(distro=distro, type=t):
+                        ref = codec.encode(t, fixed_sample(t), distro)
+                        fast = subprocess.run([peer, "roundtrip", t, ref], capture_output=True, text=True, check=True)
+                        self.assertEqual(fast.stdout.strip(), ref)
+                        self.assertTrue(ref.startswith("0001"), "CDR little-endian (XCDR1) encapsulation")
+            finally:
+                codec.close()
+
+
+class DiveExportTest(unittest.TestCase):
+    """caracaractl export --format mcap --encoding cdr on the regression dives (tests/dives): read
+    as rosbag2 would (mcap_ros_check.mjs: @mcap/core, ros2msg schemas, every message decoded by
+    rosmsg2-serialization and written back to the same bytes), judged against the dive's CSV."""
+
+    def test_regression_dives(self):
+        npm_ci()
+        dives = os.path.join(SOURCE, "tests", "dives")
+        ctl = harness.command("caracaractl")
+        names = sorted(n for n in os.listdir(dives) if n.endswith(".cdive"))
+        self.assertTrue(names)
+        with tempfile.TemporaryDirectory() as d:
+            for name in names:
+                with self.subTest(dive=name):
+                    path = os.path.join(dives, name)
+                    out = os.path.join(d, name + ".mcap")
+                    r = subprocess.run(ctl + ["export", path, "--format", "mcap", "--encoding", "cdr", "--out", out],
+                                       capture_output=True, text=True)
+                    self.assertEqual(r.returncode, 0, r.stderr)
+                    check = subprocess.run(["node", "mcap_ros_check.mjs", out], cwd=HERE, capture_output=True,
+                                           text=True)
+                    self.assertEqual(check.returncode, 0, check.stderr)
+                    self.judge(json.loads(check.stdout), path, ctl)
+
+    def judge(self, bag, path, ctl):
+        csv = subprocess.run(ctl + ["export", path], capture_output=True, text=True, check=True).stdout.splitlines()
+        cols = csv[0].split(",")
+        rows = [dict(zip(cols, line.split(","))) for line in csv[1:]]
+        events = subprocess.run(ctl + ["export", path, "--events"], capture_output=True, text=True,
+                                check=True).stdout.splitlines()[1:]
+        self.assertEqual(bag["profile"], "ros2")
+        types = {t: v["type"] for t, v in bag["topics"].items()}
+        self.assertEqual(types["/caracara/imu"], "sensor_msgs/msg/Imu")
+        self.assertEqual(types["/caracara/joint_states"], "sensor_msgs/msg/JointState")
+        self.assertEqual(types["/tf"], "tf2_msgs/msg/TFMessage")
+        self.assertEqual(types["/diagnostics"], "diagnostic_msgs/msg/DiagnosticArray")
+        for topic in ("/caracara/imu", "/tf", "/caracara/joint_states", "/caracara/thrusters/ordered"):
+            self.assertEqual(bag["topics"][topic]["count"], len(rows), topic)
+        msgs = bag["messages"]
+        for n, (row, js, od, imu) in enumerate(zip(rows, msgs["/caracara/joint_states"],
+                                                   msgs["/caracara/thrusters/ordered"], msgs["/caracara/imu"])):
+            for i in range(MOTORS):
+                speed = row["speed_%d" % i]
+                self.assertAlmostEqual(js["velocity"][i] * MOTOR_MAX, int(speed) if speed else 0, places=6)
+                self.assertAlmostEqual(od["velocity"][i] * MOTOR_MAX, int(row["app_%d" % i]), places=6)
+            q = imu["orientation"]
+            yaw = math.atan2(2 * (q["w"] * q["z"] + q["x"] * q["y"]), 1 - 2 * (q["y"] ** 2 + q["z"] ** 2))
+            self.assertAlmostEqual(yaw, float(row["yaw"]), delta=1e-3)
+            distances = row["distances_mm"].split()
+            for k, mm in enumerate(distances):
+                self.assertAlmostEqual(msgs["/caracara/range/%d" % k][n]["range"], int(mm) / 1000, places=4)
+        states = [e.split(",")[2].split()[0] for e in events if e.split(",")[1] == "state"]
+        got = [m["data"] for m in msgs["/caracara/state"]]
+        # The first state message is the dive's start (arming); each change after it follows the events.
+        self.assertEqual(got, [s for k, s in enumerate(["arming"] + states) if k == 0 or s != (["arming"] + states)[k - 1]])
+        self.assertEqual([m["data"] for m in msgs["/caracara/killed"]], [s in ("killed", "powered-off") for s in got])
+
+
+class PublishedTest(RosTestCase):
+    """Every topic's type name, QoS and values as the Fast DDS peer receives them, against the simulator."""
+
+    def test_discovery_data(self):
+        _, participants, writers = self.listen(3)
+        self.assertTrue(any(p["user_data"] == "enclave=/;" for p in participants), participants)
+        for topic, type_ in PUBLISHED.items():
+            with self.subTest(topic=topic):
+                w = writers.get(topic)
+                self.assertIsNotNone(w, "no writer on %s (saw %s)" % (topic, sorted(writers)))
+                pkg, name = type_.split("/")
+                self.assertEqual(w["type"], "%s::msg::dds_::%s_" % (pkg, name))
+                self.assertTrue(w["reliable"])
+                self.assertTrue(w["xcdr1"])
+                self.assertEqual(w["transient_local"], topic.split("/")[-1] in ("killed", "state", "kill_source"))
+
+    def test_values_against_the_simulator(self):
+        rig = self.rig
+        rig.reset()
+        values = [4425, -4425, 0, 0, 0, 0, 0, 0]
+        rig.thrust(values)
+        rig.wait_sim_speeds([speed_byte(v) for v in values])
+        # The simulator's attitude through the window (the body turns under this thrust), to
+        # compare each Imu sample with the simulator's attitude at its stamp.
+        attitude = []
+        samples, _, _ = self.listen(3, during=lambda: attitude.append(
+            (time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")])))
+        for topic in PUBLISHED:
+            self.assertIn(topic, samples, "nothing received on " + topic)
+        last = {t: s[-1][1] for t, s in samples.items()}
+        # Latched state: a late subscriber gets it.
+        self.assertEqual(last["rt/caracara/state"]["data"], "ready")
+        self.assertIs(last["rt/caracara/killed"]["data"], False)
+        # JointState: names, actual speed as a fraction of full thrust, as the simulator reports it.
+        js = last["rt/caracara/joint_states"]
+        self.assertEqual(js["name"], ["thruster_%d" % i for i in range(MOTORS)])
+        self.assertAlmostEqual(js["velocity"][0], 0.5, delta=0.02)
+        self.assertAlmostEqual(js["velocity"][1], -0.5, delta=0.02)
+        self.assertEqual(len(js["effort"]), MOTORS)
+        ordered = last["rt/caracara/thrusters/ordered"]["velocity"]
+        self.assertEqual([round(v * MOTOR_MAX) for v in ordered], rig.motor_values())
+        # Imu and /tf: the simulator's yaw, pitch, roll as a quaternion; REP 145's unknown fields.
+        self.assertGreater(len(attitude), 10)
+        for _, imu in samples["rt/caracara/imu"]:
+            stamp = imu["header"]["stamp"]["sec"] * 10 ** 9 + imu["header"]["stamp"]["nanosec"]
+            yaw, pitch, roll = min(attitude, key=lambda a: abs(a[0] - stamp))[1]
+            q = imu["orientation"]
+            self.assertLess(abs(angle_diff(math.atan2(2 * (q["w"] * q["z"] + q["x"] * q["y"]),
+                                                      1 - 2 * (q["y"] ** 2 + q["z"] ** 2)), yaw)), 0.02)
+            self.assertAlmostEqual(math.asin(max(-1, min(1, 2 * (q["w"] * q["y"] - q["z"] * q["x"])))), pitch,
+                                   delta=0.02)
+            self.assertAlmostEqual(math.atan2(2 * (q["w"] * q["x"] + q["y"] * q["z"]),
+                                              1 - 2 * (q["x"] ** 2 + q["y"] ** 2)), roll, delta=0.02)
+        imu = last["rt/caracara/imu"]
+        self.assertEqual(imu["angular_velocity_covariance"][0], -1)
+        self.assertEqual(imu["linear_acceleration_covariance"][0], -1)
+        tf = last["rt/tf"]["transforms"][0]
+        self.assertEqual((tf["header"]["frame_id"], tf["child_frame_id"]), ("odom", "base_link"))
+        # Range: the simulator's first distance in metres.
+        mm = int(rig.sim_teensy("Distances")[0])
+        self.assertAlmostEqual(last["rt/caracara/range/0"]["range"], mm / 1000, delta=0.002)
+        # Diagnostics: each thruster, the bus, the Teensy, the failsafes, the vehicle.
+        names = [s["name"] for s in last["rt/diagnostics"]["status"]]
+        for n in ["caracara: thruster_%d" % i for i in range(MOTORS)] + ["caracara: i2c bus", "caracara: teensy",
+                                                                         "caracara: failsafes", "caracara: vehicle"]:
+            self.assertIn(n, names)
+        # Rates follow the daemon's announcements: joint_states comes many times a second.
+        self.assertGreater(len(samples["rt/caracara/joint_states"]), 10)
+
+    def test_kill_topic_with_commands_off(self):
+        """Kill is always taken; the kill output's edge is on the wire."""
+        rig = self.rig
+        rig.reset()
+        since = rig.wire_next()
+        self.publish("rt/caracara/kill", "std_msgs/Empty", {})
+        rig.wait_state("killed")
+        self.assertEqual(rig.vget("KillSource"), "dbus")
+        poll(lambda: kill_edges(rig.wire_log(since)[1]), 5, message="no kill output edge")
+        samples, _, _ = self.listen(1.5, {"rt/caracara/killed": "std_msgs/Bool", "rt/caracara/kill_source": "std_msgs/String"})
+        self.assertIs(samples["rt/caracara/killed"][-1][1]["data"], True)
+        self.assertEqual(samples["rt/caracara/kill_source"][-1][1]["data"], "dbus")
+
+    def test_commands_off_nothing_moves(self):
+        rig = self.rig
+        rig.rearm()
+        since = rig.wire_next()
+        # No reader: the peer's publish finds none to match and says so.
+        hex_ = self.codec.encode("geometry_msgs/Wrench", {"force": {"x": 0.5, "y": 0, "z": 0},
+                                                          "torque": {"x": 0, "y": 0, "z": 0}})
+        r = subprocess.run([self.peer, "publish", "rt/caracara/cmd_wrench", "geometry_msgs/Wrench", hex_, "10", "20"],
+                           capture_output=True, text=True, timeout=60)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("no reader matched", r.stderr)
+        self.assertEqual(nonzero_orders(rig.wire_log(since)[1]), [])
+        self.assertEqual(rig.motor_values(), [0] * MOTORS)
+        self.assertNotIn("pilot", rig.log("caracara-ros"))
+
+
+class JazzyRangeTest(RosTestCase):
+    """range_layout = "jazzy": sensor_msgs/Range with Jazzy's variance, read by a peer built from
+    Jazzy's definitions (a Humble-layout sample would be 4 bytes short for it)."""
+    DISTRO = "jazzy"
+
+    def test_range_in_jazzy_layout(self):
+        samples, _, writers = self.listen(2, {"rt/caracara/range/0": "sensor_msgs/Range"})
+        self.assertEqual(writers["rt/caracara/range/0"]["type"], "sensor_msgs::msg::dds_::Range_")
+        r = samples["rt/caracara/range/0"][-1][1]
+        self.assertEqual(r["variance"], 0.0)
+        self.assertAlmostEqual(r["range"], int(self.rig.sim_teensy("Distances")[0]) / 1000, delta=0.002)
+
+
+class CommandsTest(RosTestCase):
+    COMMANDS = True
+
+    def setUp(self):
+        self.rig.rearm()
+
+    def test_wrench_axes_as_the_mixing_says(self):
+        rig = self.rig
+        # force x, y, z, torque z, y, x -> SetMotion's x, y, z, yaw, pitch, roll
+        axes = [("force", "x", "x"), ("force", "y", "y"), ("force", "z", "z"),
+                ("torque", "z", "yaw"), ("torque", "y", "pitch"), ("torque", "x", "roll")]
+        for part, comp, axis in axes:
+            with self.subTest(axis=axis):
+                rig.motion(**{axis: 0.4})
+                expected = poll(lambda: rig.sim_speeds() if rig.sim_speeds() != [ZERO] * MOTORS else None, 10)
+                rig.thrust([0] * MOTORS)
+                rig.wait_sim_zero()
+                w = {"force": {"x": 0, "y": 0, "z": 0}, "torque": {"x": 0, "y": 0, "z": 0}}
+                w[part][comp] = 0.4
+                with self.driving("rt/caracara/cmd_wrench", "geometry_msgs/Wrench", w):
+                    rig.wait_sim_speeds(expected)
+                rig.wait_sim_zero()
+
+    def test_per_thruster_values(self):
+        rig = self.rig
+        data = [0.5, -0.5, 0, 0, 0.2, 0, 0, -0.2]  # whole motor values: 4425, 1770
+        with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
+                          {"layout": {"dim": [], "data_offset": 0}, "data": data}):
+            rig.wait_sim_speeds([speed_byte(round(v * MOTOR_MAX)) for v in data])
+        rig.wait_sim_zero()
+
+    def test_bad_messages_refused_by_name(self):
+        rig = self.rig
+        since = rig.wire_next()
+        cases = [([0.1] * 7, "org.caracara.Vehicle1.Error."), ([1.5] + [0] * 7, "OutOfRange"),
+                 ([float("nan")] + [0] * 7, "InvalidValue")]
+        for data, name in cases:
+            with self.subTest(data=data):
+                before = rig.log("caracara-ros").count("refused")
+                self.publish("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
+                             {"layout": {"dim": [], "data_offset": 0}, "data": ["NaN" if d != d else d for d in data]})
+                poll(lambda: rig.log("caracara-ros").count("refused") > before, 10, message="no refusal logged")
+                self.assertIn(name, rig.log("caracara-ros").split("refused")[-1].splitlines()[0])
+        for x, name in ((2.0, "OutOfRange"), ("NaN", "InvalidValue")):
+            with self.subTest(wrench_force_x=x):
+                before = rig.log("caracara-ros").count("refused")
+                self.publish("rt/caracara/cmd_wrench", "geometry_msgs/Wrench",
+                             {"force": {"x": x, "y": 0, "z": 0}, "torque": {"x": 0, "y": 0, "z": 0}})
+                poll(lambda: rig.log("caracara-ros").count("refused") > before, 10, message="no refusal logged")
+                self.assertIn(name, rig.log("caracara-ros").split("refused")[-1].splitlines()[0])
+        self.assertEqual(nonzero_orders(rig.wire_log(since)[1]), [])
+        self.assertEqual(rig.motor_values(), [0] * MOTORS)
+
+    def test_peer_killed_zeros_within_the_client_loss_bound(self):
+        rig = self.rig
+        data = [0.3] * 2 + [0] * 6
+        with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
+                          {"layout": {"dim": [], "data_offset": 0}, "data": data}):
+            rig.wait_sim_speeds([speed_byte(round(v * MOTOR_MAX)) for v in data])
+            since = rig.wire_next()
+            killed_at = time.monotonic_ns()  # the block's end SIGKILLs the peer
+        rig.wait_sim_zero()
+        log = rig.wire_log(since)[1]
+        # The first order of zero to each thruster that was moving: the last of them is when the
+        # thrust was gone.
+        firsts = {}
+        for e, i, speed in orders(log):
+            if speed == ZERO and data[i] != 0 and i not in firsts:
+                firsts[i] = e.time_ns
+        self.assertEqual(sorted(firsts), [0, 1])
+        firsts = list(firsts.values())
+        ms = (max(firsts) - killed_at) / 1e6
+        print("peer SIGKILL -> zeros on the wire: %.1f ms" % ms, file=sys.stderr)
+        self.assertLess(ms, CLIENT_LOSS_ZERO_MS_MAX)
+        self.assertIn("gone", rig.log("caracara-ros"))
+
+
+if __name__ == "__main__":
+    unittest.main()

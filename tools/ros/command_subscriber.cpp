@@ -1,0 +1,173 @@
+#include "tools/ros/command_subscriber.hpp"
+
+#include "core/motor.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <ros_msgs.h>
+#include <set>
+#include <stdexcept>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+namespace caracara::ros {
+
+namespace {
+
+constexpr int kBatch = 16;
+// Takes all that `reader` holds, a batch at a time, and hands each valid sample with its writer to `use`.
+template <typename T, typename Use>
+void take_each(dds_entity_t reader, Use use) {
+    for (dds_return_t n = kBatch; n == kBatch;) {
+        void* samples[kBatch] = {};
+        dds_sample_info_t info[kBatch];
+        n = dds_take(reader, samples, info, kBatch, kBatch);
+        for (dds_return_t i = 0; i < n; ++i)
+            if (info[i].valid_data)
+                use(*static_cast<const T*>(samples[i]), info[i].publication_handle);
+        if (n > 0)
+            dds_return_loan(reader, samples, n);
+    }
+}
+
+std::string writer_name(dds_instance_handle_t h) {
+    char b[24];
+    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h));
+    return b;
+}
+
+} // namespace
+
+CommandSubscriber::CommandSubscriber(sd_event* event, DdsParticipant& dds, const RosConfig& config,
+                                     std::function<void()> kill)
+    : event_(event), config_(config), kill_(std::move(kill)) {
+    wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    sd_event_source* s = nullptr;
+    if (wake_fd_ < 0 || sd_event_add_io(event_, &s, wake_fd_, EPOLLIN, on_wake, this) < 0)
+        throw std::runtime_error("cannot make the command wake-up");
+    wake_.reset(s);
+    // Above D-Bus: a kill never waits behind telemetry.
+    sd_event_source_set_priority(s, SD_EVENT_PRIORITY_IMPORTANT);
+    listener_ = dds_create_listener(this);
+    dds_lset_data_available(listener_, on_dds);
+    dds_lset_publication_matched(listener_, on_matched);
+    // Kill: reliable, as `ros2 topic pub` sends by default.
+    kill_reader_ = dds.reader(&std_msgs_msg_dds__Empty__desc, ros_topic(config_, "kill"), Profile::Default, listener_);
+    if (config_.commands) {
+        // Best-effort readers match both reliable and best-effort writers.
+        wrench_reader_ = dds.reader(&geometry_msgs_msg_dds__Wrench__desc, ros_topic(config_, "cmd_wrench"),
+                                    Profile::SensorReader, listener_);
+        thrust_reader_ = dds.reader(&std_msgs_msg_dds__Float64MultiArray__desc, ros_topic(config_, "cmd_thrust"),
+                                    Profile::SensorReader, listener_);
+    }
+}
+
+CommandSubscriber::~CommandSubscriber() {
+    for (const dds_entity_t r : {kill_reader_, wrench_reader_, thrust_reader_})
+        if (r > 0)
+            dds_set_listener(r, nullptr);
+    dds_delete_listener(listener_);
+    wake_.reset();
+    if (wake_fd_ >= 0)
+        close(wake_fd_);
+}
+
+void CommandSubscriber::on_dds(dds_entity_t, void* arg) {
+    const uint64_t one = 1;
+    [[maybe_unused]] const auto n = write(static_cast<CommandSubscriber*>(arg)->wake_fd_, &one, sizeof one);
+}
+
+void CommandSubscriber::on_matched(dds_entity_t reader, const dds_publication_matched_status_t, void* arg) {
+    on_dds(reader, arg);
+}
+
+int CommandSubscriber::on_wake(sd_event_source*, int fd, uint32_t, void* userdata) {
+    uint64_t count = 0;
+    [[maybe_unused]] const auto n = read(fd, &count, sizeof count);
+    static_cast<CommandSubscriber*>(userdata)->drain();
+    return 0;
+}
+
+void CommandSubscriber::drain() {
+    take_kills();
+    if (!config_.commands)
+        return;
+    take_wrenches();
+    take_thrusts();
+    drop_unmatched();
+}
+
+void CommandSubscriber::take_kills() {
+    bool any = false;
+    take_each<std_msgs_msg_dds__Empty_>(kill_reader_, [&](const auto&, dds_instance_handle_t) { any = true; });
+    if (any) {
+        std::fprintf(stderr, "caracara-ros: kill from DDS\n");
+        kill_();
+    }
+}
+
+Pilot* CommandSubscriber::pilot(dds_instance_handle_t writer) {
+    auto& p = pilots_[writer];
+    if (!p) {
+        try {
+            p = std::make_unique<Pilot>(event_, config_.bus, writer_name(writer));
+            std::fprintf(stderr, "caracara-ros: writer %s commands as a pilot\n", writer_name(writer).c_str());
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "caracara-ros: writer %s: %s\n", writer_name(writer).c_str(), e.what());
+            pilots_.erase(writer);
+            return nullptr;
+        }
+    }
+    return p.get();
+}
+
+void CommandSubscriber::take_wrenches() {
+    take_each<geometry_msgs_msg_dds__Wrench_>(wrench_reader_, [&](const auto& w, dds_instance_handle_t writer) {
+        // force x, y, z -> surge, sway, heave; torque z, y, x -> yaw, pitch, roll (SetMotion's
+        // order). Range and NaN are the daemon's to refuse, by name.
+        if (Pilot* p = pilot(writer))
+            p->set_motion({w.force.x, w.force.y, w.force.z, w.torque.z, w.torque.y, w.torque.x});
+    });
+}
+
+void CommandSubscriber::take_thrusts() {
+    take_each<std_msgs_msg_dds__Float64MultiArray_>(thrust_reader_, [&](const auto& a, dds_instance_handle_t writer) {
+        // Each value -1..1 of full thrust becomes the motor value round(v * kMotorMax); the daemon
+        // refuses a wrong count or a value out of range by name (a value past +-2 is sent as
+        // +-2 * kMotorMax, out of range all the same). NaN has no motor value: refused here.
+        std::vector<int32_t> values;
+        for (uint32_t k = 0; k < a.data._length; ++k) {
+            const double v = a.data._buffer[k];
+            if (!std::isfinite(v)) {
+                std::fprintf(stderr, "caracara-ros: cmd_thrust from writer %s refused: "
+                                     "org.caracara.Vehicle1.Error.InvalidValue: value %u is not a number\n",
+                             writer_name(writer).c_str(), k);
+                return;
+            }
+            values.push_back(std::fabs(v) < 2.0 ? static_cast<int32_t>(std::lround(v * caracara::kMotorMax))
+                                                : (v > 0 ? 2 : -2) * caracara::kMotorMax);
+        }
+        if (Pilot* p = pilot(writer))
+            p->set_thrust(values);
+    });
+}
+
+void CommandSubscriber::drop_unmatched() {
+    std::set<dds_instance_handle_t> matched;
+    for (const dds_entity_t r : {wrench_reader_, thrust_reader_}) {
+        dds_instance_handle_t h[64];
+        const dds_return_t n = dds_get_matched_publications(r, h, 64);
+        for (dds_return_t i = 0; i < n && i < 64; ++i)
+            matched.insert(h[i]);
+    }
+    for (auto it = pilots_.begin(); it != pilots_.end();) {
+        if (matched.contains(it->first)) {
+            ++it;
+            continue;
+        }
+        std::fprintf(stderr, "caracara-ros: writer %s gone; its connection closed\n", writer_name(it->first).c_str());
+        it = pilots_.erase(it);
+    }
+}
+
+} // namespace caracara::ros

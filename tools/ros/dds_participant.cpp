@@ -1,0 +1,90 @@
+#include "tools/ros/dds_participant.hpp"
+
+#include <stdexcept>
+
+namespace caracara::ros {
+
+namespace {
+
+std::string error(const char* what, dds_return_t r) { return std::string(what) + ": " + dds_strretcode(r); }
+
+dds_qos_t* qos_for(Profile p) {
+    dds_qos_t* q = dds_create_qos();
+    switch (p) {
+    case Profile::Default:
+        dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+        dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+        dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 10);
+        break;
+    case Profile::Latched:
+        dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+        dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+        dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+        break;
+    case Profile::SensorReader:
+        dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
+        dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+        dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 5);
+        break;
+    }
+    // XCDR1, as rmw_cyclonedds_cpp and rmw_fastrtps_cpp speak (XCDR2 is not what ROS 2 uses).
+    const dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};
+    dds_qset_data_representation(q, 1, xcdr1);
+    return q;
+}
+
+} // namespace
+
+DdsParticipant::DdsParticipant(const RosConfig& c) {
+    dds_domainid_t domain = c.domain_id;
+    if (!c.interface.empty()) {
+        // The one interface it may use, multicast on it (SPDP) even on a loopback interface.
+        const std::string xml = "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"" +
+                                c.interface + "\" multicast=\"true\"/></Interfaces></General></Domain></CycloneDDS>";
+        domain_ = dds_create_domain(domain, xml.c_str());
+        if (domain_ < 0)
+            throw std::runtime_error(error(("DDS domain on interface " + c.interface).c_str(), domain_));
+    }
+    dds_qos_t* q = dds_create_qos();
+    static const char kEnclave[] = "enclave=/;";
+    dds_qset_userdata(q, kEnclave, sizeof kEnclave - 1);
+    participant_ = dds_create_participant(domain, q, nullptr);
+    dds_delete_qos(q);
+    if (participant_ < 0)
+        throw std::runtime_error(error("DDS participant", participant_));
+}
+
+DdsParticipant::~DdsParticipant() {
+    dds_delete(participant_);
+    if (domain_ > 0)
+        dds_delete(domain_);
+}
+
+dds_entity_t DdsParticipant::topic(const dds_topic_descriptor_t* desc, const std::string& ros_name) {
+    const std::string name = "rt" + ros_name;
+    const dds_entity_t t = dds_create_topic(participant_, desc, name.c_str(), nullptr, nullptr);
+    if (t < 0)
+        throw std::runtime_error(error(("DDS topic " + name).c_str(), t));
+    return t;
+}
+
+dds_entity_t DdsParticipant::writer(const dds_topic_descriptor_t* desc, const std::string& ros_name, Profile p) {
+    dds_qos_t* q = qos_for(p);
+    const dds_entity_t w = dds_create_writer(participant_, topic(desc, ros_name), q, nullptr);
+    dds_delete_qos(q);
+    if (w < 0)
+        throw std::runtime_error(error(("DDS writer on " + ros_name).c_str(), w));
+    return w;
+}
+
+dds_entity_t DdsParticipant::reader(const dds_topic_descriptor_t* desc, const std::string& ros_name, Profile p,
+                                    const dds_listener_t* listener) {
+    dds_qos_t* q = qos_for(p);
+    const dds_entity_t r = dds_create_reader(participant_, topic(desc, ros_name), q, listener);
+    dds_delete_qos(q);
+    if (r < 0)
+        throw std::runtime_error(error(("DDS reader on " + ros_name).c_str(), r));
+    return r;
+}
+
+} // namespace caracara::ros

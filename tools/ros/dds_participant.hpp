@@ -1,0 +1,41 @@
+// caracara-ros's one DDS participant (Cyclone DDS) as a ROS 2 node's participant looks: on
+// ROS_DOMAIN_ID's domain, "enclave=/;" in its USER_DATA (rmw_cyclonedds registers only such
+// participants), every writer and reader XCDR1 on "rt/<topic>" with ROS 2's QoS profiles.
+#pragma once
+
+#include "tools/ros/ros_config.hpp"
+
+#include <dds/dds.h>
+#include <string>
+
+namespace caracara::ros {
+
+// The QoS profiles of rmw_qos_profile_t that the topics use.
+enum class Profile {
+    Default,        // reliable, volatile, keep-last 10 (rmw_qos_profile_default)
+    Latched,        // reliable, transient-local, keep-last 1 (a late subscriber gets the state)
+    SensorReader,   // best-effort, keep-last 5: matches reliable and best-effort writers alike
+};
+
+class DdsParticipant {
+public:
+    // Throws std::runtime_error with Cyclone's message when the domain cannot be made.
+    explicit DdsParticipant(const RosConfig& config);
+    ~DdsParticipant();
+    DdsParticipant(const DdsParticipant&) = delete;
+    DdsParticipant& operator=(const DdsParticipant&) = delete;
+
+    dds_entity_t handle() const { return participant_; }
+    // A writer of `desc` on ROS topic `ros_name` ("/caracara/imu" -> "rt/caracara/imu").
+    dds_entity_t writer(const dds_topic_descriptor_t* desc, const std::string& ros_name, Profile profile);
+    dds_entity_t reader(const dds_topic_descriptor_t* desc, const std::string& ros_name, Profile profile,
+                        const dds_listener_t* listener);
+
+private:
+    dds_entity_t topic(const dds_topic_descriptor_t* desc, const std::string& ros_name);
+
+    dds_entity_t domain_ = 0;
+    dds_entity_t participant_ = 0;
+};
+
+} // namespace caracara::ros

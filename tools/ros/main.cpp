@@ -1,0 +1,126 @@
+// caracara-ros: the vehicle as ROS 2 topics over DDS (Cyclone DDS), without ROS on the vehicle.
+// One DDS participant named like a ROS 2 node's; a client of caracarad's D-Bus API and of nothing
+// else (docs/ros2.md).
+#include "tools/ros/command_subscriber.hpp"
+#include "tools/ros/telemetry_publisher.hpp"
+
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <unistd.h>
+#include <iostream>
+#include <systemd/sd-daemon.h>
+
+namespace {
+
+constexpr const char* kDefaultConfig = "/etc/caracara/ros.toml";
+
+void help() {
+    std::cout << "caracara-ros [OPTIONS...]\n\n"
+                 "Publish caracarad (org.caracara.Vehicle1) as ROS 2 topics over DDS and take commands\n"
+                 "from them when the config allows (docs/ros2.md).\n\n"
+                 "  --config FILE    The settings (default " << kDefaultConfig << "; a missing default is no error)\n"
+                 "  --commands       Take cmd_wrench and cmd_thrust (the config's ros.commands = true)\n"
+                 "  --system | --user | --bus-address ADDR   The bus caracarad is on (default: system)\n"
+                 "  -h --help        Show this help\n"
+                 "  --version        Show the version\n"
+                 "ROS_DOMAIN_ID picks the DDS domain unless the config names one.\n";
+}
+
+int usage(const std::string& m) {
+    std::cerr << "caracara-ros: " << m << "\nTry 'caracara-ros --help'.\n";
+    return 2;
+}
+
+int on_signal(sd_event_source* s, const signalfd_siginfo*, void*) {
+    return sd_event_exit(sd_event_source_get_event(s), 0);
+}
+
+// Kill() on the reading connection, sent at once. Without one (caracarad restarting, the
+// connection being made again) on a connection of its own, so a kill is never dropped.
+void kill_over(sd_bus* bus, const caracara::dbus::BusChoice& choice) {
+    caracara::dbus::BusPtr own;
+    if (!bus) {
+        if (const int r = caracara::dbus::open_bus(choice, "caracara-ros-kill", own); r < 0) {
+            std::fprintf(stderr, "caracara-ros: kill not sent: cannot reach the bus: %s\n", std::strerror(-r));
+            return;
+        }
+        bus = own.get();
+    }
+    sd_bus_message* m = nullptr;
+    if (sd_bus_message_new_method_call(bus, &m, caracara::dbus::kBusName, caracara::dbus::kRootPath,
+                                       caracara::dbus::kVehicleIface, "Kill") < 0)
+        return;
+    sd_bus_message_set_auto_start(m, 0);
+    const int r = sd_bus_call_async(bus, nullptr, m, nullptr, nullptr, 0);
+    sd_bus_message_unref(m);
+    if (r < 0)
+        std::fprintf(stderr, "caracara-ros: kill not sent: %s\n", std::strerror(-r));
+    sd_bus_flush(bus); // now, not at the next turn of the loop; on its own connection, before it closes
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    caracara::ros::RosConfig config;
+    if (const char* d = std::getenv("ROS_DOMAIN_ID"); d && *d)
+        config.domain_id = static_cast<uint32_t>(std::strtoul(d, nullptr, 10));
+    std::string config_path = kDefaultConfig;
+    bool config_given = false, commands_flag = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+        if (a == "-h" || a == "--help") {
+            help();
+            return 0;
+        } else if (a == "--version") {
+            std::cout << "caracara-ros " << CARACARA_VERSION << '\n';
+            return 0;
+        } else if (a == "--config") {
+            config_path = value();
+            config_given = true;
+        } else if (a == "--commands") {
+            commands_flag = true;
+        } else if (a == "--system") {
+            config.bus = {};
+        } else if (a == "--user") {
+            config.bus.kind = caracara::dbus::BusChoice::Kind::User;
+        } else if (a == "--bus-address") {
+            config.bus = {caracara::dbus::BusChoice::Kind::Address, value()};
+        } else {
+            return usage("unknown argument " + a);
+        }
+    }
+    if (config_given || access(config_path.c_str(), F_OK) == 0)
+        if (const std::string e = caracara::ros::load_config(config_path, config); !e.empty())
+            return usage(e);
+    config.commands = config.commands || commands_flag;
+
+    sd_event* raw = nullptr;
+    if (sd_event_default(&raw) < 0)
+        return 1;
+    caracara::EventPtr event(raw);
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGINT);
+    sigprocmask(SIG_BLOCK, &set, nullptr);
+    sd_event_add_signal(event.get(), nullptr, SIGTERM, on_signal, nullptr);
+    sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
+    try {
+        caracara::ros::DdsParticipant dds(config);
+        caracara::ros::TelemetryPublisher telemetry(event.get(), dds, config);
+        caracara::ros::CommandSubscriber commands(event.get(), dds, config, [&] { kill_over(telemetry.bus(), config.bus); });
+        telemetry.start();
+        std::fprintf(stderr, "caracara-ros: domain %u, namespace %s, commands %s\n", config.domain_id,
+                     config.ros_namespace.empty() ? "/" : config.ros_namespace.c_str(), config.commands ? "on" : "off");
+        sd_notify(0, "READY=1");
+        const int r = sd_event_loop(event.get());
+        sd_notify(0, "STOPPING=1");
+        return r < 0 ? 1 : 0;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "caracara-ros: %s\n", e.what());
+        return 1;
+    }
+}

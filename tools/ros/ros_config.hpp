@@ -1,0 +1,34 @@
+// caracara-ros's settings: the ROS namespace and domain, the Range layout (Humble or Jazzy),
+// whether commands are taken, the frames, and the network DDS may use. Read from a TOML file
+// (/etc/caracara/ros.toml; docs/ros2.md lists every key) and the command line.
+#pragma once
+
+#include "drivers/sdbus/sdbus.hpp"
+
+#include <cstdint>
+#include <string>
+
+namespace caracara::ros {
+
+enum class RangeLayout { Humble, Jazzy };
+
+struct RosConfig {
+    std::string ros_namespace = "/caracara";
+    uint32_t domain_id = 0;           // ROS_DOMAIN_ID, else 0; the file's domain_id wins
+    RangeLayout range_layout = RangeLayout::Humble;
+    bool commands = false;            // Wrench and per-thruster commands; kill is always taken
+    // The one network interface DDS uses: loopback until the config names the tether ("" = Cyclone picks).
+    std::string interface = "lo";
+    std::string world_frame = "odom";
+    std::string base_frame = "base_link";
+    float range_min_m = 0.0f, range_max_m = 65.535f, range_fov_rad = 0.0f;
+    caracara::dbus::BusChoice bus;
+};
+
+// Reads `path` into `config`; returns "" or what is wrong with the file (named key and value).
+std::string load_config(const std::string& path, RosConfig& config);
+
+// The ROS topic name under the namespace ("state" -> "/caracara/state"; "/diagnostics" stays).
+std::string ros_topic(const RosConfig& config, const std::string& name);
+
+} // namespace caracara::ros

@@ -1,0 +1,407 @@
+#include "tools/ros/telemetry_publisher.hpp"
+
+#include "drivers/protocol/seabotix.hpp"
+#include "tools/ros/ros_conventions.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <ros_msgs.h>
+#include <ctime>
+
+namespace caracara::ros {
+
+using caracaractl::Props;
+using caracaractl::Value;
+
+namespace {
+
+const std::string kRoot = caracara::dbus::kRootPath;
+const std::string kThrusterPrefix = kRoot + "/thruster/";
+constexpr unsigned kThrusters = kThrusterJoints;
+constexpr uint64_t kDiagnosticsPeriodUs = 1'000'000; // rqt_robot_monitor's expectation: about 1 Hz
+
+const Value kNone;
+const Value& get(const Props& p, const char* name) {
+    const auto it = p.find(name);
+    return it == p.end() ? kNone : it->second;
+}
+char* c_str(const std::string& s) { return const_cast<char*>(s.c_str()); }
+
+// The header's frame_id points into `frame`, which must outlive the message's write.
+std_msgs_msg_dds__Header_ header(const std::string& frame) {
+    timespec t{};
+    clock_gettime(CLOCK_REALTIME, &t);
+    return {{static_cast<int32_t>(t.tv_sec), static_cast<uint32_t>(t.tv_nsec)}, c_str(frame)};
+}
+
+int thruster_of(const std::string& path) {
+    if (!path.starts_with(kThrusterPrefix) || path.size() != kThrusterPrefix.size() + 1)
+        return -1;
+    const int n = path.back() - '0';
+    return n >= 0 && n < static_cast<int>(kThrusters) ? n : -1;
+}
+
+// The thruster's reported SPEED byte as a fraction of full thrust (-1..1), 0 when unknown.
+double actual_fraction(const Props& p) {
+    const auto m = caracara::speed_to_motor(static_cast<uint8_t>(get(p, "ActualSpeed").unsigned_integer()));
+    return m ? motor_fraction(*m) : 0.0;
+}
+
+// Jazzy's Range under the ROS type name (its IDL module is "jazzy" only so that both layouts
+// compile into one program); no XTypes type information, as for a type without one.
+dds_topic_descriptor_t jazzy_range_descriptor() {
+    const dds_topic_descriptor_t& d = jazzy_sensor_msgs_msg_dds__Range__desc;
+    return {d.m_size, d.m_align, d.m_flagset & ~DDS_TOPIC_XTYPES_METADATA, d.m_nkeys, "sensor_msgs::msg::dds_::Range_",
+            d.m_keys, d.m_nops, d.m_ops, d.m_meta, {nullptr, 0}, {nullptr, 0}, d.restrict_data_representation};
+}
+
+} // namespace
+
+TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config)
+    : event_(event), dds_(dds), config_(config), jazzy_range_(jazzy_range_descriptor()) {
+    const auto topic = [&](const char* name) { return ros_topic(config_, name); };
+    imu_ = dds_.writer(&sensor_msgs_msg_dds__Imu__desc, topic("imu"), Profile::Default);
+    tf_ = dds_.writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Default);
+    joints_ = dds_.writer(&sensor_msgs_msg_dds__JointState__desc, topic("joint_states"), Profile::Default);
+    ordered_ = dds_.writer(&sensor_msgs_msg_dds__JointState__desc, topic("thrusters/ordered"), Profile::Default);
+    diagnostics_ = dds_.writer(&diagnostic_msgs_msg_dds__DiagnosticArray__desc, "/diagnostics", Profile::Default);
+    killed_ = dds_.writer(&std_msgs_msg_dds__Bool__desc, topic("killed"), Profile::Latched);
+    state_ = dds_.writer(&std_msgs_msg_dds__String__desc, topic("state"), Profile::Latched);
+    kill_source_ = dds_.writer(&std_msgs_msg_dds__String__desc, topic("kill_source"), Profile::Latched);
+    sd_event_source* s = nullptr;
+    if (sd_event_add_defer(event_, &s, on_flush, this) >= 0) {
+        flush_.reset(s);
+        sd_event_source_set_enabled(s, SD_EVENT_OFF);
+    }
+}
+
+TelemetryPublisher::~TelemetryPublisher() { slots_.clear(); }
+
+void TelemetryPublisher::start() {
+    if (!connect())
+        retry();
+}
+
+void TelemetryPublisher::retry() {
+    sd_event_source* s = nullptr;
+    uint64_t now = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now);
+    if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now + 1'000'000, 0, on_retry, this) >= 0)
+        retry_.reset(s);
+}
+
+int TelemetryPublisher::on_retry(sd_event_source*, uint64_t, void* userdata) {
+    static_cast<TelemetryPublisher*>(userdata)->start();
+    return 0;
+}
+
+bool TelemetryPublisher::connect() {
+    slots_.clear();
+    client_ = std::make_unique<caracaractl::Client>(config_.bus);
+    try {
+        sd_bus* bus = client_->bus();
+        sd_bus_slot* slot = nullptr;
+        // Subscribe before loading, so no change falls between the two.
+        if (sd_bus_match_signal(bus, &slot, caracara::dbus::kBusName, nullptr, "org.freedesktop.DBus.Properties",
+                                "PropertiesChanged", on_properties_changed, this) < 0)
+            return false;
+        slots_.emplace_back(slot);
+        if (sd_bus_match_signal(bus, &slot, "org.freedesktop.DBus", "/org/freedesktop/DBus", "org.freedesktop.DBus",
+                                "NameOwnerChanged", on_owner_changed, this) < 0)
+            return false;
+        slots_.emplace_back(slot);
+        objects_ = client_->get_objects();
+        if (sd_bus_attach_event(bus, event_, SD_EVENT_PRIORITY_NORMAL) < 0)
+            return false;
+    } catch (const caracaractl::Failure& f) {
+        std::fprintf(stderr, "caracara-ros: caracarad not reachable (%s); retrying\n", f.message.c_str());
+        slots_.clear();
+        client_.reset();
+        return false;
+    }
+    mark(kImu | kJoints | kRanges | kDiagnostics | kState);
+    return true;
+}
+
+int TelemetryPublisher::on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto* self = static_cast<TelemetryPublisher*>(userdata);
+    const char *name = nullptr, *old_owner = nullptr, *new_owner = nullptr;
+    if (sd_bus_message_read(m, "sss", &name, &old_owner, &new_owner) >= 0 && name &&
+        std::string_view(name) == caracara::dbus::kBusName && new_owner && *new_owner)
+        self->reload();
+    return 0;
+}
+
+void TelemetryPublisher::reload() {
+    // A restarted caracarad: its objects are loaded again (the old values are gone). The call
+    // waits for its reply on this connection, which sd-bus allows from a handler.
+    try {
+        objects_ = client_->get_objects();
+    } catch (const caracaractl::Failure& f) {
+        std::fprintf(stderr, "caracara-ros: reloading caracarad's objects failed (%s)\n", f.message.c_str());
+        return;
+    }
+    mark(kImu | kJoints | kRanges | kDiagnostics | kState);
+}
+
+int TelemetryPublisher::on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    auto* self = static_cast<TelemetryPublisher*>(userdata);
+    try {
+        const char* iface = nullptr;
+        if (sd_bus_message_read(m, "s", &iface) < 0 || !iface)
+            return 0;
+        const Props changes = caracaractl::to_props(caracaractl::read_value(m));
+        self->changed(sd_bus_message_get_path(m) ? sd_bus_message_get_path(m) : "", iface, changes);
+    } catch (const caracaractl::Failure&) {
+        // A malformed signal changes nothing.
+    }
+    return 0;
+}
+
+const Props& TelemetryPublisher::props(const std::string& path, const char* iface) const {
+    static const Props none;
+    const auto o = objects_.find(path);
+    if (o == objects_.end())
+        return none;
+    const auto i = o->second.find(iface);
+    return i == o->second.end() ? none : i->second;
+}
+
+void TelemetryPublisher::changed(const std::string& path, const std::string& iface, const Props& changes) {
+    Props& stored = objects_[path][iface];
+    for (const auto& [name, value] : changes)
+        stored[name] = value;
+    unsigned d = kDiagnostics;
+    if (path == kRoot) {
+        if (changes.contains("State") || changes.contains("KillSource"))
+            d |= kState;
+    } else if (thruster_of(path) >= 0) {
+        d |= kJoints;
+    } else if (path == caracara::dbus::kTeensyPath) {
+        if (changes.contains("Orientation"))
+            d |= kImu;
+        // A reading per Teensy poll (each announces its Frames count), changed or not: a range
+        // sensor's subscribers expect a steady stream, not only the changes.
+        if (changes.contains("Distances") || changes.contains("Frames"))
+            d |= kRanges;
+    }
+    mark(d);
+}
+
+void TelemetryPublisher::mark(unsigned dirty) {
+    // One message per topic for all the changes one batch of signals brings.
+    dirty_ |= dirty;
+    if (flush_)
+        sd_event_source_set_enabled(flush_.get(), SD_EVENT_ONESHOT);
+}
+
+int TelemetryPublisher::on_flush(sd_event_source*, void* userdata) {
+    auto* self = static_cast<TelemetryPublisher*>(userdata);
+    const unsigned d = self->dirty_;
+    self->dirty_ = 0;
+    if (d & kState)
+        self->write_state();
+    if (d & kImu)
+        self->write_imu_and_tf();
+    if (d & kJoints)
+        self->write_joints();
+    if (d & kRanges)
+        self->write_ranges();
+    if (d & kDiagnostics) {
+        uint64_t now = 0;
+        sd_event_now(self->event_, CLOCK_MONOTONIC, &now);
+        const bool level_changed = self->levels() != self->last_levels_;
+        if (level_changed || now >= self->diagnostics_last_us_ + kDiagnosticsPeriodUs) {
+            self->diagnostics_timer_.reset();
+            self->write_diagnostics();
+            self->diagnostics_last_us_ = now;
+        } else if (!self->diagnostics_timer_) {
+            sd_event_source* s = nullptr;
+            if (sd_event_add_time(self->event_, &s, CLOCK_MONOTONIC, self->diagnostics_last_us_ + kDiagnosticsPeriodUs,
+                                  0, on_diagnostics_due, self) >= 0)
+                self->diagnostics_timer_.reset(s);
+        }
+    }
+    return 0;
+}
+
+int TelemetryPublisher::on_diagnostics_due(sd_event_source*, uint64_t usec, void* userdata) {
+    auto* self = static_cast<TelemetryPublisher*>(userdata);
+    self->diagnostics_timer_.reset();
+    self->write_diagnostics();
+    self->diagnostics_last_us_ = usec;
+    return 0;
+}
+
+void TelemetryPublisher::write_state() {
+    const Props& p = props(kRoot, caracara::dbus::kVehicleIface);
+    const std::string state = get(p, "State").s, source = get(p, "KillSource").s;
+    if (state_written_ && state == last_state_ && source == last_source_)
+        return; // latched topics carry changes only
+    std_msgs_msg_dds__Bool_ killed{state_is_killed(state)};
+    dds_write(killed_, &killed);
+    std_msgs_msg_dds__String_ s{c_str(state)};
+    dds_write(state_, &s);
+    std_msgs_msg_dds__String_ k{c_str(source)};
+    dds_write(kill_source_, &k);
+    last_state_ = state;
+    last_source_ = source;
+    state_written_ = true;
+}
+
+void TelemetryPublisher::write_imu_and_tf() {
+    const Value& o = get(props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Orientation");
+    if (o.items.size() != 3)
+        return;
+    const Quaternion r = quaternion_from_ypr(o.items[0].number(), o.items[1].number(), o.items[2].number());
+    const geometry_msgs_msg_dds__Quaternion_ q{r.x, r.y, r.z, r.w};
+    sensor_msgs_msg_dds__Imu_ imu{};
+    imu.header = header(config_.base_frame);
+    imu.orientation = q;
+    // REP 145: the orientation's covariance is unknown (all zeros); the Teensy gives no angular
+    // velocity or linear acceleration, marked by -1 in the first element of their covariances.
+    imu.angular_velocity_covariance[0] = -1;
+    imu.linear_acceleration_covariance[0] = -1;
+    dds_write(imu_, &imu);
+    geometry_msgs_msg_dds__TransformStamped_ t{};
+    t.header = header(config_.world_frame);
+    t.child_frame_id = c_str(config_.base_frame);
+    t.transform.rotation = q;
+    tf2_msgs_msg_dds__TFMessage_ tf{};
+    tf.transforms = {1, 1, &t, false};
+    dds_write(tf_, &tf);
+}
+
+void TelemetryPublisher::write_joints() {
+    std::vector<std::string> names;
+    std::vector<char*> name_ptrs;
+    std::vector<double> actual, current, ordered;
+    for (unsigned i = 0; i < kThrusters; ++i) {
+        const Props& p = props(kThrusterPrefix + std::to_string(i), caracara::dbus::kThrusterIface);
+        names.push_back(thruster_joint_name(i));
+        actual.push_back(actual_fraction(p));
+        current.push_back(get(p, "Current").number());
+        ordered.push_back(motor_fraction(static_cast<int32_t>(get(p, "OrderedValue").integer())));
+    }
+    for (auto& n : names)
+        name_ptrs.push_back(c_str(n));
+    std::vector<double> none;
+    const auto n = static_cast<uint32_t>(names.size());
+    // velocity: the reported speed as a fraction of full thrust; effort: the current in A.
+    sensor_msgs_msg_dds__JointState_ js{header(config_.base_frame), {n, n, name_ptrs.data(), false}, {0, 0, nullptr, false},
+                                        {n, n, actual.data(), false}, {n, n, current.data(), false}};
+    dds_write(joints_, &js);
+    sensor_msgs_msg_dds__JointState_ os{header(config_.base_frame), {n, n, name_ptrs.data(), false}, {0, 0, nullptr, false},
+                                        {n, n, ordered.data(), false}, {0, 0, nullptr, false}};
+    dds_write(ordered_, &os);
+}
+
+void TelemetryPublisher::write_ranges() {
+    const Value& d = get(props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Distances");
+    for (std::size_t i = ranges_.size(); i < d.items.size(); ++i)
+        ranges_.push_back(dds_.writer(config_.range_layout == RangeLayout::Jazzy ? &jazzy_range_ : &sensor_msgs_msg_dds__Range__desc,
+                                      ros_topic(config_, "range/" + std::to_string(i)), Profile::Default));
+    for (std::size_t i = 0; i < d.items.size(); ++i) {
+        const std::string frame = range_frame(i);
+        const float metres = range_metres(static_cast<uint32_t>(d.items[i].unsigned_integer()));
+        // radiation_type ULTRASOUND (0): the Teensy does not say which kind of sensor it reads.
+        if (config_.range_layout == RangeLayout::Jazzy) {
+            jazzy_sensor_msgs_msg_dds__Range_ r{header(frame), 0, config_.range_fov_rad, config_.range_min_m,
+                                                config_.range_max_m, metres, 0.0f};
+            dds_write(ranges_[i], &r);
+        } else {
+            sensor_msgs_msg_dds__Range_ r{header(frame), 0, config_.range_fov_rad, config_.range_min_m,
+                                          config_.range_max_m, metres};
+            dds_write(ranges_[i], &r);
+        }
+    }
+}
+
+// OK 0, WARN 1, ERROR 2 for: each thruster, the bus, the Teensy, the failsafes, the vehicle.
+std::vector<uint8_t> TelemetryPublisher::levels() const {
+    std::vector<uint8_t> out;
+    for (unsigned i = 0; i < kThrusters; ++i) {
+        const Props& p = props(kThrusterPrefix + std::to_string(i), caracara::dbus::kThrusterIface);
+        out.push_back(!get(p, "Online").boolean() ? 2 : get(p, "Faults").items.empty() ? 0 : 1);
+    }
+    const std::string bus = get(props(caracara::dbus::kBusPath, caracara::dbus::kBusIface), "State").s;
+    out.push_back(bus == "lost" ? 2 : bus == "ok" ? 0 : 1);
+    out.push_back(get(props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Online").boolean() ? 0 : 2);
+    const Props& v = props(kRoot, caracara::dbus::kVehicleIface);
+    out.push_back(get(v, "Failsafes").items.empty() ? 0 : 1);
+    const std::string state = get(v, "State").s;
+    out.push_back(state == "fault" ? 2 : state == "ready" || state == "arming" ? 0 : 1);
+    return out;
+}
+
+void TelemetryPublisher::write_diagnostics() {
+    struct Status {
+        uint8_t level;
+        std::string name, message, hardware_id;
+        std::vector<std::pair<std::string, std::string>> values;
+    };
+    static const char* const kLevel[] = {"OK", "WARN", "ERROR"};
+    const std::vector<uint8_t> lv = levels();
+    std::vector<Status> st;
+    const auto num = [](const Value& v) {
+        char b[32];
+        std::snprintf(b, sizeof b, "%g", v.number());
+        return std::string(b);
+    };
+    for (unsigned i = 0; i < kThrusters; ++i) {
+        const Props& p = props(kThrusterPrefix + std::to_string(i), caracara::dbus::kThrusterIface);
+        std::string faults;
+        for (const Value& f : get(p, "Faults").items)
+            faults += (faults.empty() ? "" : ",") + f.s;
+        st.push_back({lv[i], "caracara: " + thruster_joint_name(i),
+                      lv[i] == 2 ? "unreachable" : faults.empty() ? "ok" : "faults: " + faults,
+                      "seabotix@0x" + [&] { char b[8]; std::snprintf(b, sizeof b, "%02x", static_cast<unsigned>(get(p, "Address").unsigned_integer())); return std::string(b); }(),
+                      {{"ordered value", std::to_string(get(p, "OrderedValue").integer())},
+                       {"actual speed", std::to_string(get(p, "ActualSpeed").unsigned_integer())},
+                       {"current A", num(get(p, "Current"))}, {"temperature C", num(get(p, "Temperature"))},
+                       {"faults", faults}, {"orders sent", std::to_string(get(p, "OrdersSent").unsigned_integer())},
+                       {"order failures", std::to_string(get(p, "OrderFailures").unsigned_integer())},
+                       {"last error", get(p, "LastError").s}}});
+    }
+    const Props& b = props(caracara::dbus::kBusPath, caracara::dbus::kBusIface);
+    st.push_back({lv[kThrusters], "caracara: i2c bus", get(b, "State").s, get(b, "Device").s,
+                  {{"transactions", std::to_string(get(b, "Transactions").unsigned_integer())},
+                   {"errors", std::to_string(get(b, "Errors").unsigned_integer())},
+                   {"recoveries", std::to_string(get(b, "Recoveries").unsigned_integer())},
+                   {"last error", get(b, "LastError").s}}});
+    const Props& t = props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface);
+    st.push_back({lv[kThrusters + 1], "caracara: teensy", get(t, "Online").boolean() ? "online" : "offline", "teensy",
+                  {{"frames", std::to_string(get(t, "Frames").unsigned_integer())},
+                   {"busy retries", std::to_string(get(t, "BusyRetries").unsigned_integer())},
+                   {"link errors", std::to_string(get(t, "LinkErrors").unsigned_integer())}}});
+    const Props& v = props(kRoot, caracara::dbus::kVehicleIface);
+    Status fs{lv[kThrusters + 2], "caracara: failsafes", "", "caracarad", {}};
+    for (const Value& f : get(v, "Failsafes").items) // (condition, action, thruster)
+        if (f.items.size() == 3)
+            fs.values.push_back({f.items[0].s, f.items[1].s + (f.items[2].integer() >= 0 ? " thruster " + std::to_string(f.items[2].integer()) : "")});
+    fs.message = fs.values.empty() ? "none active" : std::to_string(fs.values.size()) + " active";
+    st.push_back(std::move(fs));
+    st.push_back({lv[kThrusters + 3], "caracara: vehicle", get(v, "State").s, "caracarad",
+                  {{"kill source", get(v, "KillSource").s}, {"profile", get(v, "Profile").s},
+                   {"controller", get(v, "Controller").s}, {"budget limit", std::to_string(get(v, "BudgetLimit").integer())}}});
+    std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> kvs(st.size());
+    std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_> out;
+    for (std::size_t i = 0; i < st.size(); ++i) {
+        for (auto& [k, val] : st[i].values)
+            kvs[i].push_back({c_str(k), c_str(val)});
+        const auto n = static_cast<uint32_t>(kvs[i].size());
+        out.push_back({st[i].level, c_str(st[i].name), c_str(st[i].message), c_str(st[i].hardware_id),
+                       {n, n, kvs[i].data(), false}});
+    }
+    const auto n = static_cast<uint32_t>(out.size());
+    static const std::string kNoFrame; // diagnostics have no frame; header() keeps a pointer into it
+    diagnostic_msgs_msg_dds__DiagnosticArray_ a{header(kNoFrame), {n, n, out.data(), false}};
+    dds_write(diagnostics_, &a);
+    if (lv != last_levels_)
+        for (std::size_t i = 0; i < lv.size() && i < st.size(); ++i)
+            if (last_levels_.size() != lv.size() || last_levels_[i] != lv[i])
+                std::fprintf(stderr, "caracara-ros: %s: %s (%s)\n", st[i].name.c_str(), kLevel[lv[i]], st[i].message.c_str());
+    last_levels_ = lv;
+}
+
+} // namespace caracara::ros

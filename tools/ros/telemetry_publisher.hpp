@@ -1,0 +1,69 @@
+// caracara-ros's reading connection to caracarad and the topics it publishes: the vehicle's
+// objects (GetManagedObjects) kept current by PropertiesChanged, each change written to the
+// topics it touches once per batch of signals, so the rates are the daemon's announcement
+// rates; nothing is polled. The topics (docs/ros2.md): imu, joint_states, thrusters/ordered,
+// range/N, /diagnostics (at most 1 Hz, at once when a level changes), killed, state and
+// kill_source (transient-local), /tf.
+#pragma once
+
+#include "tools/client/client.hpp"
+#include "tools/ros/dds_participant.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace caracara::ros {
+
+class TelemetryPublisher {
+public:
+    TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config);
+    ~TelemetryPublisher();
+    TelemetryPublisher(const TelemetryPublisher&) = delete;
+    TelemetryPublisher& operator=(const TelemetryPublisher&) = delete;
+
+    // Connects and loads the objects; retries every second while caracarad is not there.
+    void start();
+    // The reading connection (for Kill, which any client may send), or null while reconnecting.
+    sd_bus* bus() const { return client_ ? client_->bus() : nullptr; }
+
+private:
+    enum Dirty : unsigned { kImu = 1, kJoints = 2, kRanges = 4, kDiagnostics = 8, kState = 16 };
+    static int on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
+    static int on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
+    static int on_flush(sd_event_source* s, void* userdata);
+    static int on_retry(sd_event_source* s, uint64_t usec, void* userdata);
+    static int on_diagnostics_due(sd_event_source* s, uint64_t usec, void* userdata);
+    bool connect();
+    void retry();
+    void reload();
+    void mark(unsigned dirty);
+    void changed(const std::string& path, const std::string& iface, const caracaractl::Props& props);
+    const caracaractl::Props& props(const std::string& path, const char* iface) const;
+
+    void write_imu_and_tf();
+    void write_joints();
+    void write_ranges();
+    void write_state();
+    void write_diagnostics();
+    std::vector<uint8_t> levels() const;
+
+    sd_event* event_;
+    DdsParticipant& dds_;
+    const RosConfig& config_;
+    std::unique_ptr<caracaractl::Client> client_;
+    std::vector<caracara::dbus::SlotPtr> slots_;
+    caracara::SourcePtr flush_, retry_, diagnostics_timer_;
+    caracaractl::Objects objects_;
+    unsigned dirty_ = 0;
+    uint64_t diagnostics_last_us_ = 0;
+    std::vector<uint8_t> last_levels_;
+    std::string last_state_, last_source_;
+    bool state_written_ = false;
+
+    dds_entity_t imu_, tf_, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
+    std::vector<dds_entity_t> ranges_;
+    dds_topic_descriptor_t jazzy_range_;
+};
+
+} // namespace caracara::ros
