@@ -10,8 +10,8 @@
 
 namespace caracara::ros {
 
-using caracaractl::Props;
-using caracaractl::Value;
+using client::Props;
+using client::Value;
 
 namespace {
 
@@ -97,7 +97,7 @@ int TelemetryPublisher::on_retry(sd_event_source*, uint64_t, void* userdata) {
 
 bool TelemetryPublisher::connect() {
     slots_.clear();
-    client_ = std::make_unique<caracaractl::Client>(config_.bus);
+    client_ = std::make_unique<client::Client>(config_.bus);
     try {
         sd_bus* bus = client_->bus();
         sd_bus_slot* slot = nullptr;
@@ -113,7 +113,7 @@ bool TelemetryPublisher::connect() {
         objects_ = client_->get_objects();
         if (sd_bus_attach_event(bus, event_, SD_EVENT_PRIORITY_NORMAL) < 0)
             return false;
-    } catch (const caracaractl::Failure& f) {
+    } catch (const client::Failure& f) {
         std::fprintf(stderr, "caracara-ros: caracarad not reachable (%s); retrying\n", f.message.c_str());
         slots_.clear();
         client_.reset();
@@ -137,7 +137,7 @@ void TelemetryPublisher::reload() {
     // waits for its reply on this connection, which sd-bus allows from a handler.
     try {
         objects_ = client_->get_objects();
-    } catch (const caracaractl::Failure& f) {
+    } catch (const client::Failure& f) {
         std::fprintf(stderr, "caracara-ros: reloading caracarad's objects failed (%s)\n", f.message.c_str());
         return;
     }
@@ -150,9 +150,9 @@ int TelemetryPublisher::on_properties_changed(sd_bus_message* m, void* userdata,
         const char* iface = nullptr;
         if (sd_bus_message_read(m, "s", &iface) < 0 || !iface)
             return 0;
-        const Props changes = caracaractl::to_props(caracaractl::read_value(m));
+        const Props changes = client::to_props(client::read_value(m));
         self->changed(sd_bus_message_get_path(m) ? sd_bus_message_get_path(m) : "", iface, changes);
-    } catch (const caracaractl::Failure&) {
+    } catch (const client::Failure&) {
         // A malformed signal changes nothing.
     }
     return 0;

@@ -38,8 +38,8 @@ private:
     void retry();
     void reload();
     void mark(unsigned dirty);
-    void changed(const std::string& path, const std::string& iface, const caracaractl::Props& props);
-    const caracaractl::Props& props(const std::string& path, const char* iface) const;
+    void changed(const std::string& path, const std::string& iface, const client::Props& props);
+    const client::Props& props(const std::string& path, const char* iface) const;
 
     void write_imu_and_tf();
     void write_joints();
@@ -51,10 +51,10 @@ private:
     sd_event* event_;
     DdsParticipant& dds_;
     const RosConfig& config_;
-    std::unique_ptr<caracaractl::Client> client_;
+    std::unique_ptr<client::Client> client_;
     std::vector<caracara::dbus::SlotPtr> slots_;
     caracara::SourcePtr flush_, retry_, diagnostics_timer_;
-    caracaractl::Objects objects_;
+    client::Objects objects_;
     unsigned dirty_ = 0;
     uint64_t diagnostics_last_us_ = 0;
     std::vector<uint8_t> last_levels_;
