@@ -205,6 +205,13 @@ void parse_recorder(Checker& c, const toml::table& t, RecorderSettings& out) {
     c.integer(t, p, "max_total_mb", 1, 1048576, out.max_total_mb);
 }
 
+void parse_commissioning(Checker& c, const toml::table& t, CommissioningSettings& out) {
+    const std::string p = "commissioning.";
+    c.only_keys(t, p, {"motor_test_limit", "motor_test_keepalive_ms"});
+    c.integer(t, p, "motor_test_limit", 1, kMotorMax, out.motor_test_limit);
+    c.integer(t, p, "motor_test_keepalive_ms", 50, 500, out.motor_test_keepalive_ms);
+}
+
 } // namespace
 
 ConfigResult parse_config_string(std::string_view text, std::string_view source) {
@@ -227,7 +234,7 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     DaemonConfig cfg;
     // [sim] belongs to caracara-sim, which reads the same file; it is not checked here.
     c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "recorder", "failsafe",
-                       "sim"});
+                       "commissioning", "sim"});
     if (const toml::table* t = c.table(root, "", "i2c"))
         parse_i2c(c, *t, cfg.i2c);
     if (const toml::table* t = c.table(root, "", "spi"))
@@ -247,6 +254,8 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
         parse_recorder(c, *t, cfg.recorder);
     if (const toml::table* t = c.table(root, "", "failsafe"))
         parse_failsafe(c, *t, cfg.failsafe);
+    if (const toml::table* t = c.table(root, "", "commissioning"))
+        parse_commissioning(c, *t, cfg.commissioning);
     c.table(root, "", "sim");
     if (!cfg.profiles.empty() && !find_profile(cfg, cfg.control.profile)) {
         c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + profile_names(cfg),

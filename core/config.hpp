@@ -98,6 +98,16 @@ struct RecorderSettings {
 
 // The default vehicle: eight SeaBotix controllers at MT 0x52, 0x56, 0x58, 0x5A, 0x5C,
 // 0x5E, 0x60, 0x62 (distinct even addresses, all on the main bus).
+// Commissioning at the pool (docs/commissioning.md): how hard and how long one thruster may
+// be run by a motor test, the caller's keep-alive.
+struct CommissioningSettings {
+    // |value| a motor test may order: small by default, a thruster run in the air or by a
+    // vehicle held at the side (motor units, -8850..8850).
+    int32_t motor_test_limit = 1500;
+    // The caller repeats its MotorTest call within this or the thruster stops (ArduSub's 500 ms).
+    uint32_t motor_test_keepalive_ms = 500;
+};
+
 std::array<ThrusterConfig, kMotorCount> default_thrusters();
 
 struct DaemonConfig {
@@ -111,6 +121,7 @@ struct DaemonConfig {
     RecorderSettings recorder;
     FailsafeSettings failsafe;
     std::vector<ThrustProfile> profiles{{"water", 1.0}};
+    CommissioningSettings commissioning;
 };
 
 // The profile called `name`, or nullptr.

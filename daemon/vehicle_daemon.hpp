@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/commissioning/motor_test.hpp"
 #include "daemon/recovery/bus_recovery.hpp"
 #include "daemon/bus/thruster_bus.hpp"
 #include "daemon/dive/dive_recorder.hpp"
@@ -57,6 +58,8 @@ public:
     ControlLoop& loop() { return loop_; }
     const ControlLoop& loop() const { return loop_; }
     ServiceStatus& status() { return status_; }
+    MotorTest& motor_test() { return motor_test_; }
+    const MotorTest& motor_test() const { return motor_test_; }
     FailsafeMonitor& failsafes() { return failsafes_; }
     const FailsafeMonitor& failsafes() const { return failsafes_; }
     // The dive recorder, or nullptr when recorder.enabled is false.
@@ -81,6 +84,7 @@ private:
     BusRecovery recovery_;
     ServiceStatus status_;
     FailsafeMonitor failsafes_;
+    MotorTest motor_test_;
     std::unique_ptr<DiveWriter> dive_writer_;
     std::unique_ptr<DiveRecorder> recorder_;
     bool started_ = false;

@@ -96,6 +96,13 @@ int m_set_profile(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return reply(m, ctl(userdata).set_profile(name));
 }
 
+int m_motor_test(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    int32_t thruster = 0, value = 0;
+    if (int r = sd_bus_message_read(m, "ii", &thruster, &value); r < 0)
+        return r;
+    return reply(m, static_cast<Parts*>(userdata)->motor_test.run(thruster, value, sender(m)));
+}
+
 const ControlSettings& control(D d) { return d.control; }
 
 constexpr Member kMembers[] = {
@@ -110,6 +117,8 @@ constexpr Member kMembers[] = {
     member(SD_BUS_SIGNAL_WITH_ARGS("Failsafe", SD_BUS_ARGS("s", condition, "s", action, "i", thruster), 0)),
     property<[](D d) { return failsafes(d); }>("Failsafes", kChange, kChangeFailsafes),
     member(SD_BUS_METHOD_WITH_ARGS("PowerOff", SD_BUS_ARGS("s", confirmation), SD_BUS_NO_RESULT, m_power_off, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("MotorTest", SD_BUS_ARGS("i", thruster, "i", value), SD_BUS_NO_RESULT, m_motor_test,
+                                   kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetProfile", SD_BUS_ARGS("s", name), SD_BUS_NO_RESULT, m_set_profile, kUnpriv)),
@@ -125,6 +134,8 @@ constexpr Member kMembers[] = {
     property<[](D d) { auto l = d.teensy.leds(); return std::tuple{l[0], l[1], l[2]}; }>("Leds", kChange, kChangeLeds),
     property<[](D d) { return d.vehicle.command_age_ms(); }>("CommandAgeMs", kChange, kTelemetryTick),
     property<[](D d) -> const auto& { return d.vehicle.controller_client(); }>("Controller", kChange, kChangeController),
+    property<[](D d) { return std::tuple{d.motor_test.active_thruster(), d.motor_test.value()}; }>(
+        "MotorTest", kChange, kChangeMotors | kChangeController | kChangeState),
     property<[](D d) { return control(d).command_timeout_ms; }>("CommandTimeoutMs", kConst),
     property<[](D d) { return control(d).arming_delay_ms; }>("ArmingDelayMs", kConst),
     property<[](D d) { return double(control(d).loop_rate_hz); }>("LoopRateHz", kConst),

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <unistd.h>
@@ -30,7 +31,8 @@ struct Options {
     bool yes_power_off = false;
     bool all = false;    // monitor --all
     bool for_given = false;
-    HoldOptions hold;    // thrust, motion, packet: --for SECONDS, --once
+    HoldOptions hold;    // thrust, motion, packet, motor-test: --for SECONDS, --once
+    std::optional<int32_t> value; // motor-test --value V
 };
 
 // The longest --for: beyond any dive, and far from overflowing the microsecond clock.
@@ -118,6 +120,16 @@ int cmd_motion(Client& c, const Args& a, const Options& o) {
         v[i] = parse_double(a[i], names[i]);
     return hold_command(c, "SetMotion", append_args("dddddd", v[0], v[1], v[2], v[3], v[4], v[5]),
                         strf("SetMotion(%g, %g, %g, %g, %g, %g)", v[0], v[1], v[2], v[3], v[4], v[5]), o.hold);
+}
+
+// One thruster, the others at zero, held like thrust: caracarad stops it when the re-sends
+// (every 100 ms) stop for its keep-alive (500 ms), and when this client leaves.
+int cmd_motor_test(Client& c, const Args& a, const Options& o) {
+    const int32_t thruster = parse_int(a[0], "thruster");
+    if (!o.value)
+        usage_error("motor-test needs --value V");
+    return hold_command(c, "MotorTest", append_args("ii", thruster, *o.value),
+                        strf("MotorTest(%d, %d)", thruster, *o.value), o.hold);
 }
 
 // Packet words 8 and 9: killState and powerOffState.
@@ -216,6 +228,7 @@ enum CommandOption : unsigned {
     kOptHold = 1 << 0,        // --for SECONDS, --once
     kOptAll = 1 << 1,         // --all
     kOptYesPowerOff = 1 << 2, // --yes-power-off
+    kOptValue = 1 << 3,       // --value V
 };
 
 struct Command {
@@ -238,6 +251,8 @@ constexpr Command kCommands[] = {
     {"packet", "W0 ... W12", "Hold a 13-word Caracara packet (motors, kill, power-off, RGB)", 13, cmd_packet,
      nullptr, kOptHold},
     {"kill", "", "Zero every thruster at once and latch the kill", 0, cmd_kill},
+    {"motor-test", "N --value V", "Run thruster N alone at V (bounded, armed only) until ^C or --for", 1,
+     cmd_motor_test, nullptr, kOptHold | kOptValue},
     {"clear-kill", "", "Clear the kill, e.g. the one every start comes up with (arming, then ready)", 0,
      cmd_clear_kill},
     {"clear-kill-override", "CONDITION",
@@ -285,10 +300,12 @@ void print_help() {
                  "  --version                        Show the version\n"
                  "  -h --help                        Show this help\n"
                  "\nCommand options (after the command, before or after its values):\n"
-                 "  --for SECONDS                    thrust, motion, packet: hold for SECONDS (decimals\n"
+                 "  --for SECONDS                    thrust, motion, packet, motor-test: hold for SECONDS (decimals\n"
                  "                                   allowed, e.g. 2.5), then let go\n"
                  "  --once                           thrust, motion, packet: send once and exit; caracarad\n"
                  "                                   zeroes the thrusters as soon as caracaractl has left\n"
+                 "  --value V                        motor-test: the motor value (-8850..8850; caracarad\n"
+                 "                                   refuses beyond commissioning.motor_test_limit)\n"
                  "  --all                            monitor: print every announcement, with the fast\n"
                  "                                   counters (Cycles, CommandAgeMs, OrdersSent,\n"
                  "                                   StatusReads, Frames, BusyRetries, Transactions) and\n"
@@ -404,6 +421,11 @@ int main(int argc, char** argv) {
                     usage_error("--for needs a number of seconds");
                 options.hold.duration_usec = parse_duration(a == "--for" ? argv[++i] : a.substr(6));
                 options.for_given = true;
+            } else if (a == "--value" || a.starts_with("--value=")) {
+                takes(kOptValue, "--value");
+                if (a == "--value" && i + 1 >= argc)
+                    usage_error("--value needs a motor value");
+                options.value = parse_int(a == "--value" ? argv[++i] : a.substr(8), "--value");
             } else if (a.starts_with("--")) {
                 usage_error("unknown option '" + a + "'"); // values never start with "--"
             } else {
