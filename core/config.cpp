@@ -207,9 +207,16 @@ void parse_recorder(Checker& c, const toml::table& t, RecorderSettings& out) {
 
 void parse_commissioning(Checker& c, const toml::table& t, CommissioningSettings& out) {
     const std::string p = "commissioning.";
-    c.only_keys(t, p, {"motor_test_limit", "motor_test_keepalive_ms"});
+    c.only_keys(t, p, {"motor_test_limit", "motor_test_keepalive_ms", "detect_pulse_value", "detect_pulse_ms",
+                       "detect_threshold_mrad", "detect_settle_mrad", "detect_settle_ms", "detect_settle_timeout_ms"});
     c.integer(t, p, "motor_test_limit", 1, kMotorMax, out.motor_test_limit);
     c.integer(t, p, "motor_test_keepalive_ms", 50, 500, out.motor_test_keepalive_ms);
+    c.integer(t, p, "detect_pulse_value", 100, 5000, out.detect_pulse_value);
+    c.integer(t, p, "detect_pulse_ms", 100, 3000, out.detect_pulse_ms);
+    c.integer(t, p, "detect_threshold_mrad", 1, 500, out.detect_threshold_mrad);
+    c.integer(t, p, "detect_settle_mrad", 1, 500, out.detect_settle_mrad);
+    c.integer(t, p, "detect_settle_ms", 100, 5000, out.detect_settle_ms);
+    c.integer(t, p, "detect_settle_timeout_ms", 1000, 60000, out.detect_settle_timeout_ms);
 }
 
 } // namespace

@@ -24,6 +24,7 @@ std::string_view status_name(Status s) {
     case Status::ThrusterUnreachable: return "ThrusterUnreachable";
     case Status::Surfacing: return "Surfacing";
     case Status::FailsafeActive: return "FailsafeActive";
+    case Status::NotStill: return "NotStill";
     }
     return "Hardware";
 }

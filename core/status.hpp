@@ -29,6 +29,7 @@ enum class Status {
     ThrusterUnreachable,
     Surfacing,       // a failsafe's ascent is running: other motion waits for it (Kill does not)
     FailsafeActive,  // ClearKill while the failsafe that killed still holds
+    NotStill,        // direction detection: the vehicle did not settle before a pulse
 };
 std::string_view status_name(Status s); // "OutOfRange", ...
 

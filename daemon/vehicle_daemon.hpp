@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/commissioning/direction_detection.hpp"
 #include "daemon/commissioning/motor_test.hpp"
 #include "daemon/recovery/bus_recovery.hpp"
 #include "daemon/bus/thruster_bus.hpp"
@@ -60,6 +61,7 @@ public:
     ServiceStatus& status() { return status_; }
     MotorTest& motor_test() { return motor_test_; }
     const MotorTest& motor_test() const { return motor_test_; }
+    DirectionDetection& directions() { return directions_; }
     FailsafeMonitor& failsafes() { return failsafes_; }
     const FailsafeMonitor& failsafes() const { return failsafes_; }
     // The dive recorder, or nullptr when recorder.enabled is false.
@@ -85,6 +87,7 @@ private:
     ServiceStatus status_;
     FailsafeMonitor failsafes_;
     MotorTest motor_test_;
+    DirectionDetection directions_;
     std::unique_ptr<DiveWriter> dive_writer_;
     std::unique_ptr<DiveRecorder> recorder_;
     bool started_ = false;

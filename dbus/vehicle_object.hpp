@@ -2,6 +2,7 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/commissioning/direction_detection.hpp"
 #include "daemon/commissioning/motor_test.hpp"
 #include "daemon/failsafe/failsafe_monitor.hpp"
 #include "daemon/teensy/teensy_port.hpp"
@@ -15,7 +16,8 @@ namespace caracara::dbus {
 class VehicleObject {
 public:
     // What the object drives and shows: the vehicle, its legacy packet, the Teensy's LEDs, the loop's cycle
-    // count, the control settings, the failsafes (active ones, ClearKillOverride) and the motor test.
+    // count, the control settings, the failsafes (active ones, ClearKillOverride), the motor test and
+    // direction detection.
     struct Parts {
         Vehicle& vehicle;
         PacketHandler& packets;
@@ -24,6 +26,7 @@ public:
         const ControlSettings& control;
         FailsafeMonitor& failsafes;
         MotorTest& motor_test;
+        DirectionDetection& directions;
     };
     VehicleObject(sd_bus* bus, const Parts& parts);
     VehicleObject(const VehicleObject&) = delete;
