@@ -107,13 +107,14 @@ struct CommissioningSettings {
     // The caller repeats its MotorTest call within this or the thruster stops (ArduSub's 500 ms).
     uint32_t motor_test_keepalive_ms = 500;
     // Direction detection: each thruster pulsed alone at this value for this long, once the
-    // vehicle has held still (each angle within settle_mrad over settle_ms, at most
-    // settle_timeout_ms); a change under threshold_mrad along the mixing's rotation is inconclusive.
+    // vehicle has held still (each angle's mean moved at most settle_mrad between the halves of
+    // settle_ms; waited for at most settle_timeout_ms); a change under threshold_mrad along the
+    // mixing's rotation is inconclusive.
     int32_t detect_pulse_value = 3000;
     uint32_t detect_pulse_ms = 800;
     uint32_t detect_threshold_mrad = 10;
-    uint32_t detect_settle_mrad = 20;
-    uint32_t detect_settle_ms = 400;
+    uint32_t detect_settle_mrad = 5;
+    uint32_t detect_settle_ms = 1000;
     uint32_t detect_settle_timeout_ms = 10000;
 };
 

@@ -145,15 +145,31 @@ void DirectionDetection::step() {
 void DirectionDetection::settle_step(uint64_t now) {
     const auto& c = config_.commissioning;
     const uint64_t window = uint64_t(c.detect_settle_ms) * kMs;
+    // The zeros re-sent, as the pulse is, so the command timeout does not take the caller's
+    // place as the commanding client between pulses.
+    if (Result r = vehicle_.drive(MotorValues{}, client_); !r.ok()) {
+        end(r);
+        return;
+    }
     std::erase_if(samples_, [&](const Sample& s) { return s.t_ns + window < now; });
-    if (now - phase_start_ns_ >= window) {
-        const std::array<double, 3> mean = mean_from(samples_, 0);
-        double spread = 0.0;
-        for (const Sample& s : samples_)
-            for (std::size_t k = 0; k < 3; ++k)
-                spread = std::max(spread, std::abs(k == 0 ? wrap(s.att[k] - mean[k]) : s.att[k] - mean[k]));
-        if (spread * 2.0 <= c.detect_settle_mrad / 1000.0) {
-            baseline_ = mean;
+    // A vertical thruster's pulse leaves pitch and roll swinging back (the vehicle is
+    // bottom-heavy); the window is judged only after a rest of two windows.
+    if (now - phase_start_ns_ >= (motor_ == 0 ? 1 : 3) * window) {
+        // Still: the mean attitude of the window's second half is within detect_settle_mrad of
+        // its first half's on every axis (a spread test would be fooled by the sensor's noise).
+        const uint64_t half = window / 2;
+        const std::array<double, 3> first = mean_from(samples_, 0);
+        const std::array<double, 3> second = mean_from(samples_, now - half);
+        std::array<double, 3> moved{};
+        double worst = 0.0;
+        for (std::size_t k = 0; k < 3; ++k) {
+            moved[k] = k == 0 ? wrap(second[k] - first[k]) : second[k] - first[k];
+            worst = std::max(worst, std::abs(moved[k]));
+        }
+        if (worst <= c.detect_settle_mrad / 1000.0) {
+            // The whole window's mean: the sensor's noise averaged over every sample. A slow drift
+            // is left in (0.5 mrad/s moves ~1 mrad by the measurement, a tenth of the threshold).
+            baseline_ = mean_from(samples_, 0);
             samples_.clear();
             phase_ = Phase::Pulse;
             phase_start_ns_ = now;

@@ -1,6 +1,7 @@
 // Thruster direction detection (docs/commissioning.md; ArduSub's motor detection on our
 // mixing): armed, in the water, still; for each thruster in turn it waits until the vehicle
-// holds still (the Teensy's orientation within detect_settle_mrad over detect_settle_ms), takes
+// holds still (after a rest, the Teensy's orientation moved at most detect_settle_mrad between
+// the halves of detect_settle_ms), takes
 // that attitude, pulses the thruster alone (detect_pulse_value for detect_pulse_ms, through
 // Vehicle::drive like any motor command: budget, state, commanding client, the wire), takes the
 // attitude over the end of the pulse, orders it zero, and has core/direction_judgement say ok,
@@ -75,7 +76,7 @@ private:
     Completion done_;
     uint64_t phase_start_ns_ = 0;
     std::vector<Sample> samples_;
-    std::array<double, 3> baseline_{};
+    std::array<double, 3> baseline_{}; // rad: the still window's mean
     std::array<DirectionFinding, kMotorCount> findings_{};
 };
 
