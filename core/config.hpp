@@ -110,9 +110,10 @@ struct CommissioningSettings {
     // vehicle has held still (each angle's mean moved at most settle_mrad between the halves of
     // settle_ms; waited for at most settle_timeout_ms); a change under threshold_mrad along the
     // mixing's rotation is inconclusive.
-    int32_t detect_pulse_value = 3000;
+    int32_t detect_pulse_value = 3000;       // motor units
     uint32_t detect_pulse_ms = 800;
-    uint32_t detect_threshold_mrad = 10;
+    uint32_t detect_threshold_mrad = 10;     // along the mixing's rotation
+    // Still enough to pulse: the angles' drift between the window's halves, the window, the wait.
     uint32_t detect_settle_mrad = 5;
     uint32_t detect_settle_ms = 1000;
     uint32_t detect_settle_timeout_ms = 10000;

@@ -152,9 +152,10 @@ void DirectionDetection::settle_step(uint64_t now) {
         return;
     }
     std::erase_if(samples_, [&](const Sample& s) { return s.t_ns + window < now; });
-    // A vertical thruster's pulse leaves pitch and roll swinging back (the vehicle is
-    // bottom-heavy); the window is judged only after a rest of two windows.
-    if (now - phase_start_ns_ >= (motor_ == 0 ? 1 : 3) * window) {
+    // A vertical thruster's pulse (this run's or whatever moved the vehicle before it) leaves
+    // pitch and roll swinging back (the vehicle is bottom-heavy); the window is judged only after
+    // a rest of two windows.
+    if (now - phase_start_ns_ >= 3 * window) {
         // Still: the mean attitude of the window's second half is within detect_settle_mrad of
         // its first half's on every axis (a spread test would be fooled by the sensor's noise).
         const uint64_t half = window / 2;

@@ -91,6 +91,10 @@ class ReversedThrustersTest(DetectionCase):
                     self.assertGreater(spans[i][0], spans[i - 1][1], "pulses of %d and %d overlap" % (i - 1, i))
                 self.assertEqual(self.rig.sim_speeds(), [ZERO] * MOTORS)
 
+class WrittenFragmentTest(DetectionCase):
+    """The same vehicle; its own rig, since loading the fragment changes caracarad's configuration."""
+    SIM_CONFIG = ReversedThrustersTest.SIM_CONFIG
+
     def test_the_written_fragment_makes_yaw_turn_the_right_way(self):
         rig = self.rig
         path = os.path.join(rig.dir, "directions.toml")
