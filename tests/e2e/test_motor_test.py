@@ -42,6 +42,7 @@ class MotorTestTest(VehicleTestCase):
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         rig.wait_sim_speeds(alone(3, 1500), timeout=5)
         self.assertEqual(tuple(int(v) for v in rig.vget("MotorTest")), (3, 1500))
+        self.assertIn("thruster 3 at 1500", rig.ctl("status").stdout)
         out, err = p.communicate(timeout=30)
         self.assertEqual(p.returncode, 0, err)
         self.assertIn("MotorTest(3, 1500)", out)
