@@ -17,6 +17,8 @@ foreach(name properties announcements thrusters bus_recovery budget motion packe
                        TIMEOUT 600
                        LABELS e2e)
 endforeach()
+# Seven direction detections of eight pulses each, every pulse after the vehicle settles.
+set_tests_properties(e2e_direction_detection PROPERTIES TIMEOUT 1200)
 
 # The dive recorder: a dive listed and plotted, bad dive files refused, and the regression dives
 # of tests/dives replayed against their expected output (tests/dives/test_dives.py).
