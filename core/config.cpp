@@ -270,6 +270,20 @@ void parse_realtime(Checker& c, const toml::table& t, RealtimeSettings& out) {
                t.get("teensy_priority"));
 }
 
+void parse_commissioning(Checker& c, const toml::table& t, CommissioningSettings& out) {
+    const std::string p = "commissioning.";
+    c.only_keys(t, p, {"motor_test_limit", "motor_test_keepalive_ms", "detect_pulse_value", "detect_pulse_ms",
+                       "detect_threshold_mrad", "detect_settle_mrad", "detect_settle_ms", "detect_settle_timeout_ms"});
+    c.integer(t, p, "motor_test_limit", 1, kMotorMax, out.motor_test_limit);
+    c.integer(t, p, "motor_test_keepalive_ms", 50, 500, out.motor_test_keepalive_ms);
+    c.integer(t, p, "detect_pulse_value", 100, 5000, out.detect_pulse_value);
+    c.integer(t, p, "detect_pulse_ms", 100, 3000, out.detect_pulse_ms);
+    c.integer(t, p, "detect_threshold_mrad", 1, 500, out.detect_threshold_mrad);
+    c.integer(t, p, "detect_settle_mrad", 1, 500, out.detect_settle_mrad);
+    c.integer(t, p, "detect_settle_ms", 100, 5000, out.detect_settle_ms);
+    c.integer(t, p, "detect_settle_timeout_ms", 1000, 60000, out.detect_settle_timeout_ms);
+}
+
 } // namespace
 
 ConfigResult parse_config_string(std::string_view text, std::string_view source) {
@@ -292,7 +306,7 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     DaemonConfig cfg;
     // [sim] belongs to caracara-sim, which reads the same file; it is not checked here.
     c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "recorder", "failsafe",
-                       "realtime", "sim"});
+                       "realtime", "commissioning", "sim"});
     if (const toml::table* t = c.table(root, "", "i2c"))
         parse_i2c(c, *t, cfg.i2c);
     if (const toml::table* t = c.table(root, "", "spi"))
@@ -314,6 +328,8 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
         parse_failsafe(c, *t, cfg.failsafe);
     if (const toml::table* t = c.table(root, "", "realtime"))
         parse_realtime(c, *t, cfg.realtime);
+    if (const toml::table* t = c.table(root, "", "commissioning"))
+        parse_commissioning(c, *t, cfg.commissioning);
     c.table(root, "", "sim");
     if (!cfg.profiles.empty() && !find_profile(cfg, cfg.control.profile)) {
         c.fail("control.profile", "\"" + cfg.control.profile + "\" is not a profile; known: " + profile_names(cfg),

@@ -130,6 +130,27 @@ struct RealtimeSettings {
 
 // The default vehicle: eight SeaBotix controllers at MT 0x52, 0x56, 0x58, 0x5A, 0x5C,
 // 0x5E, 0x60, 0x62 (distinct even addresses, all on the main bus).
+// Commissioning at the pool (docs/commissioning.md): how hard and how long one thruster may
+// be run by a motor test, the caller's keep-alive.
+struct CommissioningSettings {
+    // |value| a motor test may order: small by default, a thruster run in the air or by a
+    // vehicle held at the side (motor units, -8850..8850).
+    int32_t motor_test_limit = 1500;
+    // The caller repeats its MotorTest call within this or the thruster stops (ArduSub's 500 ms).
+    uint32_t motor_test_keepalive_ms = 500;
+    // Direction detection: each thruster pulsed alone at this value for this long, once the
+    // vehicle has held still (each angle's mean moved at most settle_mrad between the halves of
+    // settle_ms; waited for at most settle_timeout_ms); a change under threshold_mrad along the
+    // mixing's rotation is inconclusive.
+    int32_t detect_pulse_value = 3000;       // motor units
+    uint32_t detect_pulse_ms = 800;
+    uint32_t detect_threshold_mrad = 10;     // along the mixing's rotation
+    // Still enough to pulse: the angles' drift between the window's halves, the window, the wait.
+    uint32_t detect_settle_mrad = 5;
+    uint32_t detect_settle_ms = 1000;
+    uint32_t detect_settle_timeout_ms = 10000;
+};
+
 std::array<ThrusterConfig, kMotorCount> default_thrusters();
 
 struct DaemonConfig {
@@ -144,6 +165,7 @@ struct DaemonConfig {
     FailsafeSettings failsafe;
     RealtimeSettings realtime;
     std::vector<ThrustProfile> profiles{{"water", 1.0}};
+    CommissioningSettings commissioning;
 };
 
 // The profile called `name`, or nullptr.

@@ -31,10 +31,11 @@ enum class Status {
     ThrusterUnreachable,
     Surfacing,       // a failsafe's ascent is running: other motion waits for it (Kill does not)
     FailsafeActive,  // ClearKill while the failsafe that killed still holds
+    NotStill,        // direction detection: the vehicle did not settle before a pulse
 };
 template <>
 struct EnumNames<Status> {
-    static constexpr std::array<EnumName<Status>, 20> table{{
+    static constexpr std::array<EnumName<Status>, 21> table{{
         {Status::Ok, "Ok"},
         {Status::InvalidLength, "InvalidLength"},
         {Status::OutOfRange, "OutOfRange"},
@@ -55,6 +56,7 @@ struct EnumNames<Status> {
         {Status::ThrusterUnreachable, "ThrusterUnreachable"},
         {Status::Surfacing, "Surfacing"},
         {Status::FailsafeActive, "FailsafeActive"},
+        {Status::NotStill, "NotStill"},
     }};
 };
 inline std::string_view status_name(Status v) { return name_of(v); }

@@ -19,7 +19,9 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
       recovery_(event, config_, io, gpio, bus_, loop_, vehicle_, events_),
       status_(event, vehicle_, bus_, loop_),
       failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); },
-                 [this] { return vehicle_conditions(); }, vehicle_, events_) {
+                 [this] { return vehicle_conditions(); }, vehicle_, events_),
+      motor_test_(config_, vehicle_),
+      directions_(config_, vehicle_, teensy_, failsafes_) {
     vehicle_.set_demand_listener(&loop_);
     bus_.monitor().set_listener(&recovery_);
     events_.attach_status(&status_);
@@ -90,6 +92,10 @@ std::string VehicleDaemon::start() {
         return e;
     if (std::string e = failsafes_.start(); !e.empty())
         return e;
+    if (std::string e = motor_test_.start(event_); !e.empty())
+        return e;
+    if (std::string e = directions_.start(event_); !e.empty())
+        return e;
     started_ = true;
     return {};
 }
@@ -107,6 +113,8 @@ void VehicleDaemon::shutdown() {
     bus_.health().set_gate(nullptr);
     loop_.stop();
     failsafes_.stop();
+    motor_test_.stop();
+    directions_.stop();
     if (recorder_) {
         recorder_->stop(); // the dive ends here, before the zeros of the way out
         events_.attach_recorder(nullptr);

@@ -5,6 +5,8 @@
 
 #include "core/config.hpp"
 #include "daemon/bus/thruster_bus.hpp"
+#include "daemon/commissioning/direction_detection.hpp"
+#include "daemon/commissioning/motor_test.hpp"
 #include "daemon/control/control_loop.hpp"
 #include "daemon/dive/dive_recorder.hpp"
 #include "daemon/dive/dive_writer.hpp"
@@ -57,6 +59,9 @@ public:
     ControlLoop& loop() { return loop_; }
     const ControlLoop& loop() const { return loop_; }
     ServiceStatus& status() { return status_; }
+    MotorTest& motor_test() { return motor_test_; }
+    const MotorTest& motor_test() const { return motor_test_; }
+    DirectionDetection& directions() { return directions_; }
     FailsafeMonitor& failsafes() { return failsafes_; }
     const FailsafeMonitor& failsafes() const { return failsafes_; }
     // The dive recorder, or nullptr when recorder.enabled is false.
@@ -81,6 +86,8 @@ private:
     BusRecovery recovery_;
     ServiceStatus status_;
     FailsafeMonitor failsafes_;
+    MotorTest motor_test_;
+    DirectionDetection directions_;
     std::unique_ptr<DiveWriter> dive_writer_;
     std::unique_ptr<DiveRecorder> recorder_;
     bool started_ = false;

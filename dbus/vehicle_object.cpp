@@ -5,6 +5,7 @@
 #include "dbus/vehicle_names.hpp"
 
 #include <cstring>
+#include <memory>
 #include <tuple>
 #include <vector>
 
@@ -96,6 +97,45 @@ int m_set_profile(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return reply(m, vehicle(userdata).set_profile(name));
 }
 
+int m_motor_test(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    int32_t thruster = 0, value = 0;
+    if (int r = sd_bus_message_read(m, "ii", &thruster, &value); r < 0)
+        return r;
+    return reply(m, static_cast<Parts*>(userdata)->motor_test.run(thruster, value, sender(m)));
+}
+
+// Replied to when the detection ends: each thruster's (verdict, yaw, pitch, roll change, change
+// along its row, margin) and the fragment, or the error that ended it.
+int reply_directions(sd_bus_message* call, const DirectionDetection& d) {
+    MessagePtr out;
+    sd_bus_message* m = nullptr;
+    int r = sd_bus_message_new_method_return(call, &m);
+    if (r < 0)
+        return r;
+    out.reset(m);
+    if ((r = sd_bus_message_open_container(m, 'a', "(sddddd)")) < 0)
+        return r;
+    for (const DirectionFinding& f : d.findings()) {
+        const std::string verdict(verdict_name(f.judgement.verdict));
+        if ((r = sd_bus_message_append(m, "(sddddd)", verdict.c_str(), f.change[0], f.change[1], f.change[2],
+                                       f.judgement.along, f.judgement.margin)) < 0)
+            return r;
+    }
+    if ((r = sd_bus_message_close_container(m)) < 0 || (r = sd_bus_message_append(m, "s", d.fragment().c_str())) < 0)
+        return r;
+    return sd_bus_send(nullptr, m, nullptr);
+}
+
+int m_detect_directions(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    DirectionDetection& d = static_cast<Parts*>(userdata)->directions;
+    auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
+    d.run(sender(m), [held, &d](const Result& r) {
+        if (!r.ok() || reply_directions(held.get(), d) < 0)
+            reply(held.get(), r.ok() ? Result{Status::Hardware, "cannot build the reply"} : r);
+    });
+    return 1;
+}
+
 const ControlSettings& control(D d) { return d.control; }
 
 constexpr Member kMembers[] = {
@@ -110,6 +150,10 @@ constexpr Member kMembers[] = {
     member(SD_BUS_SIGNAL_WITH_ARGS("Failsafe", SD_BUS_ARGS("s", condition, "s", action, "i", thruster), 0)),
     property<[](D d) { return failsafes(d); }>("Failsafes", kChange, kChangeFailsafes),
     member(SD_BUS_METHOD_WITH_ARGS("PowerOff", SD_BUS_ARGS("s", confirmation), SD_BUS_NO_RESULT, m_power_off, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("MotorTest", SD_BUS_ARGS("i", thruster, "i", value), SD_BUS_NO_RESULT, m_motor_test,
+                                   kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("DetectDirections", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(sddddd)", thrusters, "s", fragment),
+                                   m_detect_directions, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetProfile", SD_BUS_ARGS("s", name), SD_BUS_NO_RESULT, m_set_profile, kUnpriv)),
@@ -125,6 +169,8 @@ constexpr Member kMembers[] = {
     property<[](D d) { auto l = d.teensy.leds(); return std::tuple{l[0], l[1], l[2]}; }>("Leds", kChange, kChangeLeds),
     property<[](D d) { return d.vehicle.command_age_ms(); }>("CommandAgeMs", kChange, kTelemetryTick),
     property<[](D d) -> const auto& { return d.vehicle.controller_client(); }>("Controller", kChange, kChangeController),
+    property<[](D d) { return std::tuple{d.motor_test.active_thruster(), d.motor_test.value()}; }>(
+        "MotorTest", kChange, kChangeMotors | kChangeController | kChangeState),
     property<[](D d) { return control(d).command_timeout_ms; }>("CommandTimeoutMs", kConst),
     property<[](D d) { return control(d).arming_delay_ms; }>("ArmingDelayMs", kConst),
     property<[](D d) { return double(control(d).loop_rate_hz); }>("LoopRateHz", kConst),

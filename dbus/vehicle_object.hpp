@@ -2,6 +2,8 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/commissioning/direction_detection.hpp"
+#include "daemon/commissioning/motor_test.hpp"
 #include "daemon/failsafe/failsafe_monitor.hpp"
 #include "daemon/teensy/teensy_port.hpp"
 #include "daemon/control/control_loop.hpp"
@@ -14,7 +16,8 @@ namespace caracara::dbus {
 class VehicleObject {
 public:
     // What the object drives and shows: the vehicle, its legacy packet, the Teensy's LEDs, the loop's cycle
-    // count, the control settings and the failsafes (active ones, ClearKillOverride).
+    // count, the control settings, the failsafes (active ones, ClearKillOverride), the motor test and
+    // direction detection.
     struct Parts {
         Vehicle& vehicle;
         PacketHandler& packets;
@@ -22,6 +25,8 @@ public:
         const ControlLoop& loop;
         const ControlSettings& control;
         FailsafeMonitor& failsafes;
+        MotorTest& motor_test;
+        DirectionDetection& directions;
     };
     VehicleObject(sd_bus* bus, const Parts& parts);
     VehicleObject(const VehicleObject&) = delete;

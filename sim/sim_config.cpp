@@ -37,6 +37,41 @@ bool get_int(const toml::table& t, const char* key, const std::string& where, T 
     out = static_cast<T>(v->get());
     return true;
 }
+
+bool get_double(const toml::table& t, const char* key, const std::string& where, double lo, double hi, double& out,
+                std::string& err) {
+    auto node = t.get(key);
+    if (!node)
+        return true;
+    const auto v = node->value<double>();
+    if (!v || !(*v >= lo && *v <= hi)) {
+        err = where + key + ": must be a number between " + std::to_string(lo) + " and " + std::to_string(hi);
+        return false;
+    }
+    out = *v;
+    return true;
+}
+
+// A list of motor numbers 0..7, each marking its flag.
+bool get_motor_set(const toml::table& t, const char* key, std::array<bool, 8>& out, std::string& err) {
+    auto node = t.get(key);
+    if (!node)
+        return true;
+    const auto* arr = node->as_array();
+    if (!arr) {
+        err = std::string("sim.") + key + ": must be an array of motor numbers 0..7";
+        return false;
+    }
+    for (const auto& e : *arr) {
+        const auto* i = e.as_integer();
+        if (!i || i->get() < 0 || i->get() > 7) {
+            err = std::string("sim.") + key + ": must be an array of motor numbers 0..7";
+            return false;
+        }
+        out[static_cast<size_t>(i->get())] = true;
+    }
+    return true;
+}
 } // namespace
 
 bool parse_sim_config(const std::string& text, SimConfig& out, std::string& error) {
@@ -72,6 +107,16 @@ bool parse_sim_config(const std::string& text, SimConfig& out, std::string& erro
             return false;
         if (auto v = (*sim)["kill_switch_active_low"].value<bool>())
             c.kill_switch_active_low = *v;
+        if (!get_motor_set(*sim, "reversed_thrusters", c.mounted_reversed, error) ||
+            !get_motor_set(*sim, "disconnected_thrusters", c.disconnected, error))
+            return false;
+        if (!get_double(*sim, "orientation_noise_rad", "sim.", 0.0, 0.5, c.teensy.orientation_noise_rad, error) ||
+            !get_double(*sim, "yaw_drift_rad_s", "sim.", -0.1, 0.1, c.teensy.yaw_drift_rad_s, error))
+            return false;
+        uint32_t seed = static_cast<uint32_t>(c.teensy.noise_seed);
+        if (!get_int<uint32_t>(*sim, "noise_seed", "sim.", 0, UINT32_MAX, seed, error))
+            return false;
+        c.teensy.noise_seed = seed;
     }
     if (auto rec = root["recovery"].as_table()) {
         // Share caracarad's recovery keys so one file describes both sides.

@@ -2,7 +2,10 @@
 // The [[thruster]] tables use the same keys as caracarad.toml so one file can describe both.
 #pragma once
 
+#include "sim/teensy_config.hpp"
 #include "sim/thruster_model.hpp"
+
+#include <array>
 
 #include <string>
 #include <vector>
@@ -23,6 +26,13 @@ struct SimConfig {
     bool kill_switch_active_low = false;
     // The wire log keeps this many entries, oldest dropped first: a long soak stays bounded.
     uint32_t wire_log_entries = 200000;
+    // How the thrusters sit on the hull, which caracarad cannot see (commissioning finds it):
+    // a thruster mounted reversed pushes the body the other way; a disconnected one (motor
+    // lead off, controller still answering) pushes nothing. Indexed by motor 0..7.
+    std::array<bool, 8> mounted_reversed{};
+    std::array<bool, 8> disconnected{};
+    // The Teensy's orientation sensor noise and drift, among its other settings.
+    TeensyConfig teensy;
 };
 
 SimConfig default_sim_config();

@@ -15,14 +15,16 @@ SimVehicle::SimVehicle(const SimConfig& cfg)
         stepped_.push_back(t);
     }
     // The body is pushed by what the thrusters actually do (after ramp and faults), in the
-    // packet's motor numbering; missing thrusters push nothing.
+    // packet's motor numbering; missing and disconnected thrusters push nothing, one mounted
+    // reversed pushes the other way.
     body_ = std::make_unique<VehicleBody>([this] {
         std::array<double, 8> f{};
         for (size_t i = 0; i < f.size() && i < thrusters_.size(); ++i)
-            f[i] = thrusters_[i]->actual_fraction();
+            if (!cfg_.disconnected[i])
+                f[i] = (cfg_.mounted_reversed[i] ? -1.0 : 1.0) * thrusters_[i]->actual_fraction();
         return f;
     });
-    teensy_ = std::make_unique<TeensyModel>(TeensyConfig{}, *body_);
+    teensy_ = std::make_unique<TeensyModel>(cfg_.teensy, *body_);
     attach_spi(cfg_.spi_device, teensy_.get());
     stepped_.push_back(body_.get());
     stepped_.push_back(teensy_.get());

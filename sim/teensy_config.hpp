@@ -1,5 +1,5 @@
 // The simulated Teensy's (sim/teensy_model) wheel formula, turn rate, servos, distance sensors
-// and frame log size.
+// frame log size and the orientation sensor's noise and drift.
 #pragma once
 
 #include <cstddef>
@@ -18,6 +18,12 @@ struct TeensyConfig {
     uint8_t servo_initial_degrees = 90;
     uint16_t distance_initial_mm = 1000;
     std::size_t log_capacity = 256;
+    // The orientation sensor's imperfections, so that commissioning (direction detection) is
+    // proven against a sensor that is not the body's truth: white noise on each angle
+    // (standard deviation, rad) and a slow heading drift (rad/s) accumulated over time.
+    double orientation_noise_rad = 0.0;
+    double yaw_drift_rad_s = 0.0;
+    uint64_t noise_seed = 1;
 };
 
 } // namespace caracara::sim

@@ -63,9 +63,13 @@ std::string_view teensy_command_name(uint8_t command) {
 }
 
 TeensyModel::TeensyModel(TeensyConfig cfg, AttitudeSource attitude)
-    : cfg_(cfg), attitude_(std::move(attitude)), frames_(cfg.log_capacity) {
+    : cfg_(cfg), attitude_(std::move(attitude)), frames_(cfg.log_capacity), noise_rng_(cfg.noise_seed) {
     if (!attitude_)
         throw std::invalid_argument("TeensyModel needs an attitude source");
+    if (!std::isfinite(cfg_.orientation_noise_rad) || cfg_.orientation_noise_rad < 0.0 ||
+        !std::isfinite(cfg_.yaw_drift_rad_s))
+        throw std::invalid_argument("TeensyModel noise must be finite and non-negative, drift finite");
+    noise_ = std::normal_distribution<double>(0.0, cfg_.orientation_noise_rad > 0.0 ? cfg_.orientation_noise_rad : 1.0);
     if (!std::isfinite(cfg_.wheel_k) || !std::isfinite(cfg_.front_circumference) ||
         !std::isfinite(cfg_.back_circumference) || cfg_.front_circumference <= 0.0 ||
         cfg_.back_circumference <= 0.0)
@@ -186,7 +190,7 @@ void TeensyModel::prepare_answer() {
             f_.invalid = true;
             break;
         }
-        const BodyAttitude a = orientation();
+        const BodyAttitude a = measured_orientation();
         const double v = d[0] == 0 ? a.yaw : d[0] == 1 ? a.pitch : a.roll;
         put_f32_le(f_.answer, static_cast<float>(v));
         break;
@@ -303,6 +307,8 @@ void TeensyModel::log_frame(TeensyFrameOutcome o, uint64_t now_ns) {
 
 void TeensyModel::step(double dt_s, uint64_t now_ns) {
     (void)now_ns;
+    if (std::isfinite(dt_s) && dt_s > 0.0)
+        drift_ = VehicleBody::wrap_angle(drift_ + cfg_.yaw_drift_rad_s * dt_s);
     if (task_ != TeensyTaskState::Running || !std::isfinite(dt_s) || dt_s <= 0.0)
         return;
     const double d = cfg_.turn_rate_rad_s * dt_s;
@@ -330,7 +336,17 @@ BodyAttitude TeensyModel::orientation() const {
     if (replayed_)
         return *replayed_;
     BodyAttitude a = attitude_();
-    a.yaw = VehicleBody::wrap_angle(a.yaw + heading_offset_);
+    a.yaw = VehicleBody::wrap_angle(a.yaw + heading_offset_ + drift_);
+    return a;
+}
+
+BodyAttitude TeensyModel::measured_orientation() {
+    BodyAttitude a = orientation();
+    if (replayed_ || cfg_.orientation_noise_rad <= 0.0)
+        return a;
+    a.yaw = VehicleBody::wrap_angle(a.yaw + noise_(noise_rng_));
+    a.pitch = VehicleBody::wrap_angle(a.pitch + noise_(noise_rng_));
+    a.roll = VehicleBody::wrap_angle(a.roll + noise_(noise_rng_));
     return a;
 }
 

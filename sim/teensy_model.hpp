@@ -55,6 +55,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <random>
 #include <string_view>
 #include <vector>
 
@@ -128,8 +129,12 @@ public:
     const std::vector<uint8_t>& servo_degrees() const { return servos_; }
     const std::vector<uint16_t>& distances_mm() const { return distances_; }
     std::array<uint8_t, 3> leds() const { return leds_; }
-    // What Get orientation answers: body attitude with the heading offset applied to yaw.
+    // The sensor's reading without noise: body attitude with the heading offset and the drift
+    // applied to yaw.
     BodyAttitude orientation() const;
+    // What Get orientation answers: orientation() plus the configured noise (a new draw each call).
+    BodyAttitude measured_orientation();
+    double yaw_drift_rad() const { return drift_; }
     // caracara-sim --replay: Get orientation answers this instead (nullopt: the body model).
     void replay_orientation(const std::optional<BodyAttitude>& a) { replayed_ = a; }
     double heading_offset() const { return heading_offset_; }
@@ -184,6 +189,9 @@ private:
     std::vector<uint16_t> distances_;
     std::optional<BodyAttitude> replayed_;
     std::array<uint8_t, 3> leds_{};
+    double drift_ = 0.0; // rad, accumulated yaw drift
+    std::mt19937_64 noise_rng_;
+    std::normal_distribution<double> noise_;
 };
 
 } // namespace caracara::sim

@@ -4,8 +4,8 @@
 - each layer includes only the layers before it in ORDER (core <- drivers/protocol <-
   drivers/platform <- drivers/sdbus <- drivers/devices <- daemon <- dbus); inside daemon/
   each subsystem's folder is a layer of its own, in DAEMON's order (loop <- interfaces <- bus
-  <- teensy <- safety <- vehicle <- failsafe <- control <- recovery <- dive <- daemon/ itself,
-  where VehicleDaemon puts them together);
+  <- teensy <- safety <- vehicle <- failsafe <- control <- recovery <- commissioning <- dive
+  <- daemon/ itself, where VehicleDaemon puts them together);
 - daemon/main.cpp, the composition root, is the one product file that may see every layer;
 - sim/, tools/, bench/, tests/ and fuzz/ sit on top and may use any layer; nothing outside
   fuzz/ includes fuzz/;
@@ -20,7 +20,7 @@ import re
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-DAEMON = ["loop", "interfaces", "bus", "teensy", "safety", "vehicle", "failsafe", "control", "recovery", "dive"]
+DAEMON = ["loop", "interfaces", "bus", "teensy", "safety", "vehicle", "failsafe", "control", "recovery", "commissioning", "dive"]
 ORDER = (["core", "drivers/protocol", "drivers/platform", "drivers/sdbus", "drivers/devices"]
          + ["daemon/" + d for d in DAEMON] + ["daemon", "dbus"])
 TOP = ["sim", "tools", "bench", "tests", "fuzz"]

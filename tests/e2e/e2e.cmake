@@ -8,7 +8,8 @@ foreach(name properties announcements thrusters bus_recovery budget motion packe
              command_timeout client_loss pilot_lost start_and_sigterm invalid_input teensy
              introspection caracaractl mission faults gpio_lines dive_crash failsafes
              packet_kill fault_reports wheels bus_lost vanished_lines adapter_limits start_killed
-             command_timeout_timer thrust_profiles zero_thrusters_step realtime teensy_silence)
+             command_timeout_timer thrust_profiles zero_thrusters_step realtime teensy_silence motor_test
+             direction_detection)
   add_test(NAME e2e_${name}
            COMMAND /usr/bin/python3 -m unittest -v test_${name}
            WORKING_DIRECTORY ${CARACARA_E2E_DIR})
@@ -17,6 +18,8 @@ foreach(name properties announcements thrusters bus_recovery budget motion packe
                        TIMEOUT 600
                        LABELS e2e)
 endforeach()
+# Seven direction detections of eight pulses each, every pulse after the vehicle settles.
+set_tests_properties(e2e_direction_detection PROPERTIES TIMEOUT 1200)
 
 # The dive recorder: a dive listed and plotted, bad dive files refused, and the regression dives
 # of tests/dives replayed against their expected output (tests/dives/test_dives.py).

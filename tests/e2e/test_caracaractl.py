@@ -205,7 +205,8 @@ class CaracaractlTest(VehicleTestCase):
     def test_help(self):
         r = self.ctl("--help")
         self.assertEqual(r.returncode, OK)
-        for cmd in ("status", "thrust", "motion", "kill", "clear-kill", "leds", "power-off", "monitor"):
+        for cmd in ("status", "thrust", "motion", "kill", "clear-kill", "leds", "power-off", "monitor", "motor-test",
+                    "detect-directions"):
             self.assertRegex(r.stdout, r"(?m)^\s+%s\b" % re.escape(cmd))
 
 

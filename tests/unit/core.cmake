@@ -7,5 +7,6 @@ caracara_unit_test(test_config SOURCES unit/test_config.cpp LIBS caracara_core)
 # The shipped example must stay a valid config: the test parses it.
 target_compile_definitions(test_config PRIVATE
   CARACARA_EXAMPLE_CONFIG="${CMAKE_SOURCE_DIR}/daemon/caracarad.toml.example")
+caracara_unit_test(test_direction_judgement SOURCES unit/test_direction_judgement.cpp LIBS caracara_core)
 # Every enum's names (core/enum_names.hpp), wherever the enum lives.
 caracara_unit_test(test_enum_names SOURCES unit/test_enum_names.cpp LIBS caracara_daemon caracara_simcore)

@@ -1,1 +1,2 @@
 caracara_unit_test(test_simulated_teensy SOURCES unit/test_simulated_teensy.cpp LIBS caracara_simcore)
+caracara_unit_test(test_sim_mounting SOURCES unit/test_sim_mounting.cpp LIBS caracara_simcore)

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <unistd.h>
@@ -31,7 +32,9 @@ struct Options {
     bool yes_power_off = false;
     bool all = false;    // monitor --all
     bool for_given = false;
-    HoldOptions hold;    // thrust, motion, packet: --for SECONDS, --once
+    HoldOptions hold;    // thrust, motion, packet, motor-test: --for SECONDS, --once
+    std::optional<int32_t> value; // motor-test --value V
+    std::string write_path;       // detect-directions --write FILE
 };
 
 // The longest --for: beyond any dive, and far from overflowing the microsecond clock.
@@ -119,6 +122,48 @@ int cmd_motion(Client& c, const Args& a, const Options& o) {
         v[i] = parse_double(a[i], names[i]);
     return hold_command(c, "SetMotion", append_args("dddddd", v[0], v[1], v[2], v[3], v[4], v[5]),
                         strf("SetMotion(%g, %g, %g, %g, %g, %g)", v[0], v[1], v[2], v[3], v[4], v[5]), o.hold);
+}
+
+// One thruster, the others at zero, held like thrust: caracarad stops it when the re-sends
+// (every 100 ms) stop for its keep-alive (500 ms), and when this client leaves.
+int cmd_motor_test(Client& c, const Args& a, const Options& o) {
+    const int32_t thruster = parse_int(a[0], "thruster");
+    if (!o.value)
+        usage_error("motor-test needs --value V");
+    return hold_command(c, "MotorTest", append_args("ii", thruster, *o.value),
+                        strf("MotorTest(%d, %d)", thruster, *o.value), o.hold);
+}
+
+// Detection pulses eight thrusters, each after the vehicle settles (up to its settle timeout).
+constexpr uint64_t kDetectTimeoutUsec = 600'000'000;
+
+// Runs the daemon's direction detection and prints each thruster's finding; --write FILE gets
+// the [[thruster]] fragment (never applied by caracarad itself). Exit 0 when every thruster was
+// decided, 1 when one is inconclusive.
+int cmd_detect_directions(Client& c, const Args&, const Options& o) {
+    caracara::dbus::MessagePtr reply = c.call(kRootPath, kVehicleIface, "DetectDirections", {}, kDetectTimeoutUsec);
+    const Value rows = read_value(reply.get());
+    const Value fragment = read_value(reply.get());
+    std::cout << strf("%-8s %-13s %10s %10s %10s %10s %7s\n", "thruster", "verdict", "yaw", "pitch", "roll", "along",
+                      "margin");
+    bool all_decided = true;
+    for (size_t i = 0; i < rows.items.size(); ++i) {
+        const auto& f = rows.items[i].items;
+        if (f.size() != 6)
+            throw Failure{kExitUnavailable, "DetectDirections answered a malformed row"};
+        all_decided = all_decided && f[0].s != "inconclusive";
+        std::cout << strf("%-8zu %-13s %+10.4f %+10.4f %+10.4f %+10.4f %7.1f\n", i, f[0].s.c_str(), f[1].number(),
+                          f[2].number(), f[3].number(), f[4].number(), f[5].number());
+    }
+    std::cout << "(rad: the attitude change over each pulse; margin: the change along the mixing's rotation\n"
+                 " over commissioning.detect_threshold_mrad)\n";
+    if (!o.write_path.empty()) {
+        FILE* f = std::fopen(o.write_path.c_str(), "w");
+        if (!f || std::fputs(fragment.s.c_str(), f) < 0 || std::fclose(f) != 0)
+            throw Failure{kExitUnavailable, "cannot write " + o.write_path};
+        std::cout << "wrote the [[thruster]] fragment to " << o.write_path << "\n";
+    }
+    return all_decided ? kExitOk : kExitRefused;
 }
 
 // Packet words 8 and 9: killState and powerOffState.
@@ -217,6 +262,8 @@ enum CommandOption : unsigned {
     kOptHold = 1 << 0,        // --for SECONDS, --once
     kOptAll = 1 << 1,         // --all
     kOptYesPowerOff = 1 << 2, // --yes-power-off
+    kOptValue = 1 << 3,       // --value V
+    kOptWrite = 1 << 4,       // --write FILE
 };
 
 struct Command {
@@ -239,6 +286,11 @@ constexpr Command kCommands[] = {
     {"packet", "W0 ... W12", "Hold a 13-word Caracara packet (motors, kill, power-off, RGB)", 13, cmd_packet,
      nullptr, kOptHold},
     {"kill", "", "Zero every thruster at once and latch the kill", 0, cmd_kill},
+    {"motor-test", "N --value V", "Run thruster N alone at V (bounded, armed only) until ^C or --for", 1,
+     cmd_motor_test, nullptr, kOptHold | kOptValue},
+    {"detect-directions", "[--write FILE]",
+     "Pulse each thruster, still and armed, and tell ok/reversed/inconclusive from the rotation", 0,
+     cmd_detect_directions, nullptr, kOptWrite},
     {"clear-kill", "", "Clear the kill, e.g. the one every start comes up with (arming, then ready)", 0,
      cmd_clear_kill},
     {"clear-kill-override", "CONDITION",
@@ -286,10 +338,14 @@ void print_help() {
                  "  --version                        Show the version\n"
                  "  -h --help                        Show this help\n"
                  "\nCommand options (after the command, before or after its values):\n"
-                 "  --for SECONDS                    thrust, motion, packet: hold for SECONDS (decimals\n"
+                 "  --for SECONDS                    thrust, motion, packet, motor-test: hold for SECONDS (decimals\n"
                  "                                   allowed, e.g. 2.5), then let go\n"
                  "  --once                           thrust, motion, packet: send once and exit; caracarad\n"
                  "                                   zeroes the thrusters as soon as caracaractl has left\n"
+                 "  --value V                        motor-test: the motor value (-8850..8850; caracarad\n"
+                 "                                   refuses beyond commissioning.motor_test_limit)\n"
+                 "  --write FILE                     detect-directions: write the [[thruster]] tables with\n"
+                 "                                   the reversal flags found to FILE\n"
                  "  --all                            monitor: print every announcement, with the fast\n"
                  "                                   counters (Cycles, CommandAgeMs, OrdersSent,\n"
                  "                                   StatusReads, Frames, BusyRetries, Transactions) and\n"
@@ -405,6 +461,16 @@ int main(int argc, char** argv) {
                     usage_error("--for needs a number of seconds");
                 options.hold.duration_usec = parse_duration(a == "--for" ? argv[++i] : a.substr(6));
                 options.for_given = true;
+            } else if (a == "--value" || a.starts_with("--value=")) {
+                takes(kOptValue, "--value");
+                if (a == "--value" && i + 1 >= argc)
+                    usage_error("--value needs a motor value");
+                options.value = parse_int(a == "--value" ? argv[++i] : a.substr(8), "--value");
+            } else if (a == "--write" || a.starts_with("--write=")) {
+                takes(kOptWrite, "--write");
+                if (a == "--write" && i + 1 >= argc)
+                    usage_error("--write needs a file name");
+                options.write_path = a == "--write" ? argv[++i] : a.substr(8);
             } else if (a.starts_with("--")) {
                 usage_error("unknown option '" + a + "'"); // values never start with "--"
             } else {

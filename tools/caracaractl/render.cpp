@@ -89,6 +89,12 @@ void print_vehicle(std::ostream& out, const Props& v) {
     }, "none"));
     const std::string controller = prop(v, "Controller").s;
     key_line(out, "Controller", controller.empty() ? "none" : controller);
+    // (thruster, value); a daemon without the property shows none.
+    const Value& test = prop(v, "MotorTest");
+    const int64_t tested = test.items.size() == 2 ? test.items[0].integer() : -1;
+    key_line(out, "Motor test", tested < 0 ? std::string("none")
+                                           : strf("thruster %lld at %lld", static_cast<long long>(tested),
+                                                  static_cast<long long>(test.items[1].integer())));
     auto values = [](const Value& list) { return join(list, " ", [](const Value& x) { return render(x); }); };
     key_line(out, "Motor values", values(prop(v, "MotorValues")));
     key_line(out, "Requested", values(prop(v, "RequestedValues")));

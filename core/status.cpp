@@ -1,5 +1,0 @@
-#include "core/status.hpp"
-
-namespace caracara {
-
-} // namespace caracara

@@ -1,0 +1,83 @@
+// Thruster direction detection (docs/commissioning.md; ArduSub's motor detection on our
+// mixing): armed, in the water, still; for each thruster in turn it waits until the vehicle
+// holds still (after a rest, the Teensy's orientation moved at most detect_settle_mrad between
+// the halves of detect_settle_ms), takes
+// that attitude, pulses the thruster alone (detect_pulse_value for detect_pulse_ms, through
+// Vehicle::drive like any motor command: budget, state, commanding client, the wire), takes the
+// attitude over the end of the pulse, orders it zero, and has core/direction_judgement say ok,
+// reversed or inconclusive. It never changes the configuration: the caller gets the fragment.
+// A kill, the caller leaving or another pilot commanding, a failsafe, or a vehicle that will not
+// settle ends it with the error (the kill's zeros are the kill's own, at once).
+#pragma once
+
+#include "core/config.hpp"
+#include "core/direction_judgement.hpp"
+#include "core/status.hpp"
+#include "daemon/failsafe/failsafe_monitor.hpp"
+#include "daemon/loop/completion.hpp"
+#include "daemon/loop/deadline_timer.hpp"
+#include "daemon/teensy/teensy_port.hpp"
+#include "daemon/vehicle/vehicle.hpp"
+#include "drivers/platform/event_loop.hpp"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace caracara {
+
+// One thruster's finding: the judgement and the attitude change (yaw, pitch, roll, rad) it is on.
+struct DirectionFinding {
+    DirectionJudgement judgement;
+    std::array<double, 3> change{};
+};
+
+class DirectionDetection final {
+public:
+    DirectionDetection(const DaemonConfig& config, Vehicle& vehicle, const TeensyPort& teensy,
+                       const FailsafeMonitor& failsafes);
+    std::string start(sd_event* event); // the step timer; "" or why it could not
+    void stop();
+
+    // Runs the detection for `client`; `done` gets its end (Ok with findings() filled, or the
+    // error that ended it). Busy while one runs.
+    void run(std::string_view client, Completion done);
+    bool running() const { return phase_ != Phase::Idle; }
+    // The thruster being pulsed now, or -1.
+    int32_t pulsing() const { return phase_ == Phase::Pulse ? static_cast<int32_t>(motor_) : -1; }
+    const std::array<DirectionFinding, kMotorCount>& findings() const { return findings_; }
+    std::string fragment() const;
+
+private:
+    enum class Phase : uint8_t { Idle, Settle, Pulse };
+    struct Sample {
+        uint64_t t_ns;
+        std::array<double, 3> att;
+    };
+
+    void step();
+    void settle_step(uint64_t now);
+    void pulse_step(uint64_t now);
+    void end(Result r);
+    Result abort_reason() const;
+    void next_step(uint64_t now);
+    MotorValues pulse_values() const;
+
+    const DaemonConfig& config_;
+    Vehicle& vehicle_;
+    const TeensyPort& teensy_;
+    const FailsafeMonitor& failsafes_;
+    DeadlineTimer timer_;
+    Phase phase_ = Phase::Idle;
+    std::size_t motor_ = 0;
+    std::string client_;
+    Completion done_;
+    uint64_t phase_start_ns_ = 0;
+    std::vector<Sample> samples_;
+    std::array<double, 3> baseline_{}; // rad: the still window's mean
+    std::array<DirectionFinding, kMotorCount> findings_{};
+};
+
+} // namespace caracara
