@@ -70,7 +70,21 @@
 #endif
 #if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 3, 0)
 #define ccb_chip_select(spi) spi_get_chipselect(spi, 0)
-#define ccb_set_chip_select(spi, cs) spi_set_chipselect(spi, 0, cs)
+/*
+ * One chip select: the array's other entries unused (0xFF, the core's SPI_INVALID_CS), or
+ * 6.12's spi_add_device takes them for a second use of chip select 0 (-EBUSY, "chipselect 0
+ * already in use"); from 6.8 the mask of the ones in use says entry 0.
+ */
+static inline void ccb_set_chip_select(struct spi_device *spi, u8 cs)
+{
+	u8 idx;
+
+	for (idx = 0; idx < SPI_CS_CNT_MAX; idx++)
+		spi_set_chipselect(spi, idx, idx ? 0xFF : cs);
+#if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 8, 0)
+	spi->cs_index_mask = BIT(0);
+#endif
+}
 #else
 #define ccb_chip_select(spi) ((spi)->chip_select)
 #define ccb_set_chip_select(spi, cs) ((spi)->chip_select = (cs))
