@@ -1,7 +1,11 @@
 #!/usr/bin/python3
 """The one table scripts/test.sh ends with: each suite, ran or not, its counts and its time.
 
-    suite_table.py RESULTS_DIR
+    suite_table.py RESULTS_DIR [--record FILE]    the table; --record also writes it as JSON
+    suite_table.py --readme [--check] [--record FILE] [--readme-file README.md]
+        README's CI table (between "<!-- suite-table begin -->" and "<!-- suite-table end -->")
+        written from the committed record, bench/suite-results.json by default; --check writes
+        nothing and exits 1 when README is not what the record gives (CTest readme_suites).
 
 RESULTS_DIR holds what scripts/test.sh recorded: steps.txt (one "STEP SELECTED EXIT SECONDS"
 line per step of test.sh), and for each ctest run STEP.xml (ctest --output-junit, passed tests'
@@ -17,22 +21,43 @@ from the suites' own last words:
 
 Exit status 1 when a suite failed, or did not run although this machine can run it; under CI
 (CI=true) every skip is a failure too (a suite that cannot run there fails), and so is a python
-test skipped inside a suite. Outside CI a skip stays a skip, shown with its reason.
+test skipped inside a suite. Outside CI a skip stays a skip, shown with its reason. A suite left
+out of a run by design (the bridge and cockpit suites under arm64 and in the Debian 13 root,
+LEFT_OUT below) is shown as "not run here" with why, and fails nothing.
 """
+import argparse
+import datetime
 import json
 import os
 import re
+import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
 CI = os.environ.get("CI") == "true"
 ROOT = os.geteuid() == 0
 AMD64 = os.uname().machine == "x86_64"
+TOP = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+RECORD = os.path.join(TOP, "bench", "suite-results.json")
+README = os.path.join(TOP, "README.md")
+
+# The bridge's and the cockpit's end-to-end tests (CTest e2e_bridge, e2e_cockpit, label bridge)
+# run in the normal build only; where a run leaves them out, why (the script that does it says
+# the same where it does it). Shown unless that run's tests include them after all.
+LEFT_OUT = {
+    "arm64": "scripts/cross_test.sh runs ctest -LE bridge: under qemu-user their timing-bound "
+             "steps time out; the arm64 bridge's protocol, MCAP and file serving run in test_foxglove",
+    "Debian 13": "tests/system/debian13.sh runs ctest -LE 'system|kernel|bridge' in the Debian 13 root: "
+                 "their npm packages come from the registry, which the root has no network for; "
+                 "the Debian 12 run's suites run them",
+}
+BRIDGE_TESTS = {"bridge": "e2e_bridge", "cockpit": "e2e_cockpit"}
 
 
 class Suite:
-    def __init__(self, name, step, can_run=True, why_not=""):
+    def __init__(self, name, step, can_run=True, why_not="", left_out=""):
         self.name, self.step, self.can_run, self.why_not = name, step, can_run, why_not
+        self.left_out = left_out  # why this run leaves the suite out by design
         self.tests = []          # (name, status, seconds, output)
         self.status = None       # forced status: a suite with no ctest test of its own
         self.counts = []
@@ -46,6 +71,8 @@ class Suite:
         if self.status:
             return self.status
         if not self.tests:
+            if self.left_out:
+                return "not run here: %s" % self.left_out, False
             if not self.can_run:
                 return "not run (%s)" % self.why_not, CI
             return "NOT RUN", True
@@ -132,8 +159,8 @@ def section(text, start, end=None):
     return text[i:j if j >= 0 else len(text)]
 
 
-def main():
-    results = sys.argv[1]
+def table(results):
+    """The table's rows [(suite, result, counts, time, bad)], the steps and whether any failed."""
     steps = {}
     with open(os.path.join(results, "steps.txt")) as f:
         for line in f:
@@ -143,13 +170,19 @@ def main():
     need_root = "needs root (not root)" if not ROOT else "needs amd64"
     systemable = ROOT and AMD64
     suites = [Suite("unit", "normal"), Suite("integration", "normal"), Suite("e2e", "normal"),
-              Suite("soak", "normal"), Suite("layers", "normal"), Suite("release (version)", "normal"),
+              Suite("bridge Debian 12", "normal"), Suite("cockpit Debian 12", "normal"),
+              Suite("soak", "normal"), Suite("layers", "normal"), Suite("README CI table", "normal"),
+              Suite("release (version)", "normal"),
               Suite("system Debian 12", "normal", systemable, need_root),
               Suite("kernel Debian 12", "normal", systemable, need_root),
               Suite("Debian 13 build+ctest", "normal", systemable, need_root),
               Suite("system Debian 13", "normal", systemable, need_root),
               Suite("kernel Debian 13", "normal", systemable, need_root),
-              Suite("ASan+UBSan", "sanitize"), Suite("arm64", "cross"), Suite("fuzz", "fuzz")]
+              Suite("bridge Debian 13", "normal", left_out=LEFT_OUT["Debian 13"]),
+              Suite("cockpit Debian 13", "normal", left_out=LEFT_OUT["Debian 13"]),
+              Suite("ASan+UBSan", "sanitize"), Suite("arm64", "cross"),
+              Suite("bridge arm64", "cross", left_out=LEFT_OUT["arm64"]),
+              Suite("cockpit arm64", "cross", left_out=LEFT_OUT["arm64"]), Suite("fuzz", "fuzz")]
     by = {s.name: s for s in suites}
 
     def add(suite, t, counts_from=None):
@@ -182,8 +215,21 @@ def main():
                 part_secs = {"Debian 13 build+ctest": secs - sum(took.values()),
                              "system Debian 13": took.get("system", 0.0), "kernel Debian 13": took.get("kernel", 0.0)}
                 add(by[sname], (name, st, part_secs[sname], part), part)
+                # The Debian 13 ctest's count is the build+ctest row's (debian13.sh's last line
+                # repeats it, in the kernel part).
+                c13 = [c for c in inner_counts(text)[0] if c[0] == "Debian 13 ctest tests"][-1:]
+                by[sname].counts = [c for c in by[sname].counts if c[0] != "Debian 13 ctest tests"]
+                if sname == "Debian 13 build+ctest":
+                    by[sname].counts += c13
                 if st == "skipped" and reason:
                     by[sname].skip_reason = reason
+            # The bridge and cockpit tests, should the Debian 13 ctest have run them after all.
+            for m in re.finditer(r"Test\s+#\d+: (e2e_bridge|e2e_cockpit) \.+\s*(\*+)?\s*(\w+)", b):
+                which = "bridge" if m.group(1) == "e2e_bridge" else "cockpit"
+                by[which + " Debian 13"].tests.append((m.group(1), "passed" if m.group(3) == "Passed" else "failed", 0.0, ""))
+            continue
+        if name in ("e2e_bridge", "e2e_cockpit"):
+            add(by["bridge Debian 12" if name == "e2e_bridge" else "cockpit Debian 12"], t)
             continue
         if name in ("system_debs", "system_nspawn"):
             suite = by["system Debian 12"]
@@ -199,12 +245,17 @@ def main():
             suite = by["release (version)"]
         elif name == "layers":
             suite = by["layers"]
+        elif name == "readme_suites":
+            suite = by["README CI table"]
         else:
             suite = by["unit"]
         add(suite, t)
     for step, sname in (("sanitize", "ASan+UBSan"), ("cross", "arm64"), ("fuzz", "fuzz")):
         for t in read_junit(os.path.join(results, step + ".xml")):
-            add(by[sname], t)
+            if step == "cross" and t[0] in BRIDGE_TESTS.values():
+                add(by["bridge arm64" if t[0] == "e2e_bridge" else "cockpit arm64"], t)
+            else:
+                add(by[sname], t)
         sel, rc, _ = steps.get(step, (False, 0, 0))
         if sel and rc != 0 and not by[sname].tests:
             by[sname].status = ("FAILED (exit %d before its tests)" % rc, True)
@@ -235,18 +286,123 @@ def main():
             a[1] += of or 0
         for what, (got, of, single) in agg.items():
             counts.append("%d %s" % (got, what) if single else "%d/%d %s" % (got, of, what))
-        rows.append((s.name, verdict + (" <-" if bad else ""), ", ".join(counts) or "-",
-                     "%.0f s" % s.seconds if s.tests else "-"))
-    w = [max(len(r[i]) for r in rows + [("suite", "result", "counts", "time")]) for i in range(4)]
-    print("== suites (CI=%s)" % ("true" if CI else "unset"))
-    for r in [("suite", "result", "counts", "time")] + rows:
+        rows.append((s.name, verdict, ", ".join(counts) or "-", "%.0f s" % s.seconds if s.tests else "-", bad))
+    return rows, steps, failed
+
+
+def git(*args):
+    try:
+        return subprocess.run(["git", "-C", TOP] + list(args), capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return ""
+
+
+def print_table(rows, steps, failed, ci):
+    head = ("suite", "result", "counts", "time")
+    shown = [(r[0], r[1] + (" <-" if r[4] else ""), r[2], r[3]) for r in rows]
+    w = [max(len(r[i]) for r in shown + [head]) for i in range(4)]
+    print("== suites (CI=%s)" % ("true" if ci else "unset"))
+    for r in [head] + shown:
         print("  %-*s  %-*s  %-*s  %*s" % (w[0], r[0], w[1], r[1], w[2], r[2], w[3], r[3]))
     print("== steps: " + ", ".join("%s %s (exit %d, %d s)" % (n, "ran" if v[0] else "not selected", v[1], v[2])
                                    for n, v in steps.items()))
     if failed:
-        print("suites: FAIL (a suite failed, or did not run where it can%s)" % (", or skipped under CI" if CI else ""))
+        print("suites: FAIL (a suite failed, or did not run where it can%s)" % (", or skipped under CI" if ci else ""))
     else:
         print("suites: every selected suite ran and held")
+
+
+def record(rows, steps, failed):
+    """The run as a record: what README's CI table is written from (--readme)."""
+    commit = git("rev-parse", "HEAD")
+    return {
+        "written_by": "scripts/suite_table.py --record (scripts/test.sh)",
+        "finished": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%MZ"),
+        "commit": commit,
+        "tree_clean": git("status", "--porcelain", "--untracked-files=no") == "" if commit else None,
+        "ci": CI,
+        "machine": "%s, %d CPUs" % (os.uname().machine, os.cpu_count() or 0),
+        "steps": {n: {"selected": v[0], "exit": v[1], "seconds": v[2]} for n, v in steps.items()},
+        "suites": [{"suite": r[0], "result": r[1], "counts": r[2], "time": r[3], "failed": r[4]} for r in rows],
+        "failed": failed,
+    }
+
+
+BEGIN, END = "<!-- suite-table begin -->", "<!-- suite-table end -->"
+
+
+def readme_section(rec):
+    """README's CI table from the record, or what is missing when there is none."""
+    out = [BEGIN]
+    if rec is None:
+        out += ["No suite record is committed yet (`bench/suite-results.json`): a full `scripts/test.sh` "
+                "run writes it; `scripts/suite_table.py --readme` then writes this table from it."]
+    else:
+        steps = ", ".join(n for n, v in rec["steps"].items() if v["selected"])
+        everything = all(v["selected"] for v in rec["steps"].values())
+        out += ["The suite table of the last recorded `scripts/test.sh` run (`bench/suite-results.json`, "
+                "written by `scripts/suite_table.py --record`; this table by `scripts/suite_table.py --readme`): "
+                "finished %s on %s, commit %s%s, CI=%s, steps run: %s%s. %s" % (
+                    rec["finished"], rec["machine"], (rec["commit"] or "?")[:12],
+                    "" if rec.get("tree_clean") in (True, None) else " with uncommitted changes",
+                    "true" if rec["ci"] else "unset", steps or "none",
+                    "" if everything else " (not a full run)",
+                    "Every selected suite ran and held." if not rec["failed"] else
+                    "**It failed** (the rows marked failed)."),
+                "",
+                "| suite | result | counts | time |",
+                "| --- | --- | --- | --- |"]
+        for r in rec["suites"]:
+            cells = [r["suite"], r["result"] + (" **(failed)**" if r["failed"] else ""), r["counts"], r["time"]]
+            out.append("| " + " | ".join(c.replace("|", "/") for c in cells) + " |")
+    out.append(END)
+    return "\n".join(out)
+
+
+def readme(args):
+    rec = None
+    if os.path.exists(args.record):
+        with open(args.record) as f:
+            rec = json.load(f)
+    with open(args.readme_file) as f:
+        text = f.read()
+    pat = re.compile(re.escape(BEGIN) + ".*?" + re.escape(END), re.S)
+    if not pat.search(text):
+        print("suite_table: %s has no %s ... %s section" % (args.readme_file, BEGIN, END), file=sys.stderr)
+        return 1
+    new = pat.sub(lambda _: readme_section(rec), text)
+    if args.check:
+        if new != text:
+            print("suite_table: %s's CI table is not what %s gives (scripts/suite_table.py --readme writes it)"
+                  % (args.readme_file, args.record), file=sys.stderr)
+            return 1
+        return 0
+    if new != text:
+        with open(args.readme_file, "w") as f:
+            f.write(new)
+    return 0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("results", nargs="?", help="scripts/test.sh's results directory")
+    ap.add_argument("--record", help="the record to write (with RESULTS_DIR) or read (--readme)")
+    ap.add_argument("--readme", action="store_true")
+    ap.add_argument("--check", action="store_true")
+    ap.add_argument("--readme-file", default=README)
+    args = ap.parse_args()
+    if args.readme:
+        args.record = args.record or RECORD
+        return readme(args)
+    if not args.results:
+        ap.error("RESULTS_DIR is needed (or --readme)")
+    rows, steps, failed = table(args.results)
+    print_table(rows, steps, failed, CI)
+    if args.record:
+        with open(args.record, "w") as f:
+            json.dump(record(rows, steps, failed), f, indent=1)
+            f.write("\n")
     return 1 if failed else 0
 
 

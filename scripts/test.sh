@@ -11,7 +11,8 @@
 #   scripts/test.sh fuzz       only the fuzzers (scripts/fuzz.sh runs them longer)
 # It ends with one table (scripts/suite_table.py): each suite, ran or not, its counts and its
 # time; it fails when a suite failed or did not run where this machine can run it, and under CI
-# (CI=true) on any skip. Every step runs even after one failed, so the table is whole.
+# (CI=true) on any skip. The table is also written as a record: bench/suite-results.json after
+# a full run (scripts/test.sh alone), build-results/suites.json otherwise. Every step runs even after one failed, so the table is whole.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 "$top/scripts/deps.sh"
@@ -78,7 +79,11 @@ step arm64-packages arm64_packages
 step sanitize sanitize_suite
 step fuzz fuzz_suite
 
+# The table as a record too: a full run's is bench/suite-results.json (commit it; README's CI
+# table is written from it by scripts/suite_table.py --readme, checked by CTest readme_suites).
+record=$results/suites.json
+[ "$which" != all ] || record=$top/bench/suite-results.json
 table=0
-/usr/bin/python3 "$top/scripts/suite_table.py" "$results" || table=$?
+/usr/bin/python3 "$top/scripts/suite_table.py" "$results" --record "$record" || table=$?
 stamp "all"
 [ "$failed" -eq 0 ] && [ "$table" -eq 0 ]

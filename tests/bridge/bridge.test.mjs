@@ -4,6 +4,7 @@
 // private bus, caracara-sim, caracarad, the bridge, a private sshd and the forward.
 import { test, after } from "node:test";
 import assert from "node:assert/strict";
+import { bound } from "./bounds.mjs";
 import net from "node:net";
 import WebSocket from "ws";
 import {
@@ -100,7 +101,8 @@ test("a published motion reaches the wire as the mixing says; a closed client ze
   const zeroTimes = await poll(() => firstZeros(since, driven), 5000, "zero orders to the four motors it drove");
   const worstMs = Number(zeroTimes.reduce((a, b) => (a > b ? a : b)) - closedAt) / 1e6;
   console.log(`# close to the last zero order: ${worstMs.toFixed(1)} ms`);
-  assert.ok(worstMs <= 250, `zeroed ${worstMs} ms after the close (bound 250 ms, docs/topside.md)`);
+  assert.ok(worstMs <= bound("CLIENT_LOSS_ZERO_MS_MAX"),
+            `zeroed ${worstMs} ms after the close (bound ${bound("CLIENT_LOSS_ZERO_MS_MAX")} ms, tests/bounds.json)`);
   // It was the last pilot: the kill output after pilot-lost's persistence, never before it (a
   // reader's client sees it as a failsafe), then a plain clear-kill re-arms.
   const watcher = await client();

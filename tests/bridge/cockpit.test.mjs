@@ -3,6 +3,7 @@
 // simulator's side (inspection API, wire log). Run by test_cockpit.py.
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
+import { bound } from "./bounds.mjs";
 import fs from "node:fs";
 import net from "node:net";
 import path from "node:path";
@@ -202,7 +203,8 @@ test("closing the page while driving zeroes the thrusters within the client-loss
   }, 5000, "zero orders to the four motors it drove");
   const worstMs = Number(zeroTimes.reduce((a, b) => (a > b ? a : b)) - closedAt) / 1e6;
   console.log(`# page closed to the last zero order: ${worstMs.toFixed(1)} ms`);
-  assert.ok(worstMs <= 250, `zeroed ${worstMs} ms after the close (bound 250 ms, docs/topside.md)`);
+  assert.ok(worstMs <= bound("CLIENT_LOSS_ZERO_MS_MAX"),
+            `zeroed ${worstMs} ms after the close (bound ${bound("CLIENT_LOSS_ZERO_MS_MAX")} ms, tests/bounds.json)`);
   // The page was the last pilot: the kill output after pilot-lost's persistence, never before.
   const [edge] = await poll(() => { const k = killEdges(since); return k.length ? k : null; }, PILOT_LOST_MS + 5000,
                             "the pilot-lost kill");

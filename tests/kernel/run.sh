@@ -14,8 +14,16 @@
 #       rebuilt here; gcov is DIR's); the source tree, BUILD and WORK_DIR must be at the same
 #       paths in DIR as on the host. The label names the run in its summary line and in
 #       docs/kernel-bridge.md.
-#   CARACARA_KERNEL_DOC=0: leave docs/kernel-bridge.md alone (by default the run writes its
-#       scenario list and coverage table there, tests/kernel/write_doc.py).
+#   CARACARA_KERNEL_SUITE=trixie: boot that Debian release's own kernel (its linux-image-amd64,
+#       fetched with an apt configuration of the run's own under /var/cache/caracara-kernel,
+#       never the machine's sources) and build the test module against its linux-headers with
+#       the guest root's compiler (CARACARA_KERNEL_ROOT must be a root of that release:
+#       tests/system/debian13.sh sets both). Unset: the kernel of this machine's release.
+#   The run writes its scenario list and coverage table (tests/kernel/write_doc.py) into a copy
+#       of docs/kernel-bridge.md in WORK_DIR (the build tree) and checks the tracked copy against
+#       it: a difference fails the run (as bench/report.py --check), with the diff.
+#       CARACARA_KERNEL_DOC=write copies it over the tracked docs/kernel-bridge.md (how a change
+#       that changes the run's section is recorded); CARACARA_KERNEL_DOC=0 does neither.
 #
 # Fetches the kernel, headers and kbuild .debs with apt-get download into
 # /var/cache/caracara-kernel/VERSION (unpacked there, never installed), builds the module
@@ -73,46 +81,86 @@ mapfile -t scenario_list < <(/usr/bin/python3 "$top/tests/kernel/scenarios.py" -
 ((${#scenario_list[@]})) || { echo "$label: FAIL: no scenario list (scenarios.py --list)"; exit 1; }
 
 # --- kernel, headers -----------------------------------------------------------------------
-# Nothing cached yet: fresh package lists, so the version asked for can still be downloaded.
-ls "$cache"/*/.ok >/dev/null 2>&1 || apt-get update -qq
-kver=$(apt-cache depends linux-image-amd64 2>/dev/null | sed -n 's/.*Depends: linux-image-\(.*-amd64\)$/\1/p' | head -1)
-if [ -z "$kver" ] || { [ ! -f "$cache/$kver/.ok" ] && ! apt-cache show "linux-image-$kver" >/dev/null 2>&1; }; then
-  # No package lists: whatever was cached last.
-  kver=$(ls -t "$cache" 2>/dev/null | head -1)
+own_suite=$(. /etc/os-release && echo "${VERSION_CODENAME:-}")
+ksuite=${CARACARA_KERNEL_SUITE:-$own_suite}
+apt_opts=()
+if [ "$ksuite" != "$own_suite" ]; then
+  # Another release's kernel: its package lists in an apt configuration of this run's own
+  # (the archive this machine's apt uses, tests/system/mirror.sh; Debian's keyring).
+  . "$top/tests/system/mirror.sh"
+  mirror=$(find_mirror "$ksuite") || cannot_run "no Debian mirror for $ksuite (set CARACARA_SYSTEST_MIRROR)"
+  aptdir=$cache/apt-$ksuite-$(dpkg --print-architecture)
+  mkdir -p "$aptdir/lists/partial" "$aptdir/archives/partial"
+  echo "deb [signed-by=/usr/share/keyrings/debian-archive-keyring.gpg] $mirror $ksuite main" >"$aptdir/sources.list"
+  apt_opts=(-o "Dir::Etc::SourceList=$aptdir/sources.list" -o Dir::Etc::SourceParts=/nonexistent
+            -o "Dir::State::Lists=$aptdir/lists" -o "Dir::Cache=$aptdir" -o "Dir::Cache::Archives=$aptdir/archives"
+            -o Dir::Cache::pkgcache= -o Dir::Cache::srcpkgcache=)
+  # Refreshed once a day: a point release's kernel replaces the last one in the archive.
+  if [ -z "$(find "$aptdir/lists" -maxdepth 1 -name '*_Packages*' -mtime -1 2>/dev/null)" ]; then
+    step "apt-get update for $ksuite ($mirror)"
+    apt-get "${apt_opts[@]}" update -qq || true
+  fi
+elif ! ls "$cache"/*/.ok >/dev/null 2>&1; then
+  # Nothing cached yet: fresh package lists, so the version asked for can still be downloaded.
+  apt-get update -qq
 fi
-[ -n "$kver" ] || cannot_run "cannot tell which kernel to fetch (apt-get update?)"
+kver=$(apt-cache "${apt_opts[@]}" depends linux-image-amd64 2>/dev/null | sed -n 's/.*Depends: linux-image-\(.*-amd64\)$/\1/p' | head -1)
+if [ -z "$kver" ] || { [ ! -f "$cache/$kver/.ok" ] && ! apt-cache "${apt_opts[@]}" show "linux-image-$kver" >/dev/null 2>&1; }; then
+  # No package lists: whatever was cached last for this release.
+  kver=$(ls -t "$cache" 2>/dev/null | grep -v "^apt-" | while read -r d; do
+    [ "$(cat "$cache/$d/suite" 2>/dev/null || echo bookworm)" = "$ksuite" ] && echo "$d"; done | head -1)
+fi
+[ -n "$kver" ] || cannot_run "cannot tell which $ksuite kernel to fetch (apt-get update?)"
 kdir=$cache/$kver
 if [ ! -f "$kdir/.ok" ]; then
-  step "fetching linux-image-$kver and its headers"
+  step "fetching linux-image-$kver ($ksuite) and its headers"
   rm -rf "$kdir" && mkdir -p "$kdir/debs"
-  kbuild=$(apt-cache depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-kbuild-.*\)$/\1/p' | head -1)
-  common=$(apt-cache depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-headers-.*-common\)$/\1/p' | head -1)
-  if ! (cd "$kdir/debs" && apt-get download -qq "linux-image-$kver" "linux-headers-$kver" "$common" "$kbuild" 2>/dev/null); then
+  kbuild=$(apt-cache "${apt_opts[@]}" depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-kbuild-.*\)$/\1/p' | head -1)
+  common=$(apt-cache "${apt_opts[@]}" depends "linux-headers-$kver" | sed -n 's/.*Depends: \(linux-headers-.*-common\)$/\1/p' | head -1)
+  if ! (cd "$kdir/debs" && apt-get "${apt_opts[@]}" download -qq "linux-image-$kver" "linux-headers-$kver" "$common" "$kbuild" 2>/dev/null); then
     cannot_run "apt-get download of linux-image-$kver and its headers failed"
   fi
   for d in "$kdir"/debs/*.deb; do dpkg-deb -x "$d" "$kdir/root"; done
+  echo "$ksuite" >"$kdir/suite"
   # The headers' Makefile includes the common tree by its installed path; point it here.
   sed -i "s#^include /usr/src/#include $kdir/root/usr/src/#" "$kdir/root/usr/src/linux-headers-$kver/Makefile"
   touch "$kdir/.ok"
 fi
 kroot=$kdir/root
+# Debian 13's packages ship their modules under /usr/lib (merged /usr); this machine's depmod
+# looks under /lib.
+[ -e "$kroot/lib" ] || [ ! -d "$kroot/usr/lib/modules" ] || ln -s usr/lib "$kroot/lib"
 modroot=$kroot/lib/modules/$kver
 # The package's postinst would run depmod; unpacked, it is run here on the tree.
 [ -f "$modroot/modules.dep" ] || /sbin/depmod -b "$kroot" "$kver"
 
 # --- the test module -----------------------------------------------------------------------
-step "building caracara_bridge.ko for $kver"
+guest_root=${CARACARA_KERNEL_ROOT:-/}
 mod=$work/module
 rm -rf "$mod" && mkdir -p "$mod"
 cp "$top/tests/kernel/module/caracara_bridge.c" "$top/tests/kernel/module/Kbuild" "$top/sim/kernel_bridge_abi.h" "$mod/"
-nice -n 10 make -s -C "$kroot/usr/src/linux-headers-$kver" M="$mod" -j2 modules 2>&1 | grep -v 'Skipping BTF generation' || true
+if [ "$ksuite" = "$own_suite" ]; then
+  step "building caracara_bridge.ko for $kver"
+  nice -n 10 make -s -C "$kroot/usr/src/linux-headers-$kver" M="$mod" -j2 modules 2>&1 | grep -v 'Skipping BTF generation' || true
+else
+  # Another release's headers: its kbuild tools and compiler (gcc-14 for trixie) are the guest
+  # root's, so the module is built in a container of that root, with the kernel cache (the
+  # headers' Makefile names it) and WORK_DIR at their own paths. Without the module's BTF (the
+  # root has no pahole; nothing here reads it).
+  [ "$guest_root" != / ] || cannot_run "CARACARA_KERNEL_SUITE=$ksuite needs CARACARA_KERNEL_ROOT, a $ksuite root"
+  command -v systemd-nspawn >/dev/null || cannot_run "no systemd-nspawn (systemd-container) to build the module in $guest_root"
+  step "building caracara_bridge.ko for $kver in the guest root $guest_root"
+  nice -n 10 systemd-nspawn --quiet --keep-unit --register=no --machine="caracara-kbuild-$$" --directory="$guest_root" --private-network \
+    --bind-ro="$cache" --bind="$work" \
+    make -s -C "$kroot/usr/src/linux-headers-$kver" M="$mod" -j2 CONFIG_DEBUG_INFO_BTF_MODULES= modules 2>&1 |
+    grep -v 'Skipping BTF generation' || true
+fi
 [ -f "$mod/caracara_bridge.ko" ] || { echo "$label: FAIL: module build failed"; exit 1; }
 
 # --- gcov_flush.so: a caracarad dying of its fatal signal still writes its counters ----------
 nice -n 10 gcc -O2 -Wall -Werror -shared -fPIC "$top/tests/kernel/gcov_flush.c" -o "$work/gcov_flush.so" -ldl
 
 # --- caracarad and caracara-sim with coverage ----------------------------------------------
-guest_root=${CARACARA_KERNEL_ROOT:-/}
 if [ -n "${CARACARA_KERNEL_BUILD:-}" ]; then
   cov=$CARACARA_KERNEL_BUILD
   step "using caracarad and caracara-sim of $cov in the guest root $guest_root"
@@ -134,21 +182,34 @@ ln -s busybox "$ird/bin/sh"
 # Modules for the 9p root in load order: each one's dependencies (modules.dep) first.
 declare -A seen=()
 order=()
+# A kernel's module name uses - and _ alike; built-in ones need no loading; Debian 13's modules
+# are compressed (.ko.xz), which the initramfs's busybox insmod cannot read: unpacked below.
 add_mod() {
-  local rel deps d
-  rel=$(grep -E "^kernel/.*/$1\.ko:" "$modroot/modules.dep" | head -1 | cut -d: -f1)
+  local rel deps d pat
+  pat=$(echo "$1" | sed 's/[-_]/[-_]/g')
+  grep -qE "/$pat\.ko$" "$modroot/modules.builtin" 2>/dev/null && return 0
+  rel=$(grep -E "^kernel/.*/$pat\.ko(\.xz|\.zst|\.gz)?:" "$modroot/modules.dep" | head -1 | cut -d: -f1)
   [ -n "$rel" ] || { echo "$label: FAIL: module $1 not in modules.dep"; exit 1; }
   [ -z "${seen[$rel]:-}" ] || return 0
   seen[$rel]=1
   deps=$(grep -E "^$rel:" "$modroot/modules.dep" | cut -d: -f2)
-  for d in $deps; do add_mod "$(basename "$d" .ko)"; done
+  for d in $deps; do d=$(basename "$d"); add_mod "${d%%.ko*}"; done
   order+=("$rel")
 }
-for m in virtio_pci 9pnet_virtio 9p i2c-dev; do add_mod "$m"; done
+# The 9p root, /dev/i2c-*, and whatever the test module needs that is not built in.
+for m in virtio_pci 9pnet_virtio 9p i2c-dev $(/sbin/modinfo -F depends "$mod/caracara_bridge.ko" | tr ',' ' '); do
+  add_mod "$m"
+done
 : > "$ird/modules"
 for rel in "${order[@]}"; do
-  cp "$modroot/$rel" "$ird/lib/modules/"
-  echo "$(basename "$rel")" >> "$ird/modules"
+  name=$(basename "$rel")
+  case $name in
+    *.ko.xz) xz -dc "$modroot/$rel" >"$ird/lib/modules/${name%.xz}"; name=${name%.xz} ;;
+    *.ko.zst) zstd -qdc "$modroot/$rel" >"$ird/lib/modules/${name%.zst}"; name=${name%.zst} ;;
+    *.ko.gz) gzip -dc "$modroot/$rel" >"$ird/lib/modules/${name%.gz}"; name=${name%.gz} ;;
+    *) cp "$modroot/$rel" "$ird/lib/modules/" ;;
+  esac
+  echo "$name" >> "$ird/modules"
 done
 out=$work/out
 rm -rf "$out" && mkdir -p "$out"
@@ -212,12 +273,26 @@ for entry in "${scenario_list[@]}"; do
   fi
 done
 total=${#scenario_list[@]}
-if [ "${CARACARA_KERNEL_DOC:-1}" != 0 ]; then
-  /usr/bin/python3 "$top/tests/kernel/write_doc.py" "$top/docs/kernel-bridge.md" "${CARACARA_KERNEL_LABEL:-debian12}" \
-    "$out/scenarios.tsv" "$out/results.txt" "$out/coverage.json" "$kver" ||
-    echo "$label: could not write docs/kernel-bridge.md"
+# The run's section of docs/kernel-bridge.md, written into a copy in the build tree and the
+# tracked copy checked against it (or replaced by it: CARACARA_KERNEL_DOC=write).
+doc_rc=0
+doc_mode=${CARACARA_KERNEL_DOC:-check}
+if [ "$doc_mode" != 0 ]; then
+  cp "$top/docs/kernel-bridge.md" "$work/kernel-bridge.md"
+  /usr/bin/python3 "$top/tests/kernel/write_doc.py" "$work/kernel-bridge.md" "${CARACARA_KERNEL_LABEL:-debian12}" \
+    "$out/scenarios.tsv" "$out/results.txt" "$out/coverage.json" "$kver" || doc_rc=1
+  if [ "$doc_rc" -ne 0 ]; then
+    echo "$label: FAIL: could not write $work/kernel-bridge.md"
+  elif [ "$doc_mode" = write ]; then
+    cp "$work/kernel-bridge.md" "$top/docs/kernel-bridge.md"
+    echo "$label: wrote docs/kernel-bridge.md (CARACARA_KERNEL_DOC=write)"
+  elif ! diff -u "$top/docs/kernel-bridge.md" "$work/kernel-bridge.md"; then
+    echo "$label: FAIL: docs/kernel-bridge.md is not what this run gives (above; the run's copy is"
+    echo "$label:   $work/kernel-bridge.md). Rerun with CARACARA_KERNEL_DOC=write to record it."
+    doc_rc=1
+  fi
 fi
 echo "$label: whole run $(( $(date +%s) - t0 )) s"
 [ "$cov_rc" -eq 0 ] || echo "$label: FAIL: a kernel-facing file has no coverage data (above)"
 echo "$label: $pass of $total scenarios passed"
-[ "$pass" -eq "$total" ] && [ "$cov_rc" -eq 0 ]
+[ "$pass" -eq "$total" ] && [ "$cov_rc" -eq 0 ] && [ "$doc_rc" -eq 0 ]

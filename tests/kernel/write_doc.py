@@ -1,13 +1,16 @@
-"""Writes one kernel test run's scenario list and coverage table into docs/kernel-bridge.md.
+"""Writes one kernel test run's scenario list and coverage table into a copy of docs/kernel-bridge.md.
 
     python3 write_doc.py DOC LABEL SCENARIOS_TSV RESULTS COVERAGE_JSON KERNEL_VERSION
 
-tests/kernel/run.sh calls it at the end of each run: LABEL is debian12 (the host's root,
-libgpiod 1) or debian13 (tests/system/debian13.sh, libgpiod 2). The section between
+tests/kernel/run.sh calls it at the end of each run on a copy in its work directory (the build
+tree), then checks the tracked docs/kernel-bridge.md against that copy (CARACARA_KERNEL_DOC=write
+records it instead): LABEL is debian12 (the host's root, libgpiod 1) or debian13
+(tests/system/debian13.sh, libgpiod 2, Debian 13's kernel). The section between
 "<!-- kernel-run LABEL begin -->" and "<!-- kernel-run LABEL end -->" is replaced (appended at
-the end of the document the first time); nothing else in DOC is touched.
+the end of the document the first time); nothing else in DOC is touched. The section has no
+date: it changes when the run's kernel, a scenario, a result or the coverage does, so that a
+run with none of those changed leaves it as it is.
 """
-import datetime
 import json
 import os
 import re
@@ -33,12 +36,12 @@ def main():
         with open(cov_path) as f:
             cov = json.load(f)
     passed = sum(1 for n, _ in scenarios if results.get(n, "").startswith("PASS"))
-    day = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
     root = {"debian12": "Debian 12 root, libgpiod 1", "debian13": "Debian 13 root, libgpiod 2"}.get(label, label)
     out = ["<!-- kernel-run %s begin -->" % label,
-           "### Run: %s (kernel %s), %s" % (root, kver, day),
+           "### Run: %s (kernel %s)" % (root, kver),
            "",
-           "Written by `tests/kernel/run.sh` (`tests/kernel/write_doc.py`) from that run; not edited by hand.",
+           "Written by `tests/kernel/run.sh` (`tests/kernel/write_doc.py`) from a run; not edited by hand "
+           "(`CARACARA_KERNEL_DOC=write` records a run's section, every other run checks it).",
            "",
            "**%d of %d scenarios passed.**" % (passed, len(scenarios)),
            "",

@@ -17,8 +17,10 @@
 # 3. tests/system/run.sh --debs with CARACARA_SYSTEST_SUITE=trixie: the system test's checks
 #    (check.sh, check-debs.sh) in a booted Debian 13 container that installs those packages
 #    with apt-get, upgrades them while the thrusters run, and purges them.
-# 4. tests/kernel/run.sh with CARACARA_KERNEL_ROOT set to the Debian 13 root: the kernel test's
-#    scenarios under QEMU, caracarad's libgpiod 2 backend on the test module's GPIO chip, with
+# 4. tests/kernel/run.sh with CARACARA_KERNEL_ROOT set to the Debian 13 root and
+#    CARACARA_KERNEL_SUITE=trixie: the kernel test's scenarios under QEMU on Debian 13's own
+#    kernel (its 6.12 linux-image, the test module built against its linux-headers with the
+#    root's GCC 14), caracarad's libgpiod 2 backend on the test module's GPIO chip, with
 #    caracarad and caracara-sim built with --coverage in the root (GCC 14; its gcov reads them).
 #    CARACARA_DEBIAN13_KERNEL=0 leaves this step out, and says so ("kernel: not run (...)");
 #    under CI that fails.
@@ -240,7 +242,7 @@ if [ "$kernel_rc" = skipped ] && [ "${CARACARA_DEBIAN13_KERNEL:-1}" != 0 ]; then
     mount --bind -o ro "$src" "$root$src"
     mount --bind "$build" "$root$build"
     mount --bind "$kwork" "$root$kwork"
-    CARACARA_KERNEL_ROOT=$root CARACARA_KERNEL_BUILD=$kcov CARACARA_KERNEL_LABEL=debian13 \
+    CARACARA_KERNEL_ROOT=$root CARACARA_KERNEL_SUITE=$suite CARACARA_KERNEL_BUILD=$kcov CARACARA_KERNEL_LABEL=debian13 \
       "$src/tests/kernel/run.sh" "$kwork" || kernel_rc=$?
   fi
   kernel_s=$(($(date +%s) - t3))

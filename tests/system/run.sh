@@ -74,11 +74,14 @@ cannot_run() {
 # and the dive list on the socket) and pilot-lost (+8: the kill after the persistence and the
 # re-arm, after the busctl pilot of check.sh and after each of topside.sh's three pilots that
 # leave), the bridge's own user (+3: its user in the group, the name it may not own,
-# MemoryMax) and real-time scheduling (+2: the loop's policy, its memory locked). The install
+# MemoryMax), real-time scheduling (+2: the loop's policy, its memory locked) and the zeroing
+# step judged on this step's own zero orders and journal lines (+4: the three BOUND: lines of
+# check.sh asserted against tests/bounds.json, the step's zeros before the next daemon's start
+# and its report after a cursor, in place of zeros that a restart also sends). The install
 # count is the debs count less check-debs.sh's 34 plus check.sh's two installation checks, as it
 # was counted by hand; CI runs --debs.
-checks_planned_debs=180
-checks_planned_install=148
+checks_planned_debs=184
+checks_planned_install=152
 
 if [ "$(id -u)" -ne 0 ]; then
   cannot_run "needs root (debootstrap, systemd-nspawn)"
@@ -216,6 +219,10 @@ fi
 # The checks: a test-only unit that runs check.sh once the system is up, then powers off.
 install -D -m 0755 "$here/check.sh" "$root/usr/local/libexec/caracara-systest/check.sh"
 install -D -m 0644 "$here/helpers.sh" "$root/usr/local/libexec/caracara-systest/helpers.sh"
+# The bounds the checks assert, from the one file every test reads (tests/bounds.json): the
+# container has no python3, so they go in as a shell file.
+/usr/bin/python3 "$here/../e2e/bounds.py" --shell >"$work/bounds.sh" || die "tests/e2e/bounds.py --shell failed"
+install -D -m 0644 "$work/bounds.sh" "$root/usr/local/libexec/caracara-systest/bounds.sh"
 install -D -m 0755 "$here/check-topside.sh" "$root/usr/local/libexec/caracara-systest/check-topside.sh"
 install -D -m 0644 "$here/caracara-systest.service" "$root/etc/systemd/system/caracara-systest.service"
 mkdir -p "$root/etc/systemd/system/multi-user.target.wants"
@@ -262,7 +269,7 @@ chmod 0755 "$top/bin/caracaractl"
 # The topside's key: the private half stays out of the container, the public half goes in.
 ssh-keygen -q -t ed25519 -N '' -C caracara-topside -f "$top/id_ed25519"
 cp "$top/id_ed25519.pub" "$out/topside/id_ed25519.pub"
-CARACARA_TOPSIDE_OUT=$out CARACARA_TOPSIDE_DIR=$top CARACARA_TOPSIDE_SRC=$(cd "$here/../.." && pwd) \
+CARACARA_BOUNDS_SH=$work/bounds.sh CARACARA_TOPSIDE_OUT=$out CARACARA_TOPSIDE_DIR=$top CARACARA_TOPSIDE_SRC=$(cd "$here/../.." && pwd) \
   timeout --signal=TERM "$timeout_s" ip netns exec "$topside_ns" "$here/topside.sh" >"$work/topside.log" 2>&1 &
 topside_pid=$!
 

@@ -50,10 +50,47 @@
 #include <linux/spi/spi.h>
 #include <linux/spinlock.h>
 #include <linux/uaccess.h>
+#include <linux/version.h>
 #include <linux/vmalloc.h>
 #include <linux/wait.h>
 
 #include "kernel_bridge_abi.h"
+
+/*
+ * Built for Debian 12's kernel (6.1) and Debian 13's (6.12). Linux 6.11 made a platform
+ * driver's remove return nothing; 6.3 made a SPI device's chip select an array (read and set
+ * through spi_get_chipselect/spi_set_chipselect); the driver override of a SPI device moved
+ * to its struct device (device_set_driver_override; Kbuild defines
+ * CCB_DEVICE_DRIVER_OVERRIDE where the headers have it, Debian 13's among them).
+ */
+#if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 11, 0)
+#define CCB_REMOVE_RET void
+#define CCB_REMOVE_OK
+#else
+#define CCB_REMOVE_RET int
+#define CCB_REMOVE_OK 0
+#endif
+#if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 3, 0)
+#define ccb_chip_select(spi) spi_get_chipselect(spi, 0)
+/*
+ * One chip select: the array's other entries unused (0xFF, the core's SPI_INVALID_CS), or
+ * 6.12's spi_add_device takes them for a second use of chip select 0 (-EBUSY, "chipselect 0
+ * already in use"); from 6.8 the mask of the ones in use says entry 0.
+ */
+static inline void ccb_set_chip_select(struct spi_device *spi, u8 cs)
+{
+	u8 idx;
+
+	for (idx = 0; idx < SPI_CS_CNT_MAX; idx++)
+		spi_set_chipselect(spi, idx, idx ? 0xFF : cs);
+#if LINUX_VERSION_CODE >= KERNEL_VERSION(6, 8, 0)
+	spi->cs_index_mask = BIT(0);
+#endif
+}
+#else
+#define ccb_chip_select(spi) ((spi)->chip_select)
+#define ccb_set_chip_select(spi, cs) ((spi)->chip_select = (cs))
+#endif
 
 static int i2c_bus = 1;
 module_param(i2c_bus, int, 0444);
@@ -422,11 +459,11 @@ static int ccb_i2c_probe(struct platform_device *pdev)
 	return 0;
 }
 
-static int ccb_i2c_remove(struct platform_device *pdev)
+static CCB_REMOVE_RET ccb_i2c_remove(struct platform_device *pdev)
 {
 	i2c_del_adapter(platform_get_drvdata(pdev));
 	ccb_notify_bind(false);
-	return 0;
+	return CCB_REMOVE_OK;
 }
 
 static struct platform_driver ccb_i2c_driver = {
@@ -479,7 +516,7 @@ static int ccb_spi_transfer_one_message(struct spi_controller *ctlr, struct spi_
 	}
 	sm.mode = spi->mode;
 	sm.max_speed_hz = spi->max_speed_hz;
-	sm.chip_select = spi->chip_select;
+	sm.chip_select = ccb_chip_select(spi);
 	sm.bits_per_word = spi->bits_per_word;
 	p = (u8 *)req + sizeof(struct ccb_header);
 	memcpy(p, &sm, sizeof(sm));
@@ -568,13 +605,22 @@ static int ccb_spi_probe(struct platform_device *pdev)
 		spi_unregister_controller(ctlr);
 		return -ENOMEM;
 	}
-	spi->chip_select = 0;
+	ccb_set_chip_select(spi, 0);
 	spi->max_speed_hz = 500000;
 	spi->mode = SPI_MODE_0;
 	spi->bits_per_word = 8;
 	strscpy(spi->modalias, "spidev", sizeof(spi->modalias));
 	/* spidev refuses to be named by a board; driver_override binds it. */
+#ifdef CCB_DEVICE_DRIVER_OVERRIDE
+	ret = device_set_driver_override(&spi->dev, "spidev");
+	if (ret) {
+		spi_dev_put(spi);
+		spi_unregister_controller(ctlr);
+		return ret;
+	}
+#else
 	spi->driver_override = kstrdup("spidev", GFP_KERNEL);
+#endif
 	WRITE_ONCE(ccb_spi_probing, true);
 	ret = spi_add_device(spi);
 	WRITE_ONCE(ccb_spi_probing, false);
@@ -588,11 +634,11 @@ static int ccb_spi_probe(struct platform_device *pdev)
 	return 0;
 }
 
-static int ccb_spi_remove(struct platform_device *pdev)
+static CCB_REMOVE_RET ccb_spi_remove(struct platform_device *pdev)
 {
 	spi_unregister_device(ccb_spidev);
 	spi_unregister_controller(ccb_spi_ctlr);
-	return 0;
+	return CCB_REMOVE_OK;
 }
 
 static struct platform_driver ccb_spi_driver = {
