@@ -78,7 +78,7 @@ constexpr Member kMembers[] = {
     property<[](C c) -> const auto& { return c.telemetry().servos; }>("Servos", kChange, kTick),
     property<[](C c) { return c.telemetry().turning ? "turning" : "idle"; }>("Task", kChange, kTick),
     property<[](C c) { return c.telemetry().online; }>("Online", kChange, kTick),
-    property<[](C c) { return teensy_loss_name(c.loss()); }>("LinkLoss", kChange, kTick),
+    property<[](C c) { return name_of(c.loss()); }>("LinkLoss", kChange, kTick),
     property<[](C c) { return c.counters().frames; }>("Frames", kChange, kCounterTick), // every poll: 1 Hz
     property<[](C c) { return c.counters().busy_retries; }>("BusyRetries", kChange, kTick),
     property<[](C c) { return c.counters().link_errors; }>("LinkErrors", kChange, kTick),

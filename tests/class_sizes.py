@@ -27,6 +27,18 @@ EXCEPTIONS = {
     # One state machine playing the firmware: frames, busy, the Confirm handshake, motion.
     "sim/teensy_model": "the simulated Teensy's firmware, one state machine",
 }
+# Not yet split (issue 38 stays open until this is empty): each names its size when it was
+# listed, and fails again if it grows past it.
+NOT_YET_SPLIT = {
+    "daemon/teensy/teensy_connection": 313,  # the poll slots to a class of their own
+    "daemon/commissioning/direction_detection": 306,  # DirectionFinding beside DirectionDetection
+    "daemon/control/bus_work_dispatch": 268,
+    "daemon/bus/bus_worker": 266,
+    "daemon/vehicle/vehicle": 260,
+    "tools/bridge/telemetry": 523,  # the D-Bus object mirror, shared with caracara-ros
+    "tools/ros/telemetry_publisher": 476,  # the same mirror (see tools/bridge/telemetry)
+    "tools/caracaractl/caracaractl": 497,  # the command table and its commands
+}
 
 survey = int(sys.argv[1]) if len(sys.argv) > 1 else None
 units = {}  # unit -> [lines, classes]
@@ -44,7 +56,9 @@ for top in PRODUCT:
                 unit[1] += [c for c in re.findall(r"^(?:class|struct)\s+(\w+)[^;]*$", text, re.M)]
 
 def limit_of(unit):
-    return survey if survey is not None else LIMITS[unit.split("/")[0]]
+    if survey is not None:
+        return survey
+    return NOT_YET_SPLIT.get(unit, LIMITS[unit.split("/")[0]])
 
 
 over = sorted(((lines, unit, classes) for unit, (lines, classes) in units.items()
@@ -58,5 +72,9 @@ for unit, why in sorted(EXCEPTIONS.items()):
             over.append(unit)
         else:
             print("%5d  %s: allowed past %d (%s)" % (units[unit][0], unit, limit_of(unit), why))
+for unit, size in sorted(NOT_YET_SPLIT.items()):
+    if survey is None:
+        print("%5d  %s: not yet split (limit %d, held at %d)" % (units.get(unit, [0])[0], unit,
+                                                                LIMITS[unit.split("/")[0]], size))
 print("%d unit(s) over their limit (header + source)" % len(over))
 sys.exit(1 if over else 0)

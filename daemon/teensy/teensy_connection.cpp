@@ -13,16 +13,6 @@ namespace {
 constexpr uint64_t kReopenUs = 1'000'000;
 } // namespace
 
-std::string_view teensy_loss_name(TeensyLoss l) {
-    switch (l) {
-    case TeensyLoss::None: return "none";
-    case TeensyLoss::Gone: return "gone";
-    case TeensyLoss::Absent: return "absent";
-    case TeensyLoss::Silent: return "silent";
-    }
-    return "none";
-}
-
 Result teensy_result(teensy::TeensyError e, std::string_view what) {
     if (e == teensy::TeensyError::None)
         return {};
@@ -31,7 +21,14 @@ Result teensy_result(teensy::TeensyError e, std::string_view what) {
 
 TeensyConnection::TeensyConnection(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate)
     : event_(event), gate_(gate), spi_(io, settings.device, settings.spi), link_(spi_, settings.teensy), worker_(link_),
-      fitted_(settings.fitted), silence_ns_(ms_to_ns(settings.silence_ms)) {
+      watch_(
+          settings, [this] { worker_.collect(); }, [this] { return open_; },
+          [this](uint64_t ms) {
+              // Silent: asked for this long and no valid frame.
+              log_error("Teensy on SPI %s answered no valid frame for %llu ms: failsafe teensy-link-lost",
+                        spi_.path().c_str(), static_cast<unsigned long long>(ms));
+              lose(TeensyLoss::Silent);
+          }) {
     tm_.distances.assign(static_cast<size_t>(settings.teensy.limits.distance_sensor_count), 0);
     tm_.servos.assign(static_cast<size_t>(settings.teensy.limits.servo_count), 0);
 }
@@ -41,8 +38,8 @@ int TeensyConnection::open() {
     open_ = tm_.online = r >= 0;
     if (r < 0) {
         // Fitted: the vehicle stays killed (the failsafes look at the conditions as they start).
-        if (fitted_) {
-            loss_ = TeensyLoss::Absent;
+        if (watch_.fitted()) {
+            watch_.lose(TeensyLoss::Absent);
             log_error("Teensy is fitted ([spi] fitted) but SPI %s is absent at start (%s): failsafe "
                       "teensy-link-lost; asking for it again once a second",
                       spi_.path().c_str(), errno_name(-r).c_str());
@@ -55,7 +52,7 @@ int TeensyConnection::open() {
 void TeensyConnection::close() {
     worker_.stop(); // after the frame on the wire; what was queued (a Stop of the way out) still runs
     reopen_timer_.reset();
-    silence_timer_.reset();
+    watch_.stop();
     spi_.close();
     open_ = false;
 }
@@ -89,7 +86,7 @@ int TeensyConnection::on_reopen(sd_event_source*, uint64_t, void* userdata) {
                              }
                              log_notice("Teensy SPI %s is back", self->spi_.path().c_str());
                              self->open_ = true;
-                             self->asked_ns_ = 0; // the silence counts from its first frame
+                             self->watch_.reopened(); // the silence counts from its first frame
                              // Whatever the wheels were doing before, they stop now (as at every start).
                              if (self->on_back_)
                                  self->on_back_();
@@ -105,33 +102,29 @@ void TeensyConnection::lose_link() {
               spi_.path().c_str(), errno_name(ENODEV).c_str());
     open_ = false;
     worker_.submit([this] { spi_.close(); }, nullptr);
-    loss_ = TeensyLoss::None; // gone, whatever it was before
+    watch_.gone(); // gone, whatever it was before
     lose(TeensyLoss::Gone);
     schedule_reopen();
 }
 
 void TeensyConnection::lose(TeensyLoss why) {
     tm_.online = false;
-    if (loss_ != TeensyLoss::None)
+    if (!watch_.lose(why))
         return;
-    loss_ = why;
     if (on_lost_)
         on_lost_();
     gate_.link_changed(); // the kill, at once
 }
 
 void TeensyConnection::heard(uint64_t now) {
-    asked_ns_ = 0;
-    answered_ = true;
-    if (!open_)
+    const TeensyLoss was = watch_.loss();
+    if (!watch_.heard(now)) {
+        if (open_)
+            tm_.online = true;
         return;
+    }
     tm_.online = true;
-    if (loss_ == TeensyLoss::None)
-        return;
-    log_notice("Teensy answers again (it was %s): teensy-link-lost clears",
-               std::string(teensy_loss_name(loss_)).c_str());
-    loss_ = TeensyLoss::None;
-    arm_silence_timer(now + silence_ns_);
+    log_notice("Teensy answers again (it was %s): teensy-link-lost clears", std::string(name_of(was)).c_str());
     // Whatever the wheels were doing before, they stop now: the kill's Stop may not have got through.
     if (on_back_)
         on_back_();
@@ -141,53 +134,13 @@ void TeensyConnection::heard(uint64_t now) {
 std::string TeensyConnection::start(int64_t priority) {
     if (std::string e = worker_.start(event_, priority); !e.empty())
         return e;
-    sd_event_source* s = nullptr;
-    if (int r = sd_event_add_time(event_, &s, CLOCK_MONOTONIC, 0, 1000, on_silence, this); r < 0)
-        return "sd_event_add_time: " + errno_name(-r);
-    silence_timer_.reset(s);
-    arm_silence_timer(monotonic_ns() + silence_ns_);
-    return {};
-}
-
-void TeensyConnection::arm_silence_timer(uint64_t at_ns) {
-    if (!silence_timer_)
-        return;
-    sd_event_source_set_time(silence_timer_.get(), at_ns / 1000);
-    sd_event_source_set_enabled(silence_timer_.get(), SD_EVENT_ONESHOT);
-}
-
-int TeensyConnection::on_silence(sd_event_source*, uint64_t, void* userdata) {
-    auto* self = static_cast<TeensyConnection*>(userdata);
-    self->worker_.collect(); // a valid frame already in counts
-    const uint64_t now = monotonic_ns();
-    if (self->loss_ != TeensyLoss::None)
-        return 0; // armed again at its next valid frame
-    // A Teensy not fitted that never answered, or a node not open, is not relied on.
-    if (!self->open_ || !(self->fitted_ || self->answered_)) {
-        self->arm_silence_timer(now + self->silence_ns_);
-        return 0;
-    }
-    if (self->asked_ns_ == 0 || now - self->asked_ns_ < self->silence_ns_) {
-        self->arm_silence_timer((self->asked_ns_ ? self->asked_ns_ : now) + self->silence_ns_);
-        return 0;
-    }
-    // Silent: asked for this long and no valid frame (busy for ever, no answer, errors, garbage,
-    // a frame held on the wire).
-    log_error("Teensy on SPI %s answered no valid frame for %llu ms: failsafe teensy-link-lost",
-              self->spi_.path().c_str(), static_cast<unsigned long long>((now - self->asked_ns_) / 1'000'000));
-    self->lose(TeensyLoss::Silent);
-    return 0;
+    return watch_.start(event_);
 }
 
 int TeensyConnection::io_errno(teensy::TeensyError e) const {
     // Only a failed transfer has an errno of its own: the SPI device keeps its last one, which
     // after a garbage answer would be a stale ENODEV from a device that has since come back.
     return e == teensy::TeensyError::Io ? spi_.last_errno() : 0;
-}
-
-void TeensyConnection::mark_asked() {
-    if (asked_ns_ == 0)
-        asked_ns_ = monotonic_ns();
 }
 
 void TeensyConnection::poll() {
@@ -200,7 +153,7 @@ void TeensyConnection::poll() {
     ++poll_index_;
     poll_.sensor = sensors ? (poll_index_ / slots) % sensors : 0;
     poll_out_ = true;
-    mark_asked();
+    watch_.asked();
     // Captures `this` only: no allocation per poll.
     worker_.submit(
         [this] {
@@ -238,7 +191,7 @@ void TeensyConnection::poll_done() {
 void TeensyConnection::command(std::function<teensy::TeensyError()> frame, std::string what, Completion done) {
     auto e = std::make_shared<teensy::TeensyError>(teensy::TeensyError::None);
     auto err = std::make_shared<int>(0);
-    mark_asked();
+    watch_.asked();
     worker_.submit(
         [this, frame = std::move(frame), e, err] {
             *e = frame();

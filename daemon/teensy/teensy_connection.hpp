@@ -10,6 +10,8 @@
 #include "core/config.hpp"
 #include "core/status.hpp"
 #include "daemon/loop/completion.hpp"
+#include "daemon/teensy/teensy_link_watch.hpp"
+#include "daemon/teensy/teensy_telemetry.hpp"
 #include "daemon/teensy/teensy_worker.hpp"
 #include "daemon/interfaces/command_gate.hpp"
 #include "drivers/devices/teensy_link.hpp"
@@ -26,19 +28,6 @@
 #include <vector>
 
 namespace caracara {
-
-struct TeensyTelemetry {
-    bool online = false;
-    std::array<double, 3> orientation{}; // yaw, pitch, roll
-    std::vector<uint16_t> distances;
-    std::vector<uint8_t> servos;
-    bool turning = false;
-};
-
-// Why the link is lost: the SPI device went away (ENODEV), a fitted Teensy was absent at start,
-// or no valid frame for silence_ms.
-enum class TeensyLoss : uint8_t { None, Gone, Absent, Silent };
-std::string_view teensy_loss_name(TeensyLoss l); // "none", "gone", "absent", "silent"
 
 // The link's error as a Result naming the frame (`what`).
 Result teensy_result(teensy::TeensyError e, std::string_view what);
@@ -59,8 +48,8 @@ public:
     bool is_open() const { return open_; }
     // The link is lost (gone, absent though fitted, or silent) and no valid frame came since. A
     // Teensy not fitted that never answered is not lost.
-    bool link_lost() const { return loss_ != TeensyLoss::None; }
-    TeensyLoss loss() const { return loss_; }
+    bool link_lost() const { return watch_.loss() != TeensyLoss::None; }
+    TeensyLoss loss() const { return watch_.loss(); }
 
     // One frame: the three orientation axes, then one distance sensor, in turn; handed to the
     // worker unless the last one is still out (a slow Teensy is polled as fast as it answers).
@@ -83,16 +72,12 @@ private:
         int err = 0;
     };
     static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
-    // At silence_ms after the last valid frame: the link is lost, unless a frame came since.
-    static int on_silence(sd_event_source*, uint64_t usec, void* userdata);
-    void arm_silence_timer(uint64_t at_ns); // monotonic ns
     void poll_done();
     // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, told to the
     // gate (the wheels cannot be stopped: the failsafes kill), and asked for again once a second.
     void lose_link();
     // The link lost for `why` (the kill, at once), unless it already is.
     void lose(TeensyLoss why);
-    void mark_asked(); // a frame handed to the worker
     int io_errno(teensy::TeensyError e) const; // the worker's: the failed transfer's errno, or 0
     // A valid frame came back (`now`): a lost link is back.
     void heard(uint64_t now);
@@ -104,20 +89,12 @@ private:
     TeensyLink link_; // the worker's while it runs
     TeensyWorker worker_;
     bool open_ = false; // loop thread: the SPI node is open (as far as the loop knows)
-    TeensyLoss loss_ = TeensyLoss::None; // loop thread
-    bool fitted_;           // [spi] fitted
-    bool answered_ = false; // loop thread: a valid frame came once (a Teensy not fitted is then relied on)
-    uint64_t silence_ns_;
-    // Loop thread: when the first frame since the last valid one was handed over (0: none). The
-    // silence counts only while the Teensy is asked: a poll held back behind a hung I2C bus
-    // (the Teensy's slot comes after the cycle's transfers) is no silence of the Teensy's.
-    uint64_t asked_ns_ = 0;
+    TeensyLinkWatch watch_; // loop thread
     TeensyTelemetry tm_;
     unsigned poll_index_ = 0;
     bool poll_out_ = false;
     PollResult poll_; // the worker's while a poll is out
     SourcePtr reopen_timer_;
-    SourcePtr silence_timer_;
     std::function<void()> on_lost_;
     std::function<void()> on_back_;
 };
