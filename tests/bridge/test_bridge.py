@@ -25,36 +25,16 @@ sys.path.insert(0, os.path.join(SOURCE, "bench"))
 
 import bounds  # noqa: E402
 import harness  # noqa: E402
+from harness import missing, npm_ci  # noqa: E402
 from full_dive_dir import fill  # noqa: E402
 from harness import BUILD_DIR, Rig, poll  # noqa: E402
 from ssh_bridge import free_port, port_listens, private_sshd  # noqa: E402
 
-NPM_CACHE = "/var/cache/caracara-npm"
 # [failsafe.pilot-lost] persistence_ms of the rig: a closed tab, the last pilot, kills this long
 # after (5 s by default; shorter here, the tests wait for it).
 PILOT_LOST_MS = 1000
 # [failsafe.surface] duration_ms of the rig: the ascent the cockpit's banner shows.
 SURFACE_MS = 3000
-CI = os.environ.get("CI") == "true"
-
-
-def missing(what):
-    """Fails under CI, skips elsewhere."""
-    if CI:
-        raise AssertionError("cannot run under CI: " + what)
-    raise unittest.SkipTest(what)
-
-
-def npm_ci():
-    """node_modules as package-lock.json pins them (once per lock)."""
-    if not shutil.which("node") or not shutil.which("npm"):
-        missing("node and npm are needed (scripts/deps.sh)")
-    stamp = os.path.join(HERE, "node_modules", ".package-lock.json")
-    lock = os.path.join(HERE, "package-lock.json")
-    if os.path.exists(stamp) and os.path.getmtime(stamp) >= os.path.getmtime(lock):
-        return
-    subprocess.run(["npm", "ci", "--cache", NPM_CACHE, "--no-audit", "--no-fund", "--prefer-offline"], cwd=HERE,
-                   check=True, stdout=subprocess.DEVNULL)
 
 
 class Sshd:
@@ -106,7 +86,7 @@ class BridgeRig:
 
     @classmethod
     def setUpClass(cls):
-        npm_ci()
+        npm_ci(HERE)
         if not os.access(os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge"), os.X_OK):
             raise AssertionError("caracara-bridge is not built in %s" % BUILD_DIR)
         if not shutil.which("ssh") or not shutil.which("ssh-keygen"):

@@ -35,6 +35,29 @@ import dbus
 import dbus.mainloop.glib
 from gi.repository import GLib
 
+# The npm packages the Node tests pin (tests/bridge, tests/ros), cached between runs.
+NPM_CACHE = "/var/cache/caracara-npm"
+CI_RUN = os.environ.get("CI") == "true"
+
+
+def missing(what):
+    """A tool a test needs is missing: fails under CI, skips elsewhere."""
+    if CI_RUN:
+        raise AssertionError("cannot run under CI: " + what)
+    raise unittest.SkipTest(what)
+
+
+def npm_ci(here):
+    """node_modules in `here` as its package-lock.json pins them (once per lock)."""
+    if not shutil.which("node") or not shutil.which("npm"):
+        missing("node and npm are needed (scripts/deps.sh)")
+    stamp = os.path.join(here, "node_modules", ".package-lock.json")
+    lock = os.path.join(here, "package-lock.json")
+    if os.path.exists(stamp) and os.path.getmtime(stamp) >= os.path.getmtime(lock):
+        return
+    subprocess.run(["npm", "ci", "--cache", NPM_CACHE, "--no-audit", "--no-fund", "--prefer-offline"], cwd=here,
+                   check=True, stdout=subprocess.DEVNULL)
+
 # --- where things are -----------------------------------------------------------------------
 
 BUILD_DIR = os.environ.get("CARACARA_BUILD_DIR") or "/tmp/build-e2e"

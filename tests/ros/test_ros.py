@@ -26,12 +26,12 @@ SOURCE = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
 
 import harness  # noqa: E402
+from harness import missing, npm_ci  # noqa: E402
 from bounds import CLIENT_LOSS_ZERO_MS_MAX  # noqa: E402
 from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, angle_diff, poll, speed_byte  # noqa: E402
 from test_failsafes import kill_edges, orders  # noqa: E402
 
-NPM_CACHE = "/var/cache/caracara-npm"
-CI = os.environ.get("CI") == "true"
+
 # Every type caracara-ros speaks, with the topic it is on.
 TYPES = ["sensor_msgs/Imu", "sensor_msgs/JointState", "sensor_msgs/Range", "diagnostic_msgs/DiagnosticArray",
          "std_msgs/Bool", "std_msgs/String", "std_msgs/Empty", "std_msgs/Float64MultiArray", "geometry_msgs/Wrench",
@@ -44,23 +44,6 @@ PUBLISHED = {"rt/caracara/imu": "sensor_msgs/Imu", "rt/caracara/joint_states": "
 MOTOR_MAX = 8850
 
 
-def missing(what):
-    if CI:
-        raise AssertionError("cannot run under CI: " + what)
-    raise unittest.SkipTest(what)
-
-
-def npm_ci():
-    if not shutil.which("node") or not shutil.which("npm"):
-        missing("node and npm are needed (scripts/deps.sh)")
-    stamp = os.path.join(HERE, "node_modules", ".package-lock.json")
-    lock = os.path.join(HERE, "package-lock.json")
-    if os.path.exists(stamp) and os.path.getmtime(stamp) >= os.path.getmtime(lock):
-        return
-    subprocess.run(["npm", "ci", "--cache", NPM_CACHE, "--no-audit", "--no-fund", "--prefer-offline"], cwd=HERE,
-                   check=True, stdout=subprocess.DEVNULL)
-
-
 def build_peer(distro):
     """The Fast DDS peer for one distro's definitions, built once per source (in the build tree)."""
     for tool in ("fastddsgen", "g++"):
@@ -68,7 +51,7 @@ def build_peer(distro):
             missing(tool + " is needed (scripts/deps.sh: fastddsgen, libfastrtps-dev)")
     if not os.path.exists("/usr/include/fastdds/dds/domain/DomainParticipant.hpp"):
         missing("libfastrtps-dev is needed (scripts/deps.sh)")
-    npm_ci()
+    npm_ci(HERE)
     idl = subprocess.run(["node", "msg_to_idl.mjs", distro] + TYPES, cwd=HERE, check=True, capture_output=True,
                          text=True).stdout
     with open(os.path.join(HERE, "peer.cpp")) as f:
@@ -119,7 +102,7 @@ def network_is_private():
     links = subprocess.run(["ip", "-o", "link"], capture_output=True, text=True, check=True).stdout.splitlines()
     names = [line.split(":")[1].strip() for line in links]
     if names != ["lo"]:
-        if CI:
+        if harness.CI_RUN:
             raise AssertionError("not in a private network namespace (interfaces %s)" % names)
         raise unittest.SkipTest("run through ctest (ros.cmake starts it under unshare --net)")
     subprocess.run(["ip", "link", "set", "lo", "up", "multicast", "on"], check=True)
@@ -264,7 +247,7 @@ class DiveExportTest(unittest.TestCase):
     rosmsg2-serialization and written back to the same bytes), judged against the dive's CSV."""
 
     def test_regression_dives(self):
-        npm_ci()
+        npm_ci(HERE)
         dives = os.path.join(SOURCE, "tests", "dives")
         ctl = harness.command("caracaractl")
         names = sorted(n for n in os.listdir(dives) if n.endswith(".cdive"))
