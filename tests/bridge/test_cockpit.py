@@ -10,7 +10,7 @@ import shutil
 import subprocess
 import unittest
 
-from test_bridge import BUILD_DIR, BridgeRig, missing, npm_ci
+from test_bridge import BUILD_DIR, HERE, BridgeRig, missing, npm_ci
 
 CHROMIUM = "/usr/bin/chromium"
 
@@ -29,7 +29,7 @@ class CockpitTest(BridgeRig, unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         ensure_chromium()
-        npm_ci()
+        npm_ci(HERE)
         super().setUpClass()
 
     def test_a_gamepad_mapping(self):

@@ -81,12 +81,24 @@ std::string process_name(uint32_t pid) {
 } // namespace
 
 Telemetry::Telemetry(boost::asio::io_context& io, caracara::dbus::BusChoice bus, Publish publish)
-    : io_(io), choice_(std::move(bus)), publish_(std::move(publish)), retry_(io), latest_(fg::channels().size()) {}
+    : io_(io), choice_(std::move(bus)), publish_(std::move(publish)), retry_(io),
+      mirror_([this](const std::string& path, const std::string& iface, const Props& changes,
+                     const Props& before) { changed(path, iface, changes, before); },
+              [this] {
+                  // A restarted caracarad: its objects are loaded again (the old values are gone),
+                  // not from inside this connection's processing: the call waits for its reply.
+                  boost::asio::post(io_, [this, alive = alive_] {
+                      if (*alive)
+                          reload();
+                  });
+              }),
+      latest_(fg::channels().size()) {}
 
 Telemetry::~Telemetry() {
     *alive_ = false;
     watch_.reset();
     slots_.clear();
+    mirror_.clear();
     controller_slot_.reset();
 }
 
@@ -112,16 +124,12 @@ void Telemetry::retry() {
 bool Telemetry::connect() {
     watch_.reset();
     slots_.clear();
+    mirror_.clear();
     controller_slot_.reset();
     client_ = std::make_unique<client::Client>(choice_);
     try {
         sd_bus* bus = client_->bus();
-        // Subscribe before loading, so no change falls between the two.
         sd_bus_slot* slot = nullptr;
-        if (sd_bus_match_signal(bus, &slot, caracara::dbus::kBusName, nullptr, "org.freedesktop.DBus.Properties",
-                                "PropertiesChanged", on_properties_changed, this) < 0)
-            return false;
-        slots_.emplace_back(slot);
         for (const char* member : {"BusLost", "BusRestored"}) {
             if (sd_bus_match_signal(bus, &slot, caracara::dbus::kBusName, caracara::dbus::kBusPath,
                                     caracara::dbus::kBusIface, member, on_vehicle_signal, this) < 0)
@@ -133,15 +141,13 @@ bool Telemetry::connect() {
                                 caracara::dbus::kVehicleIface, "Failsafe", on_vehicle_signal, this) < 0)
             return false;
         slots_.emplace_back(slot);
-        // A restarted caracarad: its objects are loaded again (the old values are gone).
-        if (sd_bus_match_signal(bus, &slot, "org.freedesktop.DBus", "/org/freedesktop/DBus", "org.freedesktop.DBus",
-                                "NameOwnerChanged", on_owner_changed, this) < 0)
+        // Subscribed before loading, so no change falls between the two.
+        if (!mirror_.subscribe_and_load(*client_))
             return false;
-        slots_.emplace_back(slot);
-        objects_ = client_->get_objects();
     } catch (const client::Failure& f) {
         std::fprintf(stderr, "caracara-bridge: caracarad not reachable (%s); retrying\n", f.message.c_str());
         slots_.clear();
+        mirror_.clear();
         return false;
     }
     watch_ = std::make_unique<BusWatch>(io_, client_->bus(), [this] {
@@ -156,29 +162,6 @@ bool Telemetry::connect() {
         if (fg::channels()[i].kind != ChannelKind::Events)
             mark(i);
     return true;
-}
-
-const Props& Telemetry::props(const std::string& path, const char* iface) const {
-    static const Props none;
-    const auto o = objects_.find(path);
-    if (o == objects_.end())
-        return none;
-    const auto i = o->second.find(iface);
-    return i == o->second.end() ? none : i->second;
-}
-
-int Telemetry::on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    auto* self = static_cast<Telemetry*>(userdata);
-    try {
-        const char* iface = nullptr;
-        if (sd_bus_message_read(m, "s", &iface) < 0 || !iface)
-            return 0;
-        const Props changed = client::to_props(client::read_value(m));
-        self->changed(sd_bus_message_get_path(m) ? sd_bus_message_get_path(m) : "", iface, changed);
-    } catch (const client::Failure&) {
-        // A malformed signal changes nothing.
-    }
-    return 0;
 }
 
 int Telemetry::on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -208,25 +191,11 @@ int Telemetry::on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error
     return 0;
 }
 
-int Telemetry::on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    auto* self = static_cast<Telemetry*>(userdata);
-    const char *name = nullptr, *old_owner = nullptr, *new_owner = nullptr;
-    if (sd_bus_message_read(m, "sss", &name, &old_owner, &new_owner) < 0 || !name ||
-        std::string_view(name) != caracara::dbus::kBusName || !new_owner || !*new_owner)
-        return 0;
-    // Not from inside this connection's processing: the call waits for its reply.
-    boost::asio::post(self->io_, [self, alive = self->alive_] {
-        if (*alive)
-            self->reload();
-    });
-    return 0;
-}
-
 void Telemetry::reload() {
     if (!watch_ || !client_)
         return; // reconnecting: connect() loads the objects
     try {
-        objects_ = client_->get_objects();
+        mirror_.load(*client_);
     } catch (const client::Failure& f) {
         std::fprintf(stderr, "caracara-bridge: reloading caracarad's objects failed (%s)\n", f.message.c_str());
         return;
@@ -238,11 +207,8 @@ void Telemetry::reload() {
     watch_->kick();
 }
 
-void Telemetry::changed(const std::string& path, const std::string& iface, const Props& changes) {
-    Props& stored = objects_[path][iface];
-    const Props before = stored;
-    for (const auto& [name, value] : changes)
-        stored[name] = value;
+void Telemetry::changed(const std::string& path, const std::string& iface, const Props& changes, const Props& before) {
+    const Props& stored = mirror_.props(path, iface.c_str());
     if (path == kRoot) {
         bool state = false, motors = false;
         for (const auto& [name, _] : changes)

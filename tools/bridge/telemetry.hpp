@@ -8,6 +8,7 @@
 
 #include "tools/bridge/bus_watch.hpp"
 #include "tools/client/client.hpp"
+#include "tools/client/object_mirror.hpp"
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -35,9 +36,7 @@ public:
     Payload latest(std::size_t channel) const { return channel < latest_.size() ? latest_[channel] : nullptr; }
 
 private:
-    static int on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
     static int on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error* error);
-    static int on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
     static int on_controller_pid(sd_bus_message* m, void* userdata, sd_bus_error* error);
     // When a surface failsafe's ascent began (surfacing_ms in the state), from the root's properties.
     void follow_surfacing(const client::Props& root);
@@ -47,12 +46,13 @@ private:
     void loaded(); // after the objects were (re)loaded
     bool connect();
     void retry();
-    void changed(const std::string& path, const std::string& iface, const client::Props& props);
+    void changed(const std::string& path, const std::string& iface, const client::Props& changes,
+                 const client::Props& before);
     void mark(std::size_t channel);
     void flush();
     void build(std::size_t channel, uint64_t now);
     void log(int level, const std::string& name, const std::string& message);
-    const client::Props& props(const std::string& path, const char* iface) const;
+    const client::Props& props(const std::string& path, const char* iface) const { return mirror_.props(path, iface); }
 
     boost::asio::io_context& io_;
     caracara::dbus::BusChoice choice_;
@@ -61,7 +61,7 @@ private:
     std::vector<caracara::dbus::SlotPtr> slots_;
     std::unique_ptr<BusWatch> watch_;
     boost::asio::steady_timer retry_;
-    client::Objects objects_;
+    client::ObjectMirror mirror_;
     std::set<std::size_t> dirty_;
     bool flush_posted_ = false;
     std::vector<Payload> latest_;

@@ -58,7 +58,11 @@ dds_topic_descriptor_t jazzy_range_descriptor() {
 } // namespace
 
 TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config)
-    : event_(event), dds_(dds), config_(config), jazzy_range_(jazzy_range_descriptor()) {
+    : event_(event), dds_(dds), config_(config),
+      mirror_([this](const std::string& path, const std::string&, const Props& changes,
+                     const Props&) { changed(path, changes); },
+              [this] { reload(); }),
+      jazzy_range_(jazzy_range_descriptor()) {
     const auto topic = [&](const char* name) { return ros_topic(config_, name); };
     imu_ = dds_.writer(&sensor_msgs_msg_dds__Imu__desc, topic("imu"), Profile::Default);
     tf_ = dds_.writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Default);
@@ -75,7 +79,7 @@ TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, con
     }
 }
 
-TelemetryPublisher::~TelemetryPublisher() { slots_.clear(); }
+TelemetryPublisher::~TelemetryPublisher() { mirror_.clear(); }
 
 void TelemetryPublisher::start() {
     if (!connect())
@@ -96,26 +100,16 @@ int TelemetryPublisher::on_retry(sd_event_source*, uint64_t, void* userdata) {
 }
 
 bool TelemetryPublisher::connect() {
-    slots_.clear();
+    mirror_.clear();
     client_ = std::make_unique<client::Client>(config_.bus);
     try {
-        sd_bus* bus = client_->bus();
-        sd_bus_slot* slot = nullptr;
-        // Subscribe before loading, so no change falls between the two.
-        if (sd_bus_match_signal(bus, &slot, caracara::dbus::kBusName, nullptr, "org.freedesktop.DBus.Properties",
-                                "PropertiesChanged", on_properties_changed, this) < 0)
+        if (!mirror_.subscribe_and_load(*client_))
             return false;
-        slots_.emplace_back(slot);
-        if (sd_bus_match_signal(bus, &slot, "org.freedesktop.DBus", "/org/freedesktop/DBus", "org.freedesktop.DBus",
-                                "NameOwnerChanged", on_owner_changed, this) < 0)
-            return false;
-        slots_.emplace_back(slot);
-        objects_ = client_->get_objects();
-        if (sd_bus_attach_event(bus, event_, SD_EVENT_PRIORITY_NORMAL) < 0)
+        if (sd_bus_attach_event(client_->bus(), event_, SD_EVENT_PRIORITY_NORMAL) < 0)
             return false;
     } catch (const client::Failure& f) {
         std::fprintf(stderr, "caracara-ros: caracarad not reachable (%s); retrying\n", f.message.c_str());
-        slots_.clear();
+        mirror_.clear();
         client_.reset();
         return false;
     }
@@ -123,20 +117,11 @@ bool TelemetryPublisher::connect() {
     return true;
 }
 
-int TelemetryPublisher::on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    auto* self = static_cast<TelemetryPublisher*>(userdata);
-    const char *name = nullptr, *old_owner = nullptr, *new_owner = nullptr;
-    if (sd_bus_message_read(m, "sss", &name, &old_owner, &new_owner) >= 0 && name &&
-        std::string_view(name) == caracara::dbus::kBusName && new_owner && *new_owner)
-        self->reload();
-    return 0;
-}
-
 void TelemetryPublisher::reload() {
     // A restarted caracarad: its objects are loaded again (the old values are gone). The call
     // waits for its reply on this connection, which sd-bus allows from a handler.
     try {
-        objects_ = client_->get_objects();
+        mirror_.load(*client_);
     } catch (const client::Failure& f) {
         std::fprintf(stderr, "caracara-ros: reloading caracarad's objects failed (%s)\n", f.message.c_str());
         return;
@@ -144,33 +129,7 @@ void TelemetryPublisher::reload() {
     mark(kImu | kJoints | kRanges | kDiagnostics | kState);
 }
 
-int TelemetryPublisher::on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    auto* self = static_cast<TelemetryPublisher*>(userdata);
-    try {
-        const char* iface = nullptr;
-        if (sd_bus_message_read(m, "s", &iface) < 0 || !iface)
-            return 0;
-        const Props changes = client::to_props(client::read_value(m));
-        self->changed(sd_bus_message_get_path(m) ? sd_bus_message_get_path(m) : "", iface, changes);
-    } catch (const client::Failure&) {
-        // A malformed signal changes nothing.
-    }
-    return 0;
-}
-
-const Props& TelemetryPublisher::props(const std::string& path, const char* iface) const {
-    static const Props none;
-    const auto o = objects_.find(path);
-    if (o == objects_.end())
-        return none;
-    const auto i = o->second.find(iface);
-    return i == o->second.end() ? none : i->second;
-}
-
-void TelemetryPublisher::changed(const std::string& path, const std::string& iface, const Props& changes) {
-    Props& stored = objects_[path][iface];
-    for (const auto& [name, value] : changes)
-        stored[name] = value;
+void TelemetryPublisher::changed(const std::string& path, const Props& changes) {
     unsigned d = kDiagnostics;
     if (path == kRoot) {
         if (changes.contains("State") || changes.contains("KillSource"))

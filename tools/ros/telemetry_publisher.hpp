@@ -7,6 +7,7 @@
 #pragma once
 
 #include "tools/client/client.hpp"
+#include "tools/client/object_mirror.hpp"
 #include "tools/ros/dds_participant.hpp"
 
 #include <array>
@@ -29,8 +30,6 @@ public:
 
 private:
     enum Dirty : unsigned { kImu = 1, kJoints = 2, kRanges = 4, kDiagnostics = 8, kState = 16 };
-    static int on_properties_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
-    static int on_owner_changed(sd_bus_message* m, void* userdata, sd_bus_error* error);
     static int on_flush(sd_event_source* s, void* userdata);
     static int on_retry(sd_event_source* s, uint64_t usec, void* userdata);
     static int on_diagnostics_due(sd_event_source* s, uint64_t usec, void* userdata);
@@ -38,8 +37,8 @@ private:
     void retry();
     void reload();
     void mark(unsigned dirty);
-    void changed(const std::string& path, const std::string& iface, const client::Props& props);
-    const client::Props& props(const std::string& path, const char* iface) const;
+    void changed(const std::string& path, const client::Props& changes);
+    const client::Props& props(const std::string& path, const char* iface) const { return mirror_.props(path, iface); }
 
     void write_imu_and_tf();
     void write_joints();
@@ -52,9 +51,8 @@ private:
     DdsParticipant& dds_;
     const RosConfig& config_;
     std::unique_ptr<client::Client> client_;
-    std::vector<caracara::dbus::SlotPtr> slots_;
     caracara::SourcePtr flush_, retry_, diagnostics_timer_;
-    client::Objects objects_;
+    client::ObjectMirror mirror_;
     unsigned dirty_ = 0;
     uint64_t diagnostics_last_us_ = 0;
     std::vector<uint8_t> last_levels_;
