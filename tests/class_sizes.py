@@ -35,8 +35,7 @@ NOT_YET_SPLIT = {
     "daemon/control/bus_work_dispatch": 268,
     "daemon/bus/bus_worker": 266,
     "daemon/vehicle/vehicle": 260,
-    "tools/bridge/telemetry": 523,  # the D-Bus object mirror, shared with caracara-ros
-    "tools/ros/telemetry_publisher": 476,  # the same mirror (see tools/bridge/telemetry)
+    "tools/bridge/telemetry": 489,  # the channels' message builders to a class of their own
     "tools/caracaractl/caracaractl": 497,  # the command table and its commands
 }
 
