@@ -460,7 +460,7 @@ check "systemctl start caracara-bridge (Type=notify: returns once it listens)" t
 check "the bridge's socket is caracara-bridge:caracara, mode 0660" \
   bash -c '[ "$(stat -c %U:%G:%a /run/caracara-bridge/bridge.sock)" = caracara-bridge:caracara:660 ]'
 # Its own user, in the group (issue 35): not the daemon's, whose name it may not own.
-bridge_user() { [ "$(ps -o user=,group= -p "$(unit caracara-bridge MainPID)" | tr -s ' ')" = "caracara-bridge caracara" ]; }
+bridge_user() { [ "$(ps -o user:32=,group:32= -p "$(unit caracara-bridge MainPID)" | awk '{print $1, $2}')" = "caracara-bridge caracara" ]; }
 check "the bridge runs as caracara-bridge, group caracara" bridge_user
 # RequestName with DO_NOT_QUEUE: refused by the policy, not answered EXISTS.
 check "caracara-bridge may not own org.caracara.Vehicle1 (the bus policy)" \
