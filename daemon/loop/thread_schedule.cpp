@@ -28,7 +28,8 @@ const char* policy_name(SchedPolicy p) { return p == SchedPolicy::Fifo ? "SCHED_
 constexpr std::size_t kThreadStackBytes = 512 * 1024;
 
 // Whether the process may lock more than RLIMIT_MEMLOCK (CAP_IPC_LOCK, bit 14 of CapEff).
-bool may_lock_any_amount() {
+// (Unused in a sanitized build, which never locks.)
+[[maybe_unused]] bool may_lock_any_amount() {
     std::ifstream f("/proc/self/status");
     std::string line;
     while (std::getline(f, line))
@@ -39,7 +40,7 @@ bool may_lock_any_amount() {
 
 // The main thread's stack grows by page faults; touch what the loop will use now, while
 // memory is locked, so that a deep call on the hot path does not fault.
-[[gnu::noinline]] void fault_in_stack() {
+[[gnu::noinline, maybe_unused]] void fault_in_stack() {
     constexpr std::size_t kStackBytes = 256 * 1024;
     char buf[kStackBytes];
     std::memset(buf, 0, sizeof buf);
