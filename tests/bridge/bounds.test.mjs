@@ -19,6 +19,9 @@ const HELD_MS = Number(process.env.CARACARA_KILL_HELD_BY_LISTING_MS);
 const ZERO_MS_MAX = Number(process.env.CARACARA_CLIENT_LOSS_ZERO_MS_MAX);
 const FRAME_MAX = 64 * 1024; // the bridge's largest client message (SessionConfig::max_message_bytes)
 
+// A sanitized build (CARACARA_TEST_SANITIZED): ASan keeps freed memory in its quarantine, so the
+// bridge's RSS growth is the instrumentation's; it is judged on the plain build only.
+const SANITIZED = process.env.CARACARA_TEST_SANITIZED === "1";
 const rssKib = () => Number(/VmRSS:\s+(\d+)/.exec(fs.readFileSync(`/proc/${BRIDGE_PID}/status`, "utf8"))[1]);
 
 test("a Kill published while another client lists a full dive directory reaches the kill output at once", async () => {
@@ -73,7 +76,7 @@ test("a 64 KiB unadvertise of zeros from a client that never reads: closed with 
              "the bridge to log why it closes the client");
   const grown = rssKib() - before;
   console.log(`# the bridge's RSS: ${before} KiB before, +${grown} KiB with the flood`);
-  assert.ok(grown < 32 * 1024, `the bridge grew ${grown} KiB`);
+  if (!SANITIZED) assert.ok(grown < 32 * 1024, `the bridge grew ${grown} KiB`);
   c.ws._socket.resume();
   await poll(() => c.closed, 10000, "the connection to close");
   console.log(`# closed: ${JSON.stringify(c.closed)}`);
@@ -100,7 +103,7 @@ test("a client that sends and does not read is read no further until it reads; n
   console.log(`# paused: ${buffered} bytes not taken by the bridge, its RSS +${grown} KiB`);
   assert.ok(buffered > 0, "the bridge read on while its replies were not read");
   assert.equal(c.closed, null, "closed, though its replies stayed within their bound");
-  assert.ok(grown < 32 * 1024, `the bridge grew ${grown} KiB`);
+  if (!SANITIZED) assert.ok(grown < 32 * 1024, `the bridge grew ${grown} KiB`);
   c.ws._socket.resume();
   await poll(() => c.statuses === frames * 1000, 60000, "every reply");
   assert.equal(c.ws.bufferedAmount, 0);
