@@ -8,25 +8,19 @@ foreach(name properties announcements thrusters bus_recovery budget motion packe
              command_timeout client_loss pilot_lost start_and_sigterm invalid_input teensy
              introspection caracaractl mission faults gpio_lines dive_crash failsafes
              packet_kill fault_reports wheels bus_lost vanished_lines adapter_limits start_killed
-             command_timeout_timer thrust_profiles zero_thrusters_step realtime teensy_silence motor_test
-             direction_detection)
-  add_test(NAME e2e_${name}
-           COMMAND /usr/bin/python3 -m unittest -v test_${name}
-           WORKING_DIRECTORY ${CARACARA_E2E_DIR})
-  set_tests_properties(e2e_${name} PROPERTIES
-                       ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
-                       TIMEOUT 600
-                       LABELS e2e)
+             command_timeout_timer thrust_profiles zero_thrusters_step realtime teensy_silence motor_test)
+  caracara_python_test(e2e_${name} test_${name} ${CARACARA_E2E_DIR})
 endforeach()
-# Seven direction detections of eight pulses each, every pulse after the vehicle settles.
-set_tests_properties(e2e_direction_detection PROPERTIES TIMEOUT 1200)
+# Direction detection, one CTest test per vehicle (test class), so the three rigs run side by
+# side: each detection is eight pulses, every pulse after the vehicle settles (about 30 s).
+foreach(case reversed:ReversedThrustersTest fragment:WrittenFragmentTest disconnected:DisconnectedThrusterTest)
+  string(REPLACE ":" ";" case "${case}")
+  list(GET case 0 short)
+  list(GET case 1 class)
+  caracara_python_test(e2e_direction_detection_${short} test_direction_detection.${class} ${CARACARA_E2E_DIR}
+                       TIMEOUT 900)
+endforeach()
 
 # The dive recorder: a dive listed and plotted, bad dive files refused, and the regression dives
 # of tests/dives replayed against their expected output (tests/dives/test_dives.py).
-add_test(NAME e2e_dives
-         COMMAND /usr/bin/python3 -m unittest -v test_dives
-         WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR}/../dives)
-set_tests_properties(e2e_dives PROPERTIES
-                     ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
-                     TIMEOUT 600
-                     LABELS e2e)
+caracara_python_test(e2e_dives test_dives ${CMAKE_CURRENT_LIST_DIR}/../dives)
