@@ -25,7 +25,9 @@ const SANITIZED = process.env.CARACARA_TEST_SANITIZED === "1";
 const rssKib = () => Number(/VmRSS:\s+(\d+)/.exec(fs.readFileSync(`/proc/${BRIDGE_PID}/status`, "utf8"))[1]);
 
 test("a Kill published while another client lists a full dive directory reaches the kill output at once", async () => {
-  const r = await killsDuringListing(URL, LIST_URL, 200, 50); // p99 of 200: not one outlier's
+  // 60 Kills, each inside a listing: the median and the worst are judged here; the p99 is the
+  // bench's figure (bench/bridge_bench.mjs listing, 200 samples).
+  const r = await killsDuringListing(URL, LIST_URL, 60, 20);
   console.log(`# ${JSON.stringify(r)}`);
   assert.ok(r.dives >= 3000, `the directory lists ${r.dives} dives`);
   // The median, against the same run's without a listing: the machine's load moves both alike
