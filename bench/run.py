@@ -553,13 +553,52 @@ def stress_argv():
     return ["stress-ng", "--cpu", str(n), "--vm", "1", "--vm-bytes", "256M", "--io", "1", "--quiet"]
 
 
+def tick_lateness(times_ns, period_ns):
+    """Each loop tick's lateness, seen on the wire: a tick is a burst of transfers (the next one
+    starts a period later; a gap over half a period separates them), its time the end of its first
+    transfer. The daemon's schedule is a fixed grid (ControlLoop::on_tick: the next tick a period
+    after the last one's due time), so a tick's lateness is its distance behind that grid; the grid's
+    phase is the earliest tick's (lateness 0), the constant handoff and transfer time taken out.
+    A tick missed is a grid slot with no burst in it."""
+    starts, last = [], None
+    for t in sorted(times_ns):
+        if last is None or t - last > period_ns // 2:
+            starts.append(t)
+        last = t
+    if len(starts) < 2:
+        return {"ticks": len(starts), "missed": 0, "lateness_us": pstats([])}
+    t0 = starts[0]
+    slots = [round((t - t0) / period_ns) for t in starts]
+    offsets = [(t - t0) - k * period_ns for t, k in zip(starts, slots)]
+    phase = min(offsets)
+    missed = (slots[-1] - slots[0] + 1) - len(set(slots))
+    return {"ticks": len(starts), "missed": missed, "lateness_us": pstats([(o - phase) / 1000 for o in offsets])}
+
+
+def phase_ticks(b, p, res):
+    """4b. The loop's tick lateness at 50 Hz, judged on the wire (realistic 100 kHz timing, no commands)."""
+    log(f"4b. loop tick lateness at loop_rate_hz=50 for {p['tick_seconds']} s, from the wire log")
+    b.start_sim(realistic=True)
+    b.start_daemon(b.daemon_config(50))
+    time.sleep(1)  # the first ticks after ready are the start's
+    nxt = int(b.sim_call("GetWireLog", "t", 2 ** 63).stdout.split()[1])
+    time.sleep(p["tick_seconds"])
+    r = b.busctl("--json=short", "call", "org.caracara.Simulator1", "/org/caracara/Simulator1",
+                 "org.caracara.Simulator1", "GetWireLog", "t", str(nxt))
+    entries = json.loads(r.stdout)["data"][1]
+    b.stop_daemon()
+    b.stop_sim()
+    res["ticks"] = dict(tick_lateness([int(e[1]) for e in entries if e[3] == "i2c"], 20_000_000),
+                        seconds=p["tick_seconds"])
+
+
 def phase_loaded(b, p, res):
     """The wire and kill phases and the kill floor with every core loaded by stress-ng at the normal
     policy (as vision would load them), beside the same phases without the load, in the same run
     and at the same priorities (LOADED_PRIORITIES): the load is the only difference."""
     if not shutil.which("stress-ng"):
         raise RuntimeError("stress-ng is not installed (scripts/deps.sh)")
-    phases = (phase_wire, phase_faults, phase_kill_floor)
+    phases = (phase_wire, phase_faults, phase_kill_floor, phase_ticks)
     out = {"stress": stress_argv(), "priorities": dict(LOADED_PRIORITIES, **{"dbus-daemon": DBUS_DAEMON_PRIORITY})}
     subprocess.run(["chrt", "-a", "-f", "-p", str(DBUS_DAEMON_PRIORITY), str(b.dbusd.pid)], check=True)
     b.loaded = LOADED_PRIORITIES
@@ -865,6 +904,7 @@ def rows_from(res, p):
             v = sw["kill_output_us"]["p99"]
             row("6. kill switch edge to kill output p99, healthy, vs the floor program", v, kf["p99"], v / kf["p99"],
                 "<= 1.5x floor", v <= 1.5 * kf["p99"], "us")
+    tick_row(res, "4b. ", row)
     loaded_rows(res, row)
     if "loop" in res:
         for key, label in (("realistic", "realistic 100 kHz"), ("immediate", "sim answers at once")):
@@ -953,6 +993,14 @@ def rows_from(res, p):
 STATUS_READ_US = 740
 
 
+def tick_row(h, prefix, row):
+    tk = h.get("ticks")
+    if tk:
+        v = tk["lateness_us"]["p99"]
+        row(f"{prefix}loop tick lateness p99, 50 Hz, on the wire ({tk['ticks']} ticks, {tk['missed']} missed)",
+            v, None, None, "<= 500 us, none missed", v <= 500 and tk["missed"] == 0, "us")
+
+
 def loaded_rows(res, row):
     """Row 9: the loaded phase beside its quiet half (same run, same priorities)."""
     ld = res.get("loaded")
@@ -969,6 +1017,7 @@ def loaded_rows(res, row):
             row(f"9. {name} to kill output p99, {label}: loaded ({lk['missing']} missing) vs quiet", v, q, v / q,
                 "<= 1.5x quiet", v <= 1.5 * q and lk["missing"] == 0, "us")
     for half, h in (("quiet", qt), ("loaded", lo)):
+        tick_row(h, f"9. {half}: ", row)
         fl = (h.get("kill_floor") or {}).get("kill_output_us")
         sw = (((h.get("faults") or {}).get("healthy") or {}).get("switch") or {}).get("kill_output_us")
         if fl and sw:
@@ -1056,11 +1105,11 @@ def main():
     if a.quick:
         p = dict(rtt_calls=2000, rtt_warmup=200, cmd_samples=100, kill_samples=40, burst_samples=40, wire_blocks=2,
                  loop_rounds=2, loop_window=2, cg_floor_cycles=(50, 250), cg_warm=3, cg_window=4, stream_hz=20,
-                 cpu_warm=3, cpu_window=5, rss_seconds=30, bridge_samples=100)
+                 cpu_warm=3, cpu_window=5, rss_seconds=30, bridge_samples=100, tick_seconds=10)
     else:
         p = dict(rtt_calls=10000, rtt_warmup=500, cmd_samples=1000, kill_samples=300, burst_samples=300, wire_blocks=10,
                  loop_rounds=6, loop_window=5, cg_floor_cycles=(200, 1200), cg_warm=5, cg_window=20, stream_hz=20,
-                 cpu_warm=10, cpu_window=30, rss_seconds=600, bridge_samples=1000)
+                 cpu_warm=10, cpu_window=30, rss_seconds=600, bridge_samples=1000, tick_seconds=60)
     if a.rss_seconds is not None:
         p["rss_seconds"] = a.rss_seconds
     p["rss_seconds"] = max(p["rss_seconds"], p["cpu_warm"] + p["cpu_window"] * 4 + 10)
@@ -1077,7 +1126,8 @@ def main():
     res = {"quick": a.quick, "rt": a.rt, "params": p, "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
            "host": {"nproc": os.cpu_count(), "uname": " ".join(os.uname())}}
     phases = {"dbus": phase_dbus, "wire": phase_wire, "faults": phase_faults, "loop": phase_loop, "cost": phase_cost,
-              "ssh": phase_ssh, "bridge": phase_bridge, "kill_floor": phase_kill_floor, "loaded": phase_loaded}
+              "ssh": phase_ssh, "bridge": phase_bridge, "kill_floor": phase_kill_floor, "loaded": phase_loaded,
+              "ticks": phase_ticks}  # ticks alone: the loaded phase runs it in both halves
     try:
         b.start_bus()
         for name in a.only.split(","):
