@@ -1,6 +1,8 @@
 #include "tools/bridge/telemetry.hpp"
 
+#include "core/clock.hpp"
 #include "drivers/protocol/seabotix.hpp"
+#include "tools/bridge/time_left.hpp"
 #include "tools/foxglove/channels.hpp"
 
 #include <boost/asio/post.hpp>
@@ -338,6 +340,7 @@ void Telemetry::build(std::size_t channel, uint64_t now) {
         const Value& leds = get(p, "Leds");
         for (std::size_t i = 0; i < 3 && i < leds.items.size(); ++i)
             s.leds[i] = leds.items[i].integer();
+        add_time_left(p, caracara::monotonic_ns() / 1000, s);
         json = fg::to_json(s);
         break;
     }
