@@ -1,4 +1,6 @@
-#include "tools/bridge/time_left.hpp"
+#include "tools/bridge/failsafe_state.hpp"
+
+#include "core/clock.hpp"
 
 namespace caracara::bridge {
 
@@ -19,7 +21,18 @@ int64_t left_ms(uint64_t until_us, uint64_t now_us) {
 
 } // namespace
 
-void add_time_left(const client::Props& root, uint64_t now_us, foxglove::VehicleState& state) {
+std::vector<foxglove::ActiveFailsafe> failsafes(const client::Props& root) {
+    std::vector<foxglove::ActiveFailsafe> out;
+    const auto it = root.find("Failsafes");
+    if (it != root.end())
+        for (const client::Value& f : it->second.items)
+            if (f.items.size() == 3)
+                out.push_back({f.items[0].s, f.items[1].s, f.items[2].integer()});
+    return out;
+}
+
+void add_time_left(const client::Props& root, foxglove::VehicleState& state) {
+    const uint64_t now_us = monotonic_ns() / 1000;
     // A kill ends both (the daemon clears the ascent's deadline at its next failsafe reading).
     const bool down = state.state == "killed" || state.state == "powered-off";
     state.ascent_left_ms = down ? -1 : left_ms(unsigned_of(root, "SurfacingUntil"), now_us);
