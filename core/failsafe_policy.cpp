@@ -93,6 +93,11 @@ uint64_t FailsafePolicy::next_deadline() const {
     return at;
 }
 
+uint64_t FailsafePolicy::pending_deadline(FailsafeCondition c) const {
+    const Tracked& t = rows_.back()[static_cast<std::size_t>(c)];
+    return t.present && !t.active ? t.since + uint64_t(settings_.rule(c).persistence_ms) * 1'000'000ull : kNoDeadline;
+}
+
 std::optional<FailsafeAction> FailsafePolicy::strongest() const {
     std::optional<FailsafeAction> s;
     for (const ActiveFailsafe& a : active_)

@@ -53,6 +53,9 @@ public:
     // Raises what has held for its persistence time; call at next_deadline().
     FailsafeTransitions tick(uint64_t now);
     uint64_t next_deadline() const;
+    // When a condition of the vehicle's own that holds but is not yet active raises its failsafe
+    // (its start and persistence); kNoDeadline when it does not hold, or already raised.
+    uint64_t pending_deadline(FailsafeCondition c) const;
 
     // The active failsafes, in the order they were raised.
     const std::vector<ActiveFailsafe>& active() const { return active_; }

@@ -175,6 +175,13 @@ constexpr Member kMembers[] = {
     property<[](D d) { return control(d).arming_delay_ms; }>("ArmingDelayMs", kConst),
     property<[](D d) { return double(control(d).loop_rate_hz); }>("LoopRateHz", kConst),
     property<[](D d) { return d.loop.cycles(); }>("Cycles", kChange, kCounterTick), // every cycle: 1 Hz
+    // Deadlines in CLOCK_MONOTONIC microseconds (sd-bus's and sd-event's time base; the same on
+    // every process of the host, so a reader on it turns them into a time left); 0: none.
+    property<[](D d) { return d.failsafes.surfacing_until() / 1000; }>("SurfacingUntil", kChange, kChangeState),
+    property<[](D d) { return d.failsafes.settings().surface.duration_ms; }>("SurfaceDurationMs", kConst),
+    property<[](D d) { return d.failsafes.pilot_lost_kill_at() / 1000; }>("PilotLostKillAt", kChange, kChangeFailsafes),
+    property<[](D d) { return d.failsafes.settings().rule(FailsafeCondition::PilotLost).persistence_ms; }>(
+        "PilotLostPersistenceMs", kConst),
 };
 constexpr auto kVtable = vtable(kMembers);
 

@@ -17,6 +17,8 @@ public:
     FailsafeAscent(const SurfaceSettings& settings, Vehicle& vehicle, VehicleEvents& events)
         : settings_(settings), vehicle_(vehicle), events_(events) {}
     bool active() const { return until_ != 0; }
+    // When the running ascent ends with its kill (CLOCK_MONOTONIC ns); 0 when none runs.
+    uint64_t until() const { return until_; }
     // Starts the ascent, or kills (with `reason`) when the vehicle cannot drive it.
     void begin(std::string reason, uint64_t now);
     // At each reading: the ascent again, its kill once its time is up, or its end by a kill.

@@ -10,7 +10,7 @@ namespace caracara {
 
 FailsafeMonitor::FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters,
                                  Readings readings, Conditions conditions, Vehicle& vehicle, VehicleEvents& events)
-    : event_(event), thrusters_(thrusters), readings_(std::move(readings)),
+    : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)),
       conditions_(std::move(conditions)), vehicle_(vehicle), events_(events), policy_(settings, thrusters),
       report_(settings, events), ascent_(settings.surface, vehicle, events),
       period_us_(std::max<uint64_t>(1000, std::min(kPeriodNs, vehicle.safety().config().command_timeout_ns / 2)) /
@@ -65,6 +65,11 @@ FailsafeTransitions FailsafeMonitor::look_at_conditions(uint64_t now) {
         }
     FailsafeTransitions due = policy_.tick(now);
     ts.insert(ts.end(), due.begin(), due.end());
+    const uint64_t kill_at = policy_.pending_deadline(FailsafeCondition::PilotLost);
+    if (const uint64_t at = kill_at == FailsafePolicy::kNoDeadline ? 0 : kill_at; at != pilot_lost_kill_at_) {
+        pilot_lost_kill_at_ = at; // PilotLostKillAt: on its change only, not at every reading
+        events_.changed(kChangeFailsafes);
+    }
     return ts;
 }
 

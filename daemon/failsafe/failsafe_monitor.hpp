@@ -50,6 +50,12 @@ public:
     Result clear_kill_override(std::string_view condition, std::string_view caller);
 
     const std::vector<ActiveFailsafe>& active() const { return policy_.active(); }
+    const FailsafeSettings& settings() const { return settings_; }
+    // When the running ascent ends with its kill (CLOCK_MONOTONIC ns); 0 when none runs.
+    uint64_t surfacing_until() const { return ascent_.until(); }
+    // When the pilot-lost failsafe kills (CLOCK_MONOTONIC ns) while the last pilot is gone and
+    // its persistence runs; 0 otherwise. A change is announced with the failsafes.
+    uint64_t pilot_lost_kill_at() const { return pilot_lost_kill_at_; }
     // "water-detect surface thruster 3, overtemp exclude thruster 2" ("" when none).
     std::string summary() const;
 
@@ -63,6 +69,7 @@ private:
     void carry_out(const FailsafeTransitions& ts, uint64_t now);
 
     sd_event* event_;
+    const FailsafeSettings& settings_;
     std::size_t thrusters_;
     Readings readings_;
     Conditions conditions_;
@@ -76,6 +83,7 @@ private:
     std::array<bool, kMotorCount> excluded_{};
     std::array<std::optional<FailsafeReading>, kMotorCount> observed_{}; // each thruster's reading last observed
     std::optional<FailsafeCondition> overriding_; // set aside during ClearKillOverride's ClearKill
+    uint64_t pilot_lost_kill_at_ = 0;
 };
 
 } // namespace caracara

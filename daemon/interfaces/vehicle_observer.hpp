@@ -12,14 +12,14 @@ namespace caracara {
 
 // Which vehicle properties changed, for PropertiesChanged.
 enum VehicleChange : uint32_t {
-    kChangeState = 1u << 0,      // State, KillSource
+    kChangeState = 1u << 0,      // State, KillSource, SurfacingUntil
     kChangeMotors = 1u << 1,     // MotorValues, RequestedValues, BudgetLimit, Saturated
     kChangeLeds = 1u << 2,
     kChangeController = 1u << 3, // Controller
     kChangeBus = 1u << 4,        // the Bus object's State and recovery figures
     kChangeProfile = 1u << 5,    // Profile, ProfileFactor
     kChangeFaults = 1u << 6,     // a thruster's fault bits (its Faults property goes with telemetry)
-    kChangeFailsafes = 1u << 7,  // Failsafes (the active ones)
+    kChangeFailsafes = 1u << 7,  // Failsafes (the active ones), PilotLostKillAt
 };
 
 class VehicleObserver {

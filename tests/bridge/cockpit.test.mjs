@@ -9,7 +9,7 @@ import net from "node:net";
 import path from "node:path";
 import { armPad, launch, openCockpit, surge } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
-import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, VEHICLE, X_AXIS, ZERO, busctl, killEdges,
+import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, SURFACE_MS, VEHICLE, X_AXIS, ZERO, busctl, killEdges,
   hold, poll, rearm, simSpeeds, simThruster, sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
 
 const HTTP = process.env.CARACARA_HTTP_URL;
@@ -43,6 +43,30 @@ async function onScreen(page, sel) {
       visible: Boolean(hit && (e.contains(hit) || hit.contains(e))) };
   });
   assert.ok(r.top >= 0 && r.left >= 0 && r.bottom <= r.h && r.right <= r.w && r.visible, `${sel} not on screen: ${JSON.stringify(r)}`);
+}
+// A banner line's countdown ("... in 2.4 s", "2.4 s left") as the page shows it, and when it was read
+// (CLOCK_MONOTONIC ns, as the wire log's times): the kill it counts down to comes then + the
+// countdown, give or take the failsafes' lateness (the page shows the daemon's deadline).
+// The page redraws the banner every 100 ms: what is read may be that old, plus the read's own time
+// (`slackMs`), plus the 0.05 s of its rounding.
+async function countdown(page, sel, pattern) {
+  const read = (s, p) => {
+    const m = new RegExp(p).exec(document.querySelector(s)?.textContent ?? "");
+    return m && Number(m[1]);
+  };
+  await page.waitForFunction(read, { timeout: 5000, polling: "mutation" }, sel, pattern.source);
+  const before = process.hrtime.bigint();
+  const seconds = await page.evaluate(read, sel, pattern.source);
+  const at = process.hrtime.bigint();
+  return { seconds, at, slackMs: Number(at - before) / 1e6 + 100 + 50 };
+}
+function assertKillWhenCounted(edge, shown, what) {
+  const offMs = Number(edge.time_ns - shown.at) / 1e6 - shown.seconds * 1000;
+  console.log(`# ${what}: the kill output ${offMs.toFixed(0)} ms after the end of the page's countdown ` +
+              `(read within ${shown.slackMs.toFixed(0)} ms)`);
+  assert.ok(offMs >= -shown.slackMs, `${what}: killed ${-offMs} ms before the end of the countdown shown`);
+  assert.ok(offMs <= bound("FAILSAFE_LATENESS_MS_MAX") + 50,
+            `${what}: killed ${offMs} ms after the end of the countdown shown (bound FAILSAFE_LATENESS_MS_MAX, tests/bounds.json)`);
 }
 const simFault = (i, name, on) =>
   busctl("call", SIM, `${SIM_ROOT}/thruster/${i}`, "org.caracara.Simulator1.Thruster", "SetFault", "sb", name, on);
@@ -188,8 +212,11 @@ test("the mapping and the gain (selector and d-pad) are editable and kept in the
   await page.close();
 });
 
-test("closing the page while driving zeroes the thrusters within the client-loss bound; the kill follows after pilot-lost's persistence", async () => {
+test("closing the page while driving zeroes the thrusters within the client-loss bound; the kill follows after pilot-lost's persistence, counted down on another page", async () => {
   const page = await drivingPage();
+  // Another page, no pilot: it shows the daemon's pilot-lost countdown once the driving one is gone.
+  const { page: other } = await open();
+  await other.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 10000 });
   const since = wireNext();
   const closedAt = process.hrtime.bigint(); // CLOCK_MONOTONIC, as the wire log's times
   await page.close();
@@ -201,6 +228,7 @@ test("closing the page while driving zeroes the thrusters within the client-loss
         first.set(e.addr, e.time_ns);
     return first.size === driven.size ? [...first.values()] : null;
   }, 5000, "zero orders to the four motors it drove");
+  const shown = await countdown(other, '#banner li[data-kind="pilot-lost"]', /^PILOT LOST: the last pilot left; kill in (\d+\.\d) s/);
   const worstMs = Number(zeroTimes.reduce((a, b) => (a > b ? a : b)) - closedAt) / 1e6;
   console.log(`# page closed to the last zero order: ${worstMs.toFixed(1)} ms`);
   assert.ok(worstMs <= bound("CLIENT_LOSS_ZERO_MS_MAX"),
@@ -211,8 +239,9 @@ test("closing the page while driving zeroes the thrusters within the client-loss
   const killMs = Number(edge.time_ns - closedAt) / 1e6;
   console.log(`# page closed to the kill output: ${killMs.toFixed(0)} ms (pilot-lost persistence ${PILOT_LOST_MS} ms)`);
   assert.ok(killMs >= PILOT_LOST_MS, `killed ${killMs} ms after the close, before the persistence`);
-  // Another page shows why, and its plain clear-kill re-arms (nothing is left to lose).
-  const { page: other } = await open();
+  assert.ok(shown.seconds <= PILOT_LOST_MS / 1000, `a countdown of ${shown.seconds} s, longer than the persistence`);
+  assertKillWhenCounted(edge, shown, "pilot lost");
+  // The other page shows why, and its plain clear-kill re-arms (nothing is left to lose).
   await other.waitForFunction(() => document.getElementById("state").textContent === "killed", { timeout: 10000 });
   assert.equal(await other.$eval("#kill-source", (e) => e.dataset.source), "failsafe");
   assert.equal(await text(other, "#kill-source"), "a failsafe");
@@ -334,6 +363,10 @@ test("after a kill and Clear kill, or a reconnect, with the deadman and the stic
   // The connection drops and comes back within pilot-lost's persistence, deadman and stick held.
   const connects = await page.evaluate(() => window.cockpit.connects);
   await page.evaluate(() => window.cockpit.client.close());
+  // While the link is down the page counts pilot-lost's kill down from the daemon's persistence.
+  const lost = await countdown(page, '#banner li[data-kind="link-lost"]', /pilot-lost kill in (\d+\.\d) s/);
+  assert.ok(lost.seconds <= PILOT_LOST_MS / 1000 && lost.seconds >= PILOT_LOST_MS / 1000 - 0.5,
+            `the link-lost countdown began at ${lost.seconds} s, not the daemon's ${PILOT_LOST_MS} ms`);
   await poll(allZero, 2000, "the daemon zeroes the pilot that left");
   const since2 = wireNext();
   await page.waitForFunction((n) => window.cockpit.connects > n && window.cockpit.state !== null, { timeout: PILOT_LOST_MS },
@@ -371,17 +404,21 @@ test("the gamepad's B kills on its press; Start clears the kill only when held 2
   await page.close();
 });
 
-test("a failsafe shows in the header's banner, on screen when scrolled, and stops the page sending: surfacing with its time, an excluded thruster", async () => {
+test("a failsafe shows in the header's banner, on screen when scrolled, and stops the page sending: surfacing with its time left, an excluded thruster", async () => {
   const page = await drivingPage();
   const surfacing = '#banner li[data-kind="surfacing"]';
+  const since = wireNext();
   simFault(3, "water-detect", true);
   try {
-    await page.waitForSelector(surfacing, { timeout: 5000 });
-    assert.match(await text(page, surfacing), /^SURFACING: water in the thruster \(thruster 3\)\. Ascent running \d+\.\d s/);
+    const shown = await countdown(page, surfacing, /^SURFACING: water in the thruster \(thruster 3\)\. Ascent: (\d+\.\d) s left/);
+    assert.ok(shown.seconds <= SURFACE_MS / 1000 && shown.seconds >= SURFACE_MS / 1000 - 1,
+              `the ascent's countdown began at ${shown.seconds} s, not the configured ${SURFACE_MS} ms`);
     await page.waitForFunction(() => document.getElementById("arm").dataset.arm === "release", { timeout: 2000 });
     const s0 = await sent(page);
     await sleep(1000);
     assert.equal(await sent(page), s0, "motion sent while surfacing");
+    const later = await countdown(page, surfacing, /Ascent: (\d+\.\d) s left/);
+    assert.ok(later.seconds < shown.seconds, `the countdown stood at ${shown.seconds} s, then ${later.seconds} s`);
     const refusals = await page.$$eval("#events li", (l) => l.filter((e) => /refused/.test(e.textContent)).length);
     assert.ok(refusals <= 1, `${refusals} refusal events (one at most)`);
     await page.evaluate(() => window.scrollTo(0, document.documentElement.scrollHeight));
@@ -390,6 +427,7 @@ test("a failsafe shows in the header's banner, on screen when scrolled, and stop
     await shotView(page, "surfacing");
     await page.waitForFunction(() => document.getElementById("state").textContent === "killed", { timeout: 10000 });
     assert.equal(vget("State"), "killed");
+    assertKillWhenCounted(killEdges(since)[0], shown, "surfacing");
   } finally {
     simFault(3, "water-detect", false);
   }

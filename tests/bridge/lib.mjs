@@ -64,6 +64,8 @@ export const killEdges = (since) =>
   wireLog(since).filter((e) => e.bus === "gpio" && e.addr === KILL_OUT && e.data.length === 1 && e.data[0] === 1);
 // [failsafe.pilot-lost] persistence_ms of the rig (test_bridge.py's BridgeRig).
 export const PILOT_LOST_MS = Number(process.env.CARACARA_PILOT_LOST_MS);
+// [failsafe.surface] duration_ms of the rig (test_bridge.py's BridgeRig).
+export const SURFACE_MS = Number(process.env.CARACARA_SURFACE_MS);
 
 // Kill and ClearKill through busctl (no pilot), then ready: a test that drives starts with no
 // pilot-lost pending from an earlier test's pilot that left.

@@ -160,7 +160,8 @@ class BridgeRig:
         r = subprocess.run(["node", "--test", "--test-reporter=spec", script], cwd=HERE, capture_output=True, text=True,
                            timeout=300, env={**os.environ, "CARACARA_BUILD_DIR": BUILD_DIR,
                                              "CARACARA_BUS_ADDRESS": self.rig.address,
-                                             "CARACARA_PILOT_LOST_MS": str(PILOT_LOST_MS), **env})
+                                             "CARACARA_PILOT_LOST_MS": str(PILOT_LOST_MS),
+                                             "CARACARA_SURFACE_MS": str(SURFACE_MS), **env})
         print(r.stdout, r.stderr, sep="\n", file=sys.stderr)
         self.assertEqual(r.returncode, 0, "node --test %s failed" % script)
         return r.stdout

@@ -18,6 +18,7 @@ import dbus
 
 from harness import (DEFAULT_MT, ERR, MOTORS, ROOT, SEED_AXIS_MOTORS, VEHICLE, ZERO, Rig, budget_limit, command,
                      error_name, poll, pump_main_loop, speed_byte)
+from bounds import FAILSAFE_LATENESS_MS_MAX
 from vehicle_checks import KILL_OUT
 
 THRUSTER_CONDITIONS = ["water-detect", "ground-fault", "overtemp", "stall", "hall"]
@@ -79,6 +80,39 @@ class FailsafeSignals:
 
     def close(self):
         self.match.remove()
+
+
+class Announced:
+    """Every value of one of the vehicle's properties announced in PropertiesChanged."""
+
+    def __init__(self, rig, name):
+        self.values = []
+
+        def changed(iface, props, _invalidated):
+            if iface == VEHICLE and name in props:
+                self.values.append(props[name])
+        self.match = rig.conn.add_signal_receiver(changed, signal_name="PropertiesChanged",
+                                                  dbus_interface="org.freedesktop.DBus.Properties", path=ROOT)
+
+    def close(self):
+        self.match.remove()
+
+
+def assert_deadline_kept(case, announced, edge, what):
+    """A deadline property (CLOCK_MONOTONIC µs, 0 none: SurfacingUntil, PilotLostKillAt) announced
+    once when it began and as 0 when it ended, not at every reading, and the kill output's edge
+    `edge` no sooner than it said and within a reading period or so. Returns it in ns."""
+    poll(lambda: announced.values and announced.values[-1] == 0, 5, pump=pump_main_loop,
+         message="%s never announced its end (saw %r)" % (what, announced.values))
+    running = sorted({int(v) for v in announced.values if v})
+    case.assertEqual(len(running), 1, "%s announced %r" % (what, announced.values))
+    case.assertLessEqual(len(announced.values), 6, "%s announced at every reading: %r" % (what, announced.values))
+    at_ns = running[0] * 1000
+    late_ms = (edge.time_ns - at_ns) / 1e6
+    print("\n%s -> kill output edge: %.0f ms" % (what, late_ms))
+    case.assertGreaterEqual(edge.time_ns, at_ns, "killed before %s" % what)
+    case.assertLessEqual(late_ms, FAILSAFE_LATENESS_MS_MAX)
+    return at_ns
 
 
 class FailsafeCase(unittest.TestCase):
@@ -323,13 +357,18 @@ class SurfaceTest(FailsafeCase):
     def test_surface_orders_the_heave_for_its_time_then_kills(self):
         rig = self.rig
         rig.reset()
+        self.assertEqual(int(rig.vget("SurfaceDurationMs")), 1500)
+        self.assertEqual(int(rig.vget("SurfacingUntil")), 0)
         self.drive([0, 0, 3000, 0, 3000, 0, 0, 0])
+        until = Announced(rig, "SurfacingUntil")
+        self.addCleanup(until.close)
         since = rig.wire_next()
         self.fault(3, "water-detect", True)
         try:
             self.signals.wait(("water-detect", "surface", 3))
             ascent = [speed_byte(v) for v in self.ascent()]
             rig.wait_sim_speeds(ascent)
+            self.assertNotEqual(int(rig.vget("SurfacingUntil")), 0)
             self.assertEqual(error_name(rig.thrust, [1000] * MOTORS), ERR + "Surfacing")
             self.assertEqual(error_name(rig.motion, y=0.5), ERR + "Surfacing")
             # Nothing to clear yet: refused, and the failsafe is not overridden by the attempt.
@@ -351,6 +390,10 @@ class SurfaceTest(FailsafeCase):
             self.assertGreaterEqual(took, 1500 - 25)  # from its first order, within a loop period
             self.assertLess(took, 1500 + 500)
             self.assertFalse(nonzero_after_kill(log, edge))
+            # The ascent ran to the end SurfacingUntil said: its kill then, its orders up to it.
+            until_ns = assert_deadline_kept(self, until, edge, "SurfacingUntil")
+            self.assertLessEqual(until_ns - first.time_ns, 1500e6, "SurfacingUntil later than its duration")
+            self.assertEqual(int(rig.vget("SurfacingUntil")), 0)
             self.assertEqual(error_name(rig.vcall, "ClearKill"), ERR + "FailsafeActive")
         finally:
             self.fault(3, "water-detect", False)

@@ -13,7 +13,7 @@ import dbus
 import harness
 from bounds import CLIENT_LOSS_ZERO_MS_MAX, FAILSAFE_LATENESS_MS_MAX
 from harness import MOTORS, ROOT, VEHICLE, ZERO, Rig, poll, pump_main_loop, speed_byte
-from test_failsafes import FailsafeSignals, kill_edges, nonzero_after_kill, orders
+from test_failsafes import Announced, FailsafeSignals, assert_deadline_kept, kill_edges, nonzero_after_kill, orders
 
 PERSISTENCE_MS = 1000
 CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 60000}
@@ -53,6 +53,8 @@ class PilotCase(unittest.TestCase):
         self.addCleanup(self.signals.close)
         self.seen = FailsafesSeen(self.rig)
         self.addCleanup(self.seen.close)
+        self.kill_at = Announced(self.rig, "PilotLostKillAt")
+        self.addCleanup(self.kill_at.close)
         self.clients = []
         self.addCleanup(self.leave_all)
 
@@ -63,7 +65,10 @@ class PilotCase(unittest.TestCase):
         return proc
 
     def leave(self, proc):
-        """The client leaves the bus; the CLOCK_MONOTONIC time just before, in ns."""
+        """The client leaves the bus; the CLOCK_MONOTONIC time just before, in ns. PilotLostKillAt's
+        announcements are looked at from then on."""
+        pump_main_loop()
+        self.kill_at.values = []
         t = time.monotonic_ns()
         proc.stdin.close()
         proc.wait(10)
@@ -104,6 +109,11 @@ class PilotCase(unittest.TestCase):
         poll(lambda: any(PILOT_LOST in v for v in self.seen.values), 5, pump=pump_main_loop,
              message="Failsafes never named pilot-lost (saw %r)" % self.seen.values)
         self.assertIn("FAILSAFE pilot-lost kill: the condition held for %d ms" % PERSISTENCE_MS, rig.log())
+        # The countdown PilotLostKillAt announced: the persistence from the leaving, and kept.
+        at_ns = assert_deadline_kept(self, self.kill_at, edge, "PilotLostKillAt")
+        self.assertGreaterEqual(at_ns - left_at, PERSISTENCE_MS * 1e6)
+        self.assertLessEqual(at_ns - left_at, (PERSISTENCE_MS + FAILSAFE_LATENESS_MS_MAX) * 1e6)
+        self.assertEqual(int(rig.vget("PilotLostKillAt")), 0)
         return edge
 
     def assert_zeroed_at_once(self, since, left_at, thrusters):
@@ -174,6 +184,11 @@ class PilotLostTest(PilotCase):
         time.sleep(PERSISTENCE_MS / 2000)
         back = self.pilot([800] * MOTORS)  # a reloaded page, half way through
         rig.wait_sim_speeds([speed_byte(800)] * MOTORS)
+        # The countdown ran, and the daemon said it ended.
+        poll(lambda: self.kill_at.values and self.kill_at.values[-1] == 0, 5, pump=pump_main_loop,
+             message="PilotLostKillAt's end never announced (saw %r)" % self.kill_at.values)
+        self.assertEqual(len({int(v) for v in self.kill_at.values if v}), 1, self.kill_at.values)
+        self.assertEqual(int(rig.vget("PilotLostKillAt")), 0)
         self.assert_no_kill_for(PERSISTENCE_MS / 1000, since, [speed_byte(800)] * MOTORS)
         # Its own leaving counts from then, not from the first pilot's.
         since = rig.wire_next()
@@ -192,6 +207,8 @@ class PilotLostTest(PilotCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         since = rig.wire_next()
         self.assert_no_kill_for(PERSISTENCE_MS / 1000 + 0.5, since, [ZERO] * MOTORS)
+        self.assertEqual([v for v in self.kill_at.values if v], [], "a pilot-lost countdown with no pilot lost")
+        self.assertEqual(int(rig.vget("PilotLostPersistenceMs")), PERSISTENCE_MS)
         # With a pilot driving, a reader that comes and goes changes nothing either.
         values = [1100] * MOTORS
         proc = self.pilot(values)

@@ -171,6 +171,22 @@ TEST_CASE("failsafe: pilot lost kills after its persistence; a pilot back within
     CHECK(p.blocking().empty());
 }
 
+TEST_CASE("failsafe: the pilot-lost countdown's end while it runs (PilotLostKillAt), none before or after") {
+    FailsafeSettings s;
+    s.rule(FailsafeCondition::PilotLost).persistence_ms = 3000;
+    FailsafePolicy p(s, 8);
+    CHECK(p.pending_deadline(FailsafeCondition::PilotLost) == FailsafePolicy::kNoDeadline);
+    CHECK(p.set_condition(FailsafeCondition::PilotLost, true, ms(100)).empty());
+    CHECK(p.pending_deadline(FailsafeCondition::PilotLost) == ms(3100));
+    CHECK(p.set_condition(FailsafeCondition::PilotLost, true, ms(2000)).empty()); // still the first loss's end
+    CHECK(p.pending_deadline(FailsafeCondition::PilotLost) == ms(3100));
+    CHECK(p.pending_deadline(FailsafeCondition::BusLost) == FailsafePolicy::kNoDeadline);
+    CHECK(p.set_condition(FailsafeCondition::PilotLost, true, ms(3100)).size() == 1); // raised: no countdown
+    CHECK(p.pending_deadline(FailsafeCondition::PilotLost) == FailsafePolicy::kNoDeadline);
+    CHECK(p.set_condition(FailsafeCondition::PilotLost, false, ms(3200)).size() == 1);
+    CHECK(p.pending_deadline(FailsafeCondition::PilotLost) == FailsafePolicy::kNoDeadline);
+}
+
 TEST_CASE("failsafe: names on the wire") {
     for (std::size_t i = 0; i < kFailsafeConditionCount; ++i) {
         const auto c = static_cast<FailsafeCondition>(i);

@@ -203,6 +203,10 @@ TEST_CASE("the state's failsafes as the daemon has them, the excluded thrusters 
     CHECK(none["failsafes"].empty());
     CHECK(none["excluded"].empty());
     CHECK(none["surfacing_ms"] == -1);
+    // The daemon's time left and pilot-lost persistence: none, or not known (a dive records neither).
+    CHECK(none["ascent_left_ms"] == -1);
+    CHECK(none["pilot_lost_left_ms"] == -1);
+    CHECK(none["pilot_lost_ms"] == -1);
 }
 
 TEST_CASE("a dive exported to MCAP: the state's failsafes, excluded thrusters and surfacing follow its events", "[foxglove]") {

@@ -1,6 +1,7 @@
 #include "tools/bridge/telemetry.hpp"
 
 #include "drivers/protocol/seabotix.hpp"
+#include "tools/bridge/failsafe_state.hpp"
 #include "tools/foxglove/channels.hpp"
 
 #include <boost/asio/post.hpp>
@@ -51,15 +52,6 @@ int thruster_of(const std::string& path) {
     if (n.size() != 1 || n[0] < '0' || n[0] >= '0' + static_cast<int>(fg::kThrusters))
         return -1;
     return n[0] - '0';
-}
-
-// The daemon's Failsafes, a(ssi).
-std::vector<fg::ActiveFailsafe> failsafes(const Props& p) {
-    std::vector<fg::ActiveFailsafe> out;
-    for (const Value& f : get(p, "Failsafes").items)
-        if (f.items.size() == 3)
-            out.push_back({f.items[0].s, f.items[1].s, f.items[2].integer()});
-    return out;
 }
 
 // A process's name as the kernel has it (/proc/PID/comm), "" when gone.
@@ -338,6 +330,7 @@ void Telemetry::build(std::size_t channel, uint64_t now) {
         const Value& leds = get(p, "Leds");
         for (std::size_t i = 0; i < 3 && i < leds.items.size(); ++i)
             s.leds[i] = leds.items[i].integer();
+        add_time_left(p, s);
         json = fg::to_json(s);
         break;
     }

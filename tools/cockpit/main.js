@@ -22,7 +22,8 @@ let lostAt = null;         // performance.now() when the link was first seen los
 // released the deadman with the sticks centred ("release") and pressed it again ("press").
 const ARM_RELEASE = "release", ARM_PRESS = "press", ARM_ARMED = "armed";
 const cockpit = { state: null, motors: null, thrusters: [], teensy: null, i2c: null, sent: 0, kills: 0,
-  arm: ARM_RELEASE, killNotSentAt: null, refusal: null, clearHeldSince: null, connects: 0 };
+  arm: ARM_RELEASE, killNotSentAt: null, refusal: null, clearHeldSince: null, connects: 0,
+  stateAt: 0, pilotLostMs: null };
 window.cockpit = cockpit;  // for the tests and the curious
 const dives = new DiveList($("dives"), $("dive-plot"), token);
 
@@ -99,7 +100,7 @@ function showBanner(up) {
   const items = banner({
     state: cockpit.state, up, lostMs: lostAt === null ? 0 : performance.now() - lostAt,
     killNotSentMs: cockpit.killNotSentAt === null ? null : performance.now() - cockpit.killNotSentAt,
-    refusal: cockpit.refusal,
+    refusal: cockpit.refusal, sinceStateMs: performance.now() - cockpit.stateAt, pilotLostMs: cockpit.pilotLostMs,
   });
   const list = $("banner");
   const html = items.map((i) => `<li class="${i.level}" data-kind="${i.kind}">${i.text}</li>`).join("");
@@ -141,6 +142,9 @@ function show(topic, m) {
 function showState(m) {
   const before = cockpit.state;
   cockpit.state = m;
+  cockpit.stateAt = performance.now(); // the banner counts the daemon's time left down from here
+  // Configuration, not state: kept through a lost link, whose countdown it is.
+  if (m.pilot_lost_ms >= 0) cockpit.pilotLostMs = m.pilot_lost_ms;
   // Not ready, or surfacing: what was armed is no more; the same once it changed under us.
   if (m.state !== "ready" || m.surfacing_ms >= 0 || (before && before.state !== "ready")) disarm();
   if (m.state === "killed") cockpit.killNotSentAt = null; // killed after all (another pilot, the vehicle)

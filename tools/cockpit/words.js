@@ -22,9 +22,6 @@ const CONDITIONS = {
   "teensy-link-lost": "Teensy link lost",
   "kill-switch-unreadable": "kill switch unreadable",
 };
-// The daemon's pilot-lost persistence when not configured otherwise (daemon/caracarad.toml.example);
-// the daemon does not publish the configured one.
-export const PILOT_LOST_DEFAULT_MS = 5000;
 
 const escape = (t) => String(t).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" })[c]);
 
@@ -43,8 +40,13 @@ export function controllerWords(state, driving) {
   return state.controller_name || `client ${state.controller}`;
 }
 
+// A countdown the daemon gave as `leftMs` when the state came, `sinceMs` ago: seconds left, never below 0.
+const secondsLeft = (leftMs, sinceMs) => (Math.max(0, leftMs - sinceMs) / 1000).toFixed(1);
+
 // [{kind, level, text}]: what keeps the vehicle from doing what the pilot asks, most urgent first.
-export function banner({ state, up, lostMs, killNotSentMs, refusal }) {
+// `sinceStateMs`: how long ago the state came (its countdowns run on); `pilotLostMs`: the
+// daemon's pilot-lost persistence as last heard (null before the first state).
+export function banner({ state, up, lostMs, killNotSentMs, refusal, sinceStateMs = 0, pilotLostMs = null }) {
   const out = [];
   const add = (kind, level, text) => out.push({ kind, level, text: escape(text) });
   if (killNotSentMs !== null)
@@ -52,17 +54,23 @@ export function banner({ state, up, lostMs, killNotSentMs, refusal }) {
       "Press KILL again once connected, or use the kill switch");
   if (!up) {
     const s = lostMs / 1000;
-    const left = Math.max(0, (PILOT_LOST_DEFAULT_MS - lostMs) / 1000);
+    const left = pilotLostMs === null ? null : secondsLeft(pilotLostMs, lostMs);
     add("link-lost", "alarm", `LINK LOST ${s.toFixed(1)} s: this page cannot kill. The vehicle zeroed this page's thrust; ` +
-      (left > 0 ? `pilot-lost kill in ${left.toFixed(1)} s (default time) unless another pilot drives`
-        : "pilot-lost kill due (default time) unless another pilot drives"));
+      (left === null ? "pilot-lost kill after the vehicle's persistence unless another pilot drives"
+        : Number(left) > 0 ? `pilot-lost kill in ${left} s unless another pilot drives`
+          : "pilot-lost kill due unless another pilot drives"));
   }
   if (!state || !up) return out;
+  if (state.pilot_lost_left_ms >= 0)
+    add("pilot-lost", "alarm", `PILOT LOST: the last pilot left; kill in ${secondsLeft(state.pilot_lost_left_ms, sinceStateMs)} s ` +
+      "unless a pilot drives");
   for (const f of state.failsafes ?? []) {
     if (f.action === "surface")
-      add("surfacing", "alarm", `SURFACING: ${conditionWords(f)}. ` + (state.surfacing_ms >= 0
-        ? `Ascent running ${(state.surfacing_ms / 1000).toFixed(1)} s, then the vehicle kills itself; motion is refused`
-        : "Ascent over or ended by a kill; Clear kill is refused while it holds"));
+      add("surfacing", "alarm", `SURFACING: ${conditionWords(f)}. ` + (state.ascent_left_ms >= 0
+        ? `Ascent: ${secondsLeft(state.ascent_left_ms, sinceStateMs)} s left, then the vehicle kills itself; motion is refused`
+        : state.state === "killed" || state.state === "powered-off"
+          ? "Ascent over or ended by a kill; Clear kill is refused while it holds"
+          : "Ascent starting (its time to come with the next state), then the vehicle kills itself; motion is refused"));
     else if (f.action === "exclude")
       add("excluded", "alarm", `THRUSTER ${f.thruster} EXCLUDED: ${CONDITIONS[f.condition] ?? f.condition}; held at zero, the others drive`);
     else if (f.action === "kill")

@@ -63,7 +63,10 @@ std::vector<ChannelInfo> make_channels() {
                                                    {"required", {"condition", "action", "thruster"}},
                                                    {"additionalProperties", false}})},
                            {"excluded", array_of(integer())},
-                           {"surfacing_ms", integer()}})
+                           {"surfacing_ms", integer()},
+                           {"ascent_left_ms", integer()},
+                           {"pilot_lost_left_ms", integer()},
+                           {"pilot_lost_ms", integer()}})
                        .dump()});
     out.push_back({ChannelKind::Motors, 0, "/vehicle/motors", "caracara.Motors",
                    object("caracara.Motors", {{"applied", fixed_array(integer(), kThrusters)},
@@ -166,7 +169,10 @@ std::string to_json(const VehicleState& m) {
                 {"leds", m.leds},
                 {"failsafes", failsafes},
                 {"excluded", excluded},
-                {"surfacing_ms", m.surfacing_ms}}
+                {"surfacing_ms", m.surfacing_ms},
+                {"ascent_left_ms", m.ascent_left_ms},
+                {"pilot_lost_left_ms", m.pilot_lost_left_ms},
+                {"pilot_lost_ms", m.pilot_lost_ms}}
         .dump();
 }
 

@@ -54,6 +54,9 @@ struct VehicleState {
     std::array<int64_t, 3> leds{}; // red, green, blue (not recorded in a dive: 0)
     std::vector<ActiveFailsafe> failsafes;
     int64_t surfacing_ms = -1;   // how long a surface failsafe's ascent has run; -1 none
+    int64_t ascent_left_ms = -1; // the time left of that ascent, as the daemon has it; -1 none (or not recorded)
+    int64_t pilot_lost_left_ms = -1; // the time left of the pilot-lost failsafe's countdown; -1 none
+    int64_t pilot_lost_ms = -1;  // the configured pilot-lost persistence; -1 not known (not recorded)
     // In the JSON also "excluded": the thrusters an exclude failsafe holds at zero (from failsafes).
 };
 
