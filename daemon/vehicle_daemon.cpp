@@ -22,7 +22,7 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
                  [this] { return vehicle_conditions(); }, vehicle_, events_),
       motor_test_(config_, vehicle_),
       directions_(config_, vehicle_, teensy_, failsafes_),
-      preflight_(config_, bus_, teensy_, lines_, failsafes_) {
+      preflight_(config_, bus_, teensy_, lines_) {
     vehicle_.set_demand_listener(&loop_);
     bus_.monitor().set_listener(&recovery_);
     events_.attach_status(&status_);

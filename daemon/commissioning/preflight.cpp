@@ -9,8 +9,8 @@
 namespace caracara {
 
 Preflight::Preflight(const DaemonConfig& config, const ThrusterBus& bus, const TeensyPort& teensy,
-                     const SafetyLines& lines, const FailsafeMonitor& failsafes)
-    : config_(config), bus_(bus), teensy_(teensy), checks_(config, bus, lines, failsafes), timer_([this] { finish(); }) {}
+                     const SafetyLines& lines)
+    : config_(config), bus_(bus), teensy_(teensy), checks_(config, bus, lines), timer_([this] { finish(); }) {}
 
 std::string Preflight::start(sd_event* event) { return timer_.start(event); }
 

@@ -24,8 +24,7 @@ public:
     // The window: about 50 status reads at 50 Hz, six per thruster, and 50 orientation answers.
     static constexpr uint64_t kWindowNs = 1'000'000'000;
 
-    Preflight(const DaemonConfig& config, const ThrusterBus& bus, const TeensyPort& teensy, const SafetyLines& lines,
-              const FailsafeMonitor& failsafes);
+    Preflight(const DaemonConfig& config, const ThrusterBus& bus, const TeensyPort& teensy, const SafetyLines& lines);
     std::string start(sd_event* event); // the window's timer; "" or why it could not be made
     void stop();
     void set_config_file(std::string path) { checks_.set_config_file(std::move(path)); }

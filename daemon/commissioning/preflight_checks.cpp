@@ -163,21 +163,19 @@ PreflightRow PreflightChecks::recorder() const {
                "free space on that filesystem or lower recorder.max_total_mb");
 }
 
+// Configured, not active: an active failsafe's cause (a fault bit, an unreachable thruster, the
+// Teensy, the switch) is no-go in its own row.
 PreflightRow PreflightChecks::failsafes() const {
-    std::string warn_only, active;
-    for (FailsafeCondition c : kThrusterConditions)
-        if (config_.failsafe.rule(c).action == FailsafeAction::Warn)
+    std::string warn_only, actions;
+    for (FailsafeCondition c : kThrusterConditions) {
+        const FailsafeAction a = config_.failsafe.rule(c).action;
+        if (a == FailsafeAction::Warn)
             warn_only += (warn_only.empty() ? "" : ", ") + std::string(condition_name(c));
-    for (const ActiveFailsafe& f : failsafes_.active())
-        active += (active.empty() ? "" : ", ") + std::string(condition_name(f.condition)) +
-                  (f.thruster >= 0 ? " (thruster " + std::to_string(f.thruster) + ")" : "");
-    if (!active.empty())
-        return row(PreflightItem::Failsafes, false, "active: " + active,
-                   "clear the condition first (caracaractl status names it)");
-    if (!warn_only.empty())
-        return row(PreflightItem::Failsafes, false, "only warn on " + warn_only,
-                   "give each an action (exclude, surface or kill) in its [failsafe.<condition>] table");
-    return row(PreflightItem::Failsafes, true, "every thruster fault acts; none active", {});
+        actions += (actions.empty() ? "" : ", ") + std::string(condition_name(c)) + " " + std::string(action_name(a));
+    }
+    return row(PreflightItem::Failsafes, warn_only.empty(), actions,
+               "only warn on " + warn_only + ": give each an action (exclude, surface or kill) in its "
+               "[failsafe.<condition>] table");
 }
 
 PreflightRow PreflightChecks::clock() const {

@@ -6,7 +6,6 @@
 #include "core/config.hpp"
 #include "core/preflight_row.hpp"
 #include "daemon/bus/thruster_bus.hpp"
-#include "daemon/failsafe/failsafe_monitor.hpp"
 #include "daemon/safety/safety_lines.hpp"
 
 #include <cstddef>
@@ -16,9 +15,8 @@ namespace caracara {
 
 class PreflightChecks final {
 public:
-    PreflightChecks(const DaemonConfig& config, const ThrusterBus& bus, const SafetyLines& lines,
-                    const FailsafeMonitor& failsafes)
-        : config_(config), bus_(bus), lines_(lines), failsafes_(failsafes) {}
+    PreflightChecks(const DaemonConfig& config, const ThrusterBus& bus, const SafetyLines& lines)
+        : config_(config), bus_(bus), lines_(lines) {}
     // The file caracarad was started from ("" for the built-in defaults): the checker runs on it.
     void set_config_file(std::string path) { config_file_ = std::move(path); }
 
@@ -37,7 +35,6 @@ private:
     const DaemonConfig& config_;
     const ThrusterBus& bus_;
     const SafetyLines& lines_;
-    const FailsafeMonitor& failsafes_;
     std::string config_file_;
 };
 

@@ -30,10 +30,10 @@ int run_check(Client& client) {
         }
     }
     if (no_go == 0) {
-        std::cout << "all go\n";
+        std::cout << "preflight: all go\n";
         return kExitOk;
     }
-    std::cout << strf("%zu no-go: not ready to dive\n", no_go);
+    std::cout << strf("preflight: %zu no-go, not ready to dive\n", no_go);
     return kExitRefused;
 }
 
