@@ -1,7 +1,6 @@
 #include "dbus/preflight_reply.hpp"
 
 #include "dbus/error_reply.hpp"
-#include "drivers/sdbus/sdbus.hpp"
 
 #include <memory>
 
@@ -11,20 +10,15 @@ namespace {
 
 int reply_rows(sd_bus_message* call, const Preflight& p) {
     MessagePtr out;
-    sd_bus_message* m = nullptr;
-    int r = sd_bus_message_new_method_return(call, &m);
-    if (r < 0)
-        return r;
-    out.reset(m);
-    if ((r = sd_bus_message_open_container(m, 'a', "(sbss)")) < 0)
-        return r;
-    for (const PreflightRow& row : p.rows())
-        if ((r = sd_bus_message_append(m, "(sbss)", row.name().c_str(), int(row.go), row.observed.c_str(),
-                                       row.advice.c_str())) < 0)
-            return r;
-    if ((r = sd_bus_message_close_container(m)) < 0)
-        return r;
-    return sd_bus_send(nullptr, m, nullptr);
+    int r = new_method_return(call, out);
+    if (r >= 0)
+        r = sd_bus_message_open_container(out.get(), 'a', "(sbss)");
+    for (auto row = p.rows().begin(); r >= 0 && row != p.rows().end(); ++row)
+        r = sd_bus_message_append(out.get(), "(sbss)", row->name().c_str(), int(row->go), row->observed.c_str(),
+                                  row->advice.c_str());
+    if (r >= 0)
+        r = sd_bus_message_close_container(out.get());
+    return r < 0 ? r : sd_bus_send(nullptr, out.get(), nullptr);
 }
 
 } // namespace

@@ -109,11 +109,10 @@ int m_motor_test(sd_bus_message* m, void* userdata, sd_bus_error*) {
 // along its row, margin) and the fragment, or the error that ended it.
 int reply_directions(sd_bus_message* call, const DirectionDetection& d) {
     MessagePtr out;
-    sd_bus_message* m = nullptr;
-    int r = sd_bus_message_new_method_return(call, &m);
+    int r = new_method_return(call, out);
     if (r < 0)
         return r;
-    out.reset(m);
+    sd_bus_message* m = out.get();
     if ((r = sd_bus_message_open_container(m, 'a', "(sddddd)")) < 0)
         return r;
     for (const DirectionFinding& f : d.findings()) {

@@ -29,6 +29,13 @@ PreflightRow row(PreflightItem item, bool go, std::string observed, std::string 
     return {item, -1, go, std::move(observed), go ? std::string() : std::move(advice)};
 }
 
+// A safety line's no-go when it is not configured or cannot be read (its [gpio.*] `table`).
+PreflightRow unusable_line(PreflightItem item, bool configured, const std::string& table) {
+    if (!configured)
+        return row(item, false, "not configured", "configure [" + table + "]");
+    return row(item, false, "cannot be read", "check its wiring and the chip and line of [" + table + "]");
+}
+
 // "2026-11-27 09:30 UTC"
 std::string utc(time_t t) {
     std::tm tm{};
@@ -49,6 +56,9 @@ uint64_t recorded_bytes(const std::string& dir) {
 }
 
 } // namespace
+
+PreflightChecks::PreflightChecks(const DaemonConfig& config, const ThrusterBus& bus, const SafetyLines& lines)
+    : config_(config), bus_(bus), lines_(lines) {}
 
 std::string PreflightChecks::where(std::size_t i) const {
     const ThrusterConfig& c = config_.thrusters[i];
@@ -111,23 +121,17 @@ PreflightRow PreflightChecks::bus() const {
 }
 
 PreflightRow PreflightChecks::kill_switch() const {
-    if (!lines_.kill_switch_configured())
-        return row(PreflightItem::KillSwitch, false, "not configured", "configure [gpio.kill_switch]");
     const std::optional<bool> set = lines_.kill_switch_level();
     if (!set)
-        return row(PreflightItem::KillSwitch, false, "cannot be read",
-                   "check the switch's wiring and the chip and line of [gpio.kill_switch]");
+        return unusable_line(PreflightItem::KillSwitch, lines_.kill_switch_configured(), "gpio.kill_switch");
     return row(PreflightItem::KillSwitch, !*set, *set ? "readable, pressed (kill)" : "readable, released",
                "release the kill switch");
 }
 
 PreflightRow PreflightChecks::kill_output() const {
-    if (!lines_.kill_output_configured())
-        return row(PreflightItem::KillOutput, false, "not configured", "configure [gpio.kill_output]");
     const std::optional<bool> back = lines_.kill_output_readback();
     if (!back)
-        return row(PreflightItem::KillOutput, false, "cannot be read back",
-                   "check the chip and line of [gpio.kill_output]");
+        return unusable_line(PreflightItem::KillOutput, lines_.kill_output_configured(), "gpio.kill_output");
     const bool want = lines_.kill_output_intended();
     auto level = [](bool asserted) { return asserted ? "asserted (thrusters de-energized)" : "released (run enabled)"; };
     return row(PreflightItem::KillOutput, *back == want,

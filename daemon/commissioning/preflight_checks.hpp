@@ -15,11 +15,7 @@ namespace caracara {
 
 class PreflightChecks final {
 public:
-    PreflightChecks(const DaemonConfig& config, const ThrusterBus& bus, const SafetyLines& lines)
-        : config_(config), bus_(bus), lines_(lines) {}
-    // The file caracarad was started from ("" for the built-in defaults): the checker runs on it.
-    void set_config_file(std::string path) { config_file_ = std::move(path); }
-
+    PreflightChecks(const DaemonConfig& config, const ThrusterBus& bus, const SafetyLines& lines);
     PreflightRow thruster(std::size_t i, const ThrusterCounters& before) const;
     PreflightRow bus() const;
     PreflightRow kill_switch() const;
@@ -28,6 +24,8 @@ public:
     PreflightRow recorder() const;
     PreflightRow failsafes() const;
     PreflightRow clock() const;
+    // The file caracarad was started from ("" for the built-in defaults): the checker runs on it.
+    void set_config_file(std::string path) { config_file_ = std::move(path); }
 
 private:
     std::string where(std::size_t i) const; // "MT 0x52 on the main bus", "MT 0x52 behind mux 0x70 channel 1"

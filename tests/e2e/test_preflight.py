@@ -108,96 +108,80 @@ class HealthyVehicleTest(PreflightCase):
         self.assertEqual(errors, [])
         self.assertEqual([[str(r[0]) for r in rows] for rows in replies], [ITEMS, ITEMS])
 
-    def test_a_thruster_that_does_not_answer(self):
-        rig = self.rig
-        rig.sim_thruster_call(3, "SetNack", True, signature="b")
+    def no_go_while(self, make, undo, item, observed, advice, then=None):
+        """`make` the fault (then wait for `then`, the daemon having seen it), assert the no-go,
+        `undo` it and wait for all go again."""
+        make()
         try:
-            self.assert_no_go("thruster-3", "does not answer (nack)", "MT 0x5A")
+            if then:
+                poll(then, 10, message="the daemon did not see the fault")
+            self.assert_no_go(item, observed, advice)
         finally:
-            rig.sim_thruster_call(3, "SetNack", False, signature="b")
+            undo()
         self.wait_all_go()
 
+    def thruster_call(self, i, method, *args, signature):
+        return lambda: self.rig.sim_thruster_call(i, method, *args, signature=signature)
+
+    def sim_call(self, method, *args, signature=None, teensy=False):
+        call = self.rig.sim_teensy_call if teensy else self.rig.sim_call
+        return lambda: call(method, *args, signature=signature)
+
+    def killed(self):
+        return self.rig.state() == "killed"
+
+    def test_a_thruster_that_does_not_answer(self):
+        self.no_go_while(self.thruster_call(3, "SetNack", True, signature="b"),
+                         self.thruster_call(3, "SetNack", False, signature="b"),
+                         "thruster-3", "does not answer (nack)", "MT 0x5A")
+
     def test_a_fault_bit(self):
-        rig = self.rig
-        rig.sim_thruster_call(2, "SetFault", "stall", True, signature="sb")
-        try:
-            self.assert_no_go("thruster-2", "fault bits set: stall", "inspect thruster 2")
-        finally:
-            rig.sim_thruster_call(2, "SetFault", "stall", False, signature="sb")
-        self.wait_all_go()
+        self.no_go_while(self.thruster_call(2, "SetFault", "stall", True, signature="sb"),
+                         self.thruster_call(2, "SetFault", "stall", False, signature="sb"),
+                         "thruster-2", "fault bits set: stall", "inspect thruster 2")
 
     def test_a_hot_thruster(self):
         # 105 C: past the overtemp failsafe's clearing point (100 C), short of the bit (110 C).
-        rig = self.rig
-        rig.sim_thruster_call(5, "SetTemperature", 105.0, 105.0, signature="dd")
-        try:
-            self.assert_no_go("thruster-5", "105 C", "let it cool below 100 C")
-        finally:
-            rig.sim_thruster_call(5, "SetTemperature", 15.0, 15.0, signature="dd")
-        self.wait_all_go()
+        self.no_go_while(self.thruster_call(5, "SetTemperature", 105.0, 105.0, signature="dd"),
+                         self.thruster_call(5, "SetTemperature", 15.0, 15.0, signature="dd"),
+                         "thruster-5", "105 C", "let it cool below 100 C")
 
     def test_a_silent_teensy(self):
-        rig = self.rig
-        rig.sim_teensy_call("InjectFault", "no-answer", dbus.UInt32(1000000), signature="su")
-        try:
-            poll(lambda: rig.vget("LinkLoss", path=TEENSY_PATH, iface=TEENSY_IFACE) != "none", 10)
-            self.assert_no_go("teensy", "offline (silent)", "check the Teensy's power")
-        finally:
-            rig.sim_teensy_call("ClearFaults")
-        self.wait_all_go()
+        self.no_go_while(self.sim_call("InjectFault", "no-answer", dbus.UInt32(1000000), signature="su", teensy=True),
+                         self.sim_call("ClearFaults", teensy=True),
+                         "teensy", "offline (silent)", "check the Teensy's power",
+                         then=lambda: self.rig.vget("LinkLoss", path=TEENSY_PATH, iface=TEENSY_IFACE) != "none")
 
     def test_an_unreadable_kill_switch(self):
-        rig = self.rig
-        rig.sim_call("SetLinePresent", "KILL_SWITCH", False, signature="sb")
-        try:
-            poll(lambda: rig.state() == "killed", 10)
-            self.assert_no_go("kill-switch", "cannot be read", "[gpio.kill_switch]")
-        finally:
-            rig.sim_call("SetLinePresent", "KILL_SWITCH", True, signature="sb")
-        self.wait_all_go()
+        self.no_go_while(self.sim_call("SetLinePresent", "KILL_SWITCH", False, signature="sb"),
+                         self.sim_call("SetLinePresent", "KILL_SWITCH", True, signature="sb"),
+                         "kill-switch", "cannot be read", "[gpio.kill_switch]", then=self.killed)
 
     def test_a_pressed_kill_switch(self):
-        rig = self.rig
-        rig.sim_call("SetKillSwitch", True, signature="b")
-        try:
-            poll(lambda: rig.state() == "killed", 10)
-            self.assert_no_go("kill-switch", "pressed", "release the kill switch")
-        finally:
-            rig.sim_call("SetKillSwitch", False, signature="b")
-        self.wait_all_go()
+        self.no_go_while(self.sim_call("SetKillSwitch", True, signature="b"),
+                         self.sim_call("SetKillSwitch", False, signature="b"),
+                         "kill-switch", "pressed", "release the kill switch", then=self.killed)
 
     def test_a_kill_output_that_went_away(self):
-        rig = self.rig
-        rig.sim_call("SetLinePresent", "KILL_OUT", False, signature="sb")
-        try:
-            poll(lambda: rig.state() == "killed", 10)
-            self.assert_no_go("kill-output", "cannot be read back", "[gpio.kill_output]")
-        finally:
-            rig.sim_call("SetLinePresent", "KILL_OUT", True, signature="sb")
-        self.wait_all_go()
+        self.no_go_while(self.sim_call("SetLinePresent", "KILL_OUT", False, signature="sb"),
+                         self.sim_call("SetLinePresent", "KILL_OUT", True, signature="sb"),
+                         "kill-output", "cannot be read", "[gpio.kill_output]", then=self.killed)
 
     def test_a_config_file_the_checker_refuses(self):
         path = self.rig.config_path
         with open(path) as f:
             good = f.read()
-        try:
-            with open(path, "w") as f:
-                f.write(good + "\n[control]\nloop_rate_hz = 50\n")  # a second [control] table
-            self.assert_no_go("config", path, "caracarad --check-config " + path)
-        finally:
-            with open(path, "w") as f:
-                f.write(good)
-        self.wait_all_go()
+
+        def write(text):
+            return lambda: open(path, "w").write(text)
+        # A second [control] table: the checker refuses the file (caracarad would not start).
+        self.no_go_while(write(good + "\n[control]\nloop_rate_hz = 50\n"), write(good),
+                         "config", path, "caracarad --check-config " + path)
 
     def test_a_missing_recorder_directory(self):
         dives = os.path.join(self.rig.dir, "dives")
-        moved = dives + ".away"
-        os.rename(dives, moved)
-        try:
-            self.assert_no_go("recorder", "missing or not writable", "create " + dives)
-        finally:
-            os.rename(moved, dives)
-        self.wait_all_go()
+        self.no_go_while(lambda: os.rename(dives, dives + ".away"), lambda: os.rename(dives + ".away", dives),
+                         "recorder", "missing or not writable", "create " + dives)
 
 
 class FrozenOrientationTest(PreflightCase):
