@@ -29,7 +29,15 @@ void Preflight::run(Completion done) {
     for (std::size_t i = 0; i < bus_.size(); ++i)
         before_.push_back(bus_.thruster(i).counters());
     orientation_before_ = teensy_.telemetry().orientation;
-    timer_.arm(monotonic_ns() + kWindowNs);
+    timer_.arm(monotonic_ns() + window_ns());
+}
+
+uint64_t Preflight::window_ns() const {
+    const ControlSettings& c = config_.control;
+    if (c.loop_rate_hz == 0) // as fast as the bus allows
+        return kMinWindowNs;
+    const uint64_t ticks_per_round = (bus_.size() + c.status_reads_per_tick - 1) / c.status_reads_per_tick;
+    return std::max(kMinWindowNs, kStatusRounds * ticks_per_round * 1'000'000'000 / c.loop_rate_hz);
 }
 
 bool Preflight::all_go() const {

@@ -21,8 +21,10 @@ namespace caracara {
 
 class Preflight final {
 public:
-    // The window: about 50 status reads at 50 Hz, six per thruster, and 50 orientation answers.
-    static constexpr uint64_t kWindowNs = 1'000'000'000;
+    // The window: at least a second (50 orientation answers and six status reads per thruster at
+    // 50 Hz), and at least three rounds of status reads at a slower loop (window_ns()).
+    static constexpr uint64_t kMinWindowNs = 1'000'000'000;
+    static constexpr uint64_t kStatusRounds = 3;
 
     Preflight(const DaemonConfig& config, const ThrusterBus& bus, const TeensyPort& teensy, const SafetyLines& lines);
     std::string start(sd_event* event); // the window's timer; "" or why it could not be made
@@ -36,6 +38,7 @@ public:
     bool all_go() const;
 
 private:
+    uint64_t window_ns() const;
     void finish();
     PreflightRow teensy_row() const;
 

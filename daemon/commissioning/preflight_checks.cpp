@@ -145,7 +145,7 @@ PreflightRow PreflightChecks::config() const {
     const ConfigResult cr = parse_config_file(config_file_);
     if (cr.ok())
         return row(PreflightItem::Config, true, config_file_ + " passes the checker", {});
-    return row(PreflightItem::Config, false, config_file_ + ": " + cr.errors.front(),
+    return row(PreflightItem::Config, false, cr.errors.front(), // "<file>: <key>: <problem>"
                "fix the file (caracarad --check-config " + config_file_ + "): caracarad will not start from it");
 }
 

@@ -90,6 +90,9 @@ class HealthyVehicleTest(PreflightCase):
         self.assertIn("orientation changing", rows["teensy"][1])
         self.assertIn("released", rows["kill-switch"][1])
 
+    def test_listed_in_help(self):
+        self.assertRegex(self.rig.ctl("--help").stdout, r"(?m)^\s+check\s+Preflight")
+
     def test_dbus_rows(self):
         rows = self.rig.vcall("Preflight", timeout=30)
         self.assertEqual([str(r[0]) for r in rows], ITEMS)
@@ -182,6 +185,17 @@ class HealthyVehicleTest(PreflightCase):
         dives = os.path.join(self.rig.dir, "dives")
         self.no_go_while(lambda: os.rename(dives, dives + ".away"), lambda: os.rename(dives + ".away", dives),
                          "recorder", "missing or not writable", "create " + dives)
+
+
+class SlowLoopTest(PreflightCase):
+    """At 5 Hz one status read per tick reaches each thruster every 1.6 s: the window grows to
+    three rounds (4.8 s), so no thruster that answers is taken for one that does not."""
+    CONTROL = dict(PreflightCase.CONTROL, loop_rate_hz=5)
+
+    def test_all_go_at_a_slow_loop(self):
+        for _ in range(2):
+            code, rows, out = self.check()
+            self.assertEqual(code, 0, out)
 
 
 class FrozenOrientationTest(PreflightCase):
