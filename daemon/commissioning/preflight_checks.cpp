@@ -2,6 +2,7 @@
 
 #include "drivers/protocol/seabotix.hpp"
 
+#include <cstdarg>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -18,10 +19,12 @@ namespace {
 // been set since boot reads an earlier time.
 constexpr int64_t kBuildEpoch = CARACARA_BUILD_EPOCH;
 
-template <typename... A>
-std::string fmt(const char* f, A... a) {
+__attribute__((format(printf, 1, 2))) std::string fmt(const char* f, ...) {
     char buf[256];
-    std::snprintf(buf, sizeof buf, f, a...);
+    va_list ap;
+    va_start(ap, f);
+    std::vsnprintf(buf, sizeof buf, f, ap);
+    va_end(ap);
     return buf;
 }
 
