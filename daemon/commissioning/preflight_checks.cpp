@@ -83,7 +83,9 @@ PreflightRow PreflightChecks::thruster(std::size_t i, const ThrusterCounters& be
         return r;
     }
     if (failed > 0 || now.status_reads == before.status_reads || !t.online() || !t.last_status()) {
-        r.observed = "does not answer (" + std::string(io_error_name(t.last_error())) + ")";
+        r.observed = fmt("does not answer (%s): %llu of %llu status reads failed",
+                         std::string(io_error_name(t.last_error())).c_str(), (unsigned long long)failed,
+                         (unsigned long long)(failed + now.status_reads - before.status_reads));
         r.advice = "check its power, cable and address: configured as " + where(i);
         return r;
     }
