@@ -101,7 +101,7 @@ class HealthyVehicleTest(PreflightCase):
             self.assertTrue(go, "%s: %s" % (name, observed))
             self.assertEqual(str(advice), "")
 
-    def test_two_callers_share_one_window(self):
+    def test_two_callers_at_once_both_get_the_table(self):
         replies, errors = [], []
         obj = self.rig.obj(VEHICLE, "/org/caracara/Vehicle1")
         for _ in range(2):

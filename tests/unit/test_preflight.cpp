@@ -71,7 +71,7 @@ TEST_CASE("preflight: the kill switch pressed is no-go, the kill output read bac
     CHECK(rows.at("kill-output").observed == "reads asserted (thrusters de-energized), as driven");
 }
 
-TEST_CASE("preflight: a second caller joins the window under way; stopping answers Busy") {
+TEST_CASE("preflight: two callers at once both answered; a caller waiting when it stops gets Busy") {
     DaemonRig rig;
     int answered = 0;
     rig.daemon().preflight().run([&](const Result& r) { answered += r.ok(); });
