@@ -98,11 +98,12 @@ int main(int argc, char** argv) {
     }
 
     // An explicitly named file must exist; the default path may be absent (built-in defaults).
-    ConfigResult cr;
+    // The file read, "" for the built-in defaults (the preflight runs the checker on it again).
+    std::string config_file = config_path.empty() ? kDefaultConfig : config_path;
     if (config_path.empty() && access(kDefaultConfig, F_OK) != 0)
-        cr = parse_config_string("", "built-in defaults");
-    else
-        cr = parse_config_file(config_path.empty() ? kDefaultConfig : config_path);
+        config_file.clear();
+    const ConfigResult cr =
+        config_file.empty() ? parse_config_string("", "built-in defaults") : parse_config_file(config_file);
     if (!cr.ok()) {
         log_error("invalid configuration %s:", config_path.empty() ? kDefaultConfig : config_path.c_str());
         for (const auto& e : cr.errors)
@@ -158,6 +159,7 @@ int main(int argc, char** argv) {
     // Made before the daemon so that it outlives it: the daemon's lines tell it their kill output.
     EmergencyStop estop;
     VehicleDaemon daemon(event.get(), *hw.io, hw.bus_io(), hw.spi_io(), *hw.gpio, *cr.config);
+    daemon.preflight().set_config_file(config_file);
     if (std::string e = daemon.start(); !e.empty()) {
         log_error("%s", e.c_str());
         sd_notifyf(0, "STATUS=%s", e.c_str());
@@ -187,7 +189,7 @@ int main(int argc, char** argv) {
     // Each D-Bus object gets the parts it shows and drives, not the whole daemon.
     dbus::VehicleService service(bus.get(), {{daemon.vehicle(), daemon.packets(), daemon.teensy(), daemon.loop(),
                                               daemon.config().control, daemon.failsafes(), daemon.motor_test(),
-                                              daemon.directions()},
+                                              daemon.directions(), daemon.preflight()},
                                              daemon.bus(), daemon.bus().monitor(), daemon.teensy(), daemon.events()});
     daemon.events().attach(&service);
     if (int r = service.start(); r < 0) {

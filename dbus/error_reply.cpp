@@ -19,6 +19,13 @@ int reply(sd_bus_message* call, const Result& result) {
     return r;
 }
 
+int new_method_return(sd_bus_message* call, MessagePtr& out) {
+    sd_bus_message* m = nullptr;
+    const int r = sd_bus_message_new_method_return(call, &m);
+    out.reset(r < 0 ? nullptr : m);
+    return r;
+}
+
 Completion reply_later(sd_bus_message* call) {
     auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(call), sd_bus_message_unref);
     return [held](const Result& result) { reply(held.get(), result); };

@@ -4,6 +4,7 @@
 
 #include "core/status.hpp"
 #include "daemon/loop/completion.hpp"
+#include "drivers/sdbus/sdbus.hpp"
 
 #include <string>
 #include <systemd/sd-bus.h>
@@ -22,5 +23,7 @@ int reply(sd_bus_message* call, const Result& result);
 // The reply to `call` as a Completion, for the daemon to hand the result back later; the
 // handler then returns 1 (the reply is on its way).
 Completion reply_later(sd_bus_message* call);
+// An empty method return for `call`, to be filled and sent (DetectDirections, Preflight): 0 or -errno.
+int new_method_return(sd_bus_message* call, MessagePtr& out);
 
 } // namespace caracara::dbus

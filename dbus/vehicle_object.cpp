@@ -2,6 +2,7 @@
 
 #include "dbus/announcer.hpp"
 #include "dbus/error_reply.hpp"
+#include "dbus/preflight_reply.hpp"
 #include "dbus/vehicle_names.hpp"
 
 #include <cstring>
@@ -108,11 +109,10 @@ int m_motor_test(sd_bus_message* m, void* userdata, sd_bus_error*) {
 // along its row, margin) and the fragment, or the error that ended it.
 int reply_directions(sd_bus_message* call, const DirectionDetection& d) {
     MessagePtr out;
-    sd_bus_message* m = nullptr;
-    int r = sd_bus_message_new_method_return(call, &m);
+    int r = new_method_return(call, out);
     if (r < 0)
         return r;
-    out.reset(m);
+    sd_bus_message* m = out.get();
     if ((r = sd_bus_message_open_container(m, 'a', "(sddddd)")) < 0)
         return r;
     for (const DirectionFinding& f : d.findings()) {
@@ -136,6 +136,10 @@ int m_detect_directions(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return 1;
 }
 
+int m_preflight(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    return run_preflight(m, static_cast<Parts*>(userdata)->preflight);
+}
+
 const ControlSettings& control(D d) { return d.control; }
 
 constexpr Member kMembers[] = {
@@ -154,6 +158,7 @@ constexpr Member kMembers[] = {
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("DetectDirections", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(sddddd)", thrusters, "s", fragment),
                                    m_detect_directions, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("Preflight", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(sbss)", items), m_preflight, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetProfile", SD_BUS_ARGS("s", name), SD_BUS_NO_RESULT, m_set_profile, kUnpriv)),

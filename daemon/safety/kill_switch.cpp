@@ -45,6 +45,11 @@ std::optional<bool> KillSwitch::read() {
     return v == 1;
 }
 
+std::optional<bool> KillSwitch::level() const {
+    const int v = line_ ? line_->get() : -1;
+    return v < 0 ? std::nullopt : std::optional<bool>(v == 1);
+}
+
 void KillSwitch::drop(const std::string& why) {
     source_.reset();
     line_.reset();

@@ -30,6 +30,8 @@ public:
     bool unreadable() const { return settings_ && !line_; }
     // Set (a kill) or not; nullopt when it cannot be read (then dropped and reported lost).
     std::optional<bool> read();
+    // The same reading without dropping a line that fails (the preflight only looks).
+    std::optional<bool> level() const;
     // The event fd (for the loop's "is anything waiting" check), or -1.
     int fd() const { return line_ ? line_->event_fd() : -1; }
 

@@ -11,6 +11,7 @@
 #include "drivers/platform/gpio_backend.hpp"
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -52,6 +53,16 @@ public:
     }
     // A configured switch that cannot be read now (it counts as set meanwhile).
     bool kill_switch_unreadable() const { return kill_switch_.unreadable(); }
+    // The preflight's view: the switch's level (set = kill) and the kill output read back from
+    // its line, nullopt when unconfigured or unreadable; what the kill output should show.
+    bool kill_switch_configured() const { return settings_.kill_switch.has_value(); }
+    std::optional<bool> kill_switch_level() const { return kill_switch_.level(); }
+    bool kill_output_configured() const { return settings_.kill_output.has_value(); }
+    std::optional<bool> kill_output_readback() const {
+        const int v = kill_out_ ? kill_out_->get() : -1;
+        return v < 0 ? std::nullopt : std::optional<bool>(v == 1);
+    }
+    bool kill_output_intended() const { return kill_asserted_; }
     // The switch's event fd (for the loop's "is anything waiting" check), or -1.
     int kill_switch_fd() const { return kill_switch_.fd(); }
 

@@ -25,14 +25,15 @@ DETECTION_RUNS = int(os.environ.get("CARACARA_DETECTION_RUNS") or (2 if SANITIZE
 class SimConfiguredRig(Rig):
     """A rig whose caracara-sim reads its own vehicle description (--config)."""
 
-    def __init__(self, sim_config, **kwargs):
+    def __init__(self, sim_config, sim_toml="", **kwargs):
         super().__init__(**kwargs)
         self.sim_config = sim_config
+        self.sim_toml = sim_toml  # appended to the simulator's file (e.g. [[thruster]] tables)
 
     def start_sim(self):
         path = os.path.join(self.dir, "sim.toml")
         with open(path, "w") as f:
-            f.write(toml_dumps({"sim": self.sim_config}))
+            f.write(toml_dumps({"sim": self.sim_config}) + "\n" + self.sim_toml)
         self._spawn("caracara-sim", command("caracara-sim") + ["--socket", self.sim_socket, "--bus-address",
                                                                self.address, "--config", path])
         poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,

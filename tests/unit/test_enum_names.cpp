@@ -8,6 +8,7 @@
 #include "core/failsafe.hpp"
 #include "core/mixing.hpp"
 #include "core/packet.hpp"
+#include "core/preflight_row.hpp"
 #include "core/safety_state.hpp"
 #include "core/status.hpp"
 #include "core/thruster_config.hpp"
@@ -90,6 +91,7 @@ TEST_CASE("every enum's values have one name each, and each name reads back") {
     check_names<FailsafeCondition>("FailsafeCondition");
     check_names<MixError>("MixError");
     check_names<PacketError>("PacketError");
+    check_names<PreflightItem>("PreflightItem");
     check_names<SafetyState>("SafetyState");
     check_names<KillSource>("KillSource");
     check_names<SafetyError>("SafetyError");

@@ -2,6 +2,7 @@
 // of timedatectl. Arguments are parsed completely before anything is sent; value ranges are the
 // daemon's business (it answers with named errors), only the D-Bus wire types are checked here.
 #include "tools/caracaractl/bridge_forward.hpp"
+#include "tools/caracaractl/check.hpp"
 #include "tools/caracaractl/dives.hpp"
 #include "tools/caracaractl/hold.hpp"
 #include "tools/caracaractl/monitor.hpp"
@@ -291,6 +292,8 @@ constexpr Command kCommands[] = {
     {"detect-directions", "[--write FILE]",
      "Pulse each thruster, still and armed, and tell ok/reversed/inconclusive from the rotation", 0,
      cmd_detect_directions, nullptr, kOptWrite},
+    {"check", "", "Preflight: one go/no-go table before a dive, each no-go with what to do; exit 0 when all go", 0,
+     [](Client& c, const Args&, const Options&) { return run_check(c); }},
     {"clear-kill", "", "Clear the kill, e.g. the one every start comes up with (arming, then ready)", 0,
      cmd_clear_kill},
     {"clear-kill-override", "CONDITION",
