@@ -557,22 +557,27 @@ def tick_lateness(times_ns, period_ns):
     """Each loop tick's lateness, seen on the wire: a tick is a burst of transfers (the next one
     starts a period later; a gap over half a period separates them), its time the end of its first
     transfer. The daemon's schedule is a fixed grid (ControlLoop::on_tick: the next tick a period
-    after the last one's due time), so a tick's lateness is its distance behind that grid; the grid's
-    phase is the earliest tick's (lateness 0), the constant handoff and transfer time taken out.
-    A tick missed is a grid slot with no burst in it."""
+    after the last one's due time) until a tick comes more than a period late: then it skips ahead
+    and the grid starts again from that tick. Within each stretch of the grid, a tick's lateness is
+    its distance behind it, the grid's phase the stretch's earliest tick (the constant handoff and
+    transfer time taken out); a missed tick is a period with no burst in it."""
     starts, last = [], None
     for t in sorted(times_ns):
         if last is None or t - last > period_ns // 2:
             starts.append(t)
         last = t
-    if len(starts) < 2:
-        return {"ticks": len(starts), "missed": 0, "lateness_us": pstats([])}
-    t0 = starts[0]
-    slots = [round((t - t0) / period_ns) for t in starts]
-    offsets = [(t - t0) - k * period_ns for t, k in zip(starts, slots)]
-    phase = min(offsets)
-    missed = (slots[-1] - slots[0] + 1) - len(set(slots))
-    return {"ticks": len(starts), "missed": missed, "lateness_us": pstats([(o - phase) / 1000 for o in offsets])}
+    stretches, missed = [[]], 0
+    for i, t in enumerate(starts):
+        gap = t - starts[i - 1] if i else period_ns
+        if gap > period_ns * 3 // 2:
+            missed += round(gap / period_ns) - 1
+            stretches.append([])
+        stretches[-1].append(t)
+    late = []
+    for st in stretches:
+        offsets = [(t - st[0]) - k * period_ns for k, t in enumerate(st)]
+        late += [(o - min(offsets)) / 1000 for o in offsets]
+    return {"ticks": len(starts), "missed": missed, "stretches": len(stretches), "lateness_us": pstats(late)}
 
 
 def phase_ticks(b, p, res):
