@@ -63,7 +63,12 @@ std::vector<ChannelInfo> make_channels() {
                                                    {"required", {"condition", "action", "thruster"}},
                                                    {"additionalProperties", false}})},
                            {"excluded", array_of(integer())},
-                           {"surfacing_ms", integer()}})
+                           {"surfacing_ms", integer()},
+                           {"motor_test",
+                            {{"type", "object"},
+                             {"properties", {{"thruster", integer()}, {"value", integer()}}},
+                             {"required", {"thruster", "value"}}}},
+                           {"motor_test_limit", integer()}})
                        .dump()});
     out.push_back({ChannelKind::Motors, 0, "/vehicle/motors", "caracara.Motors",
                    object("caracara.Motors", {{"applied", fixed_array(integer(), kThrusters)},
@@ -166,7 +171,9 @@ std::string to_json(const VehicleState& m) {
                 {"leds", m.leds},
                 {"failsafes", failsafes},
                 {"excluded", excluded},
-                {"surfacing_ms", m.surfacing_ms}}
+                {"surfacing_ms", m.surfacing_ms},
+                {"motor_test", {{"thruster", m.motor_test_thruster}, {"value", m.motor_test_value}}},
+                {"motor_test_limit", m.motor_test_limit}}
         .dump();
 }
 

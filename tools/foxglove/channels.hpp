@@ -54,6 +54,9 @@ struct VehicleState {
     std::array<int64_t, 3> leds{}; // red, green, blue (not recorded in a dive: 0)
     std::vector<ActiveFailsafe> failsafes;
     int64_t surfacing_ms = -1;   // how long a surface failsafe's ascent has run; -1 none
+    // The motor test running (thruster -1 and value 0 when none; not recorded in a dive) and
+    // commissioning.motor_test_limit (0 when not known).
+    int64_t motor_test_thruster = -1, motor_test_value = 0, motor_test_limit = 0;
     // In the JSON also "excluded": the thrusters an exclude failsafe holds at zero (from failsafes).
 };
 
