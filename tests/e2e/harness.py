@@ -356,8 +356,9 @@ class Rig:
 
     START_TIMEOUT = 30.0  # generous: sanitizer builds on slow machines start slowly
 
-    def __init__(self, control=None, gpio=True, extra_config=None, extra_toml="", bus_policy_extra=""):
+    def __init__(self, control=None, gpio=True, extra_config=None, extra_toml="", bus_policy_extra="", sim_config=None):
         self.control = dict(control or {})
+        self.sim_config = dict(sim_config or {})  # caracara-sim's own [sim] table (--config), when not empty
         self.gpio = gpio
         self.extra_config = dict(extra_config or {})
         self.extra_toml = extra_toml  # appended verbatim (e.g. [[thruster]] sections)
@@ -432,8 +433,13 @@ class Rig:
 
     def start_sim(self):
         """Starts caracara-sim (again, after a test ended it: the daemon is to pick it up)."""
-        self._spawn("caracara-sim", command("caracara-sim") + ["--socket", self.sim_socket,
-                                                               "--bus-address", self.address])
+        args = ["--socket", self.sim_socket, "--bus-address", self.address]
+        if self.sim_config:
+            path = os.path.join(self.dir, "sim.toml")
+            with open(path, "w") as f:
+                f.write(toml_dumps({"sim": self.sim_config}))
+            args += ["--config", path]
+        self._spawn("caracara-sim", command("caracara-sim") + args)
         poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,
              message="caracara-sim did not take its name")
         self._check_alive("caracara-sim")
