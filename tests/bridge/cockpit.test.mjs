@@ -480,6 +480,9 @@ const onlyOn = (thruster, value) => [...Array(MOTORS).keys()].map((i) => (i === 
 const wireIs = (speeds) => JSON.stringify(simSpeeds()) === JSON.stringify(speeds);
 const addrOf = (i) => DEFAULT_MT[i] >> 1;
 
+// The commissioning panel scrolled to just under the sticky header.
+const toPanel = (page) => page.evaluate(() => window.scrollTo(0, document.getElementById("commissioning").offsetTop -
+  document.querySelector("header").offsetHeight - 8));
 // A page with the motor test chosen, its button under the mouse.
 async function motorTestPage(thruster, value) {
   await rearm();
@@ -488,8 +491,9 @@ async function motorTestPage(thruster, value) {
   await page.waitForFunction(() => document.getElementById("mt-limit").textContent === "±1500", { timeout: 5000 });
   await page.select("#mt-thruster", String(thruster));
   await page.$eval("#mt-value", (e, v) => { e.value = v; }, String(value));
-  await page.$eval("#commissioning", (e) => e.scrollIntoView());
+  await toPanel(page);
   await page.hover("#mt-run");
+  await onScreen(page, "#mt-run"); // not under the header: the press is the button's
   return { page, log };
 }
 
@@ -551,7 +555,9 @@ test("motor test: a dropped connection or a closed page while held stops the thr
   await sleep(700);
   assert.equal(nonZeroOrders(since).length, 0, "the motor test came back after the reconnect");
   await page.mouse.up();
-  // Pressed again, then the page closed while held.
+  // Pressed again (the vehicle re-armed: the page that left was its last pilot), then the page
+  // closed while held.
+  await rearm();
   await page.mouse.down();
   await poll(() => wireIs(onlyOn(1, -700)), 5000, "thruster 1 at -700 again");
   const sinceClose = wireNext();
@@ -570,7 +576,7 @@ test("direction detection from the page: progress while it pulses, the reversed 
   await page.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 20000 });
   const origin = new URL(HTTP).origin;
   await browser.defaultBrowserContext().overridePermissions(origin, ["clipboard-read", "clipboard-write", "clipboard-sanitized-write"]);
-  await page.$eval("#commissioning", (e) => e.scrollIntoView());
+  await toPanel(page);
   const since = wireNext();
   const started = Date.now();
   await page.click("#detect-start");
@@ -582,6 +588,8 @@ test("direction detection from the page: progress while it pulses, the reversed 
   await page.waitForFunction(() => document.getElementById("detect-status").dataset.phase !== "running", { timeout: 180000 });
   console.log(`# direction detection from the page: ${((Date.now() - started) / 1000).toFixed(1)} s`);
   assert.equal(await page.$eval("#detect-status", (e) => e.dataset.phase), "done", await text(page, "#detect-status"));
+  for (const row of await page.$$eval("#detect-result tbody tr", (rows) => rows.map((r) => r.innerText.replace(/\s+/g, " "))))
+    console.log(`# ${row}`);
   const verdicts = await page.$$eval("#detect-result tbody tr", (rows) => rows.map((r) => r.dataset.verdict));
   assert.deepEqual(verdicts, [...Array(MOTORS).keys()].map((i) => (i === REVERSED ? "reversed" : "ok")));
   assert.equal(await text(page, "#detect-status"), `done: reversed ${REVERSED}`);
@@ -596,7 +604,7 @@ test("direction detection from the page: progress while it pulses, the reversed 
   assert.ok(allZero());
   // The fragment: eight [[thruster]] tables, only thruster 2's reversed flag flipped.
   const fragment = await page.$eval("#detect-fragment", (e) => e.value);
-  const tables = fragment.split("[[thruster]]").slice(1);
+  const tables = fragment.split(/^\[\[thruster\]\]/m).slice(1); // the tables, not the comment naming them
   assert.equal(tables.length, MOTORS);
   tables.forEach((t, i) => assert.match(t, new RegExp(`reversed = ${i === REVERSED}\\n`), `table ${i}`));
   await page.click("#detect-copy");

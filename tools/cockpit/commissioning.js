@@ -139,7 +139,8 @@ export class Commissioning {
       return row;
     }));
     this.$("detect-fragment").value = this.result.fragment;
-    this.$("detect-copy").disabled = false;
+    this.$("detect-copied").textContent = "";
+    this.$("detect-output").hidden = false;
     const undecided = this.result.thrusters.filter((t) => t.verdict === "inconclusive").length;
     const reversed = this.result.thrusters.filter((t) => t.verdict === "reversed").map((t) => t.thruster);
     this.$("detect-status").textContent = `done: ${reversed.length ? `reversed ${reversed.join(", ")}` : "none reversed"}` +
