@@ -611,7 +611,8 @@ test("direction detection from the page: progress while it pulses, the reversed 
   await page.waitForFunction(() => document.getElementById("detect-copied").textContent !== "", { timeout: 2000 });
   assert.equal(await text(page, "#detect-copied"), "copied");
   assert.equal(await page.evaluate(() => navigator.clipboard.readText()), fragment, "the clipboard holds the fragment");
-  await shot(page, "commissioning");
+  await toPanel(page);
+  await shotView(page, "commissioning"); // docs/cockpit-commissioning.png
   assert.deepEqual(log.errors, []);
   await page.close();
 });
