@@ -176,6 +176,7 @@ constexpr Member kMembers[] = {
     property<[](D d) -> const auto& { return d.vehicle.controller_client(); }>("Controller", kChange, kChangeController),
     property<[](D d) { return std::tuple{d.motor_test.active_thruster(), d.motor_test.value()}; }>(
         "MotorTest", kChange, kChangeMotors | kChangeController | kChangeState),
+    property<[](D d) { return d.motor_test.limit(); }>("MotorTestLimit", kConst),
     property<[](D d) { return control(d).command_timeout_ms; }>("CommandTimeoutMs", kConst),
     property<[](D d) { return control(d).arming_delay_ms; }>("ArmingDelayMs", kConst),
     property<[](D d) { return double(control(d).loop_rate_hz); }>("LoopRateHz", kConst),

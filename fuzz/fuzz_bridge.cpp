@@ -39,12 +39,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
             FUZZ_CHECK(binary && frame.size() >= 5 && frame[0] == 1, "a command from a frame that is no message data");
             const auto& c = *o.command;
             if (c.kind == CommandKind::Thrust)
-                FUZZ_CHECK(c.thrust.size() == 8, "thrust with %zu values", c.thrust.size());
-            if (c.kind == CommandKind::Motion)
-                for (double a : c.axes)
-                    FUZZ_CHECK(std::isfinite(a), "a motion axis that is not finite");
+                FUZZ_CHECK(c.args.size() == 1 && std::get<std::vector<int32_t>>(c.args[0]).size() == 8,
+                           "thrust without its 8 values");
+            if (c.kind == CommandKind::Motion) {
+                FUZZ_CHECK(c.args.size() == 6, "motion with %zu axes", c.args.size());
+                for (const auto& a : c.args)
+                    FUZZ_CHECK(std::isfinite(std::get<double>(a)), "a motion axis that is not finite");
+            }
             if (c.kind == CommandKind::Profile)
-                FUZZ_CHECK(c.profile.find('\0') == std::string::npos, "a profile name with NUL");
+                FUZZ_CHECK(std::get<std::string>(c.args.at(0)).find('\0') == std::string::npos, "a profile name with NUL");
+            if (c.kind == CommandKind::MotorTest)
+                FUZZ_CHECK(c.args.size() == 2 && std::holds_alternative<int32_t>(c.args[1]), "a motor test without (ii)");
         } else {
             FUZZ_CHECK(!o.replies.empty() || !binary, "a binary frame that was neither a command nor refused");
         }

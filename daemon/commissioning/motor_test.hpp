@@ -35,6 +35,7 @@ public:
     // replaced by a pilot, a kill or the caller leaving) and the vehicle may drive.
     int32_t active_thruster() const;
     int32_t value() const { return active_thruster() < 0 ? 0 : value_; }
+    int32_t limit() const { return config_.commissioning.motor_test_limit; }
 
 private:
     void expired();

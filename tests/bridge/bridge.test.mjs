@@ -142,6 +142,15 @@ test("kill from a client, a refused command as a status with the daemon's error 
   const profile = c.publisher("/command/profile");
   c.publish(profile, { name: "no-such-profile" });
   await c.waitStatus((s) => s.message.includes(ERR + "UnknownProfile"));
+  // The commissioning commands: the bridge's named error for a body that is not theirs, the
+  // daemon's for a thruster out of range; nothing on the wire.
+  const since = wireNext();
+  const test = c.publisher("/command/motor_test");
+  c.publish(test, { thruster: 2 });
+  await c.waitStatus((s) => s.level === 2 && s.message === "/command/motor_test: motor_test needs 'value': an integer");
+  c.publish(test, { thruster: 8, value: 500 });
+  await c.waitStatus((s) => s.level === 2 && s.message.startsWith(`/command/motor_test refused: ${ERR}OutOfRange`));
+  assert.deepEqual(wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] !== ZERO), []);
 });
 
 test("a second client keeps its own pilot rules; while it is connected, another leaving kills nothing", async () => {

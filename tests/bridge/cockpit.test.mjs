@@ -9,7 +9,8 @@ import net from "node:net";
 import path from "node:path";
 import { armPad, launch, openCockpit, surge } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
-import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, SURFACE_MS, VEHICLE, X_AXIS, ZERO, busctl, killEdges,
+import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, SURFACE_MS, VEHICLE, X_AXIS, ZERO, busctl, firstZeros,
+         killEdges,
   hold, poll, rearm, simSpeeds, simThruster, sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
 
 const HTTP = process.env.CARACARA_HTTP_URL;
@@ -509,6 +510,150 @@ test("two tabs fetch the dive list once per change between them, not once each p
   assert.equal(fetches() - before, 1, "one fetch between the two tabs");
   await a.page.close();
   await b.page.close();
+});
+
+// --- commissioning (docs/commissioning.md): the motor test and direction detection from the page ---
+// test_cockpit.py's rig mounts thruster 2 reversed in the simulator, with a short detection.
+const REVERSED = 2;
+const onlyOn = (thruster, value) => [...Array(MOTORS).keys()].map((i) => (i === thruster ? speedByte(value) : ZERO));
+const wireIs = (speeds) => JSON.stringify(simSpeeds()) === JSON.stringify(speeds);
+const addrOf = (i) => DEFAULT_MT[i] >> 1;
+
+// The commissioning panel scrolled to just under the sticky header.
+const toPanel = (page) => page.evaluate(() => window.scrollTo(0, document.getElementById("commissioning").offsetTop -
+  document.querySelector("header").offsetHeight - 8));
+// A page with the motor test chosen, its button under the mouse.
+async function motorTestPage(thruster, value) {
+  await rearm();
+  const { page, log } = await open();
+  await page.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 20000 });
+  await page.waitForFunction(() => document.getElementById("mt-limit").textContent === "±1500", { timeout: 5000 });
+  await page.select("#mt-thruster", String(thruster));
+  await page.$eval("#mt-value", (e, v) => { e.value = v; }, String(value));
+  await toPanel(page);
+  await page.hover("#mt-run");
+  await onScreen(page, "#mt-run"); // not under the header: the press is the button's
+  return { page, log };
+}
+
+test("motor test from the page: the value on that thruster on the wire and the others at zero while held, kept alive by the page; zero once released", async () => {
+  const { page, log } = await motorTestPage(5, 800);
+  const since = wireNext();
+  await page.mouse.down();
+  await poll(() => wireIs(onlyOn(5, 800)), 5000, "thruster 5 alone at 800 on the wire");
+  // The running test in the header's status banner (from MotorTest in /vehicle/state) and in the panel.
+  await page.waitForFunction(() => document.querySelector('#banner li[data-kind="motor-test"]'), { timeout: 5000 });
+  assert.equal(await text(page, '#banner li[data-kind="motor-test"]'), "MOTOR TEST: thruster 5 at 800, the others held at zero");
+  assert.equal(await page.$eval("#mt-status", (e) => e.dataset.thruster), "5");
+  await onScreen(page, "#kill");
+  await shotView(page, "motor-test");
+  // Held past the daemon's keep-alive (500 ms) twice over: the page's repeats keep it running.
+  await sleep(1200);
+  assert.ok(wireIs(onlyOn(5, 800)), "the motor test stopped while held");
+  const orders = wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3 &&
+    DEFAULT_MT.includes(e.addr << 1) && e.data[0] !== ZERO);
+  assert.ok(orders.length > 0);
+  assert.deepEqual([...new Set(orders.map((e) => e.addr))], [addrOf(5)], "a non-zero order to another thruster");
+  assert.deepEqual([...new Set(orders.map((e) => e.data[0]))], [speedByte(800)]);
+  // Released: zero at once (the page's last order), then nothing more from the page.
+  const sinceRelease = wireNext(); // the wire at 800 until the release: its first zero is the release's
+  const released = process.hrtime.bigint();
+  await page.mouse.up();
+  const [zeroAt] = await poll(() => firstZeros(sinceRelease, new Set([addrOf(5)])), 2000, "thruster 5 at zero");
+  console.log(`# motor test released to thruster 5's zero order: ${(Number(zeroAt - released) / 1e6).toFixed(1)} ms`);
+  await poll(() => wireIs(onlyOn(5, 0)), 2000, "every thruster at zero");
+  const sentAfter = await page.evaluate(() => window.cockpit.commissioning.sent);
+  await sleep(600);
+  assert.equal(await page.evaluate(() => window.cockpit.commissioning.sent), sentAfter, "sent after the release");
+  await page.waitForFunction(() => document.getElementById("mt-status").dataset.thruster === "-1", { timeout: 3000 });
+  assert.equal(vget("State"), "ready");
+  // Beyond the daemon's limit: a named error on the page, nothing sent, nothing on the wire.
+  const sinceBad = wireNext();
+  await page.$eval("#mt-value", (e) => { e.value = "2000"; });
+  await page.mouse.down();
+  await sleep(400);
+  await page.mouse.up();
+  assert.match(await text(page, "#mt-error"), /within ±1500 \(commissioning\.motor_test_limit\)/);
+  assert.equal(await page.evaluate(() => window.cockpit.commissioning.sent), sentAfter, "a value beyond the limit sent");
+  assert.equal(nonZeroOrders(sinceBad).length, 0);
+  assert.deepEqual(log.errors, []);
+  await page.close();
+});
+
+test("motor test: a dropped connection or a closed page while held stops the thruster (the bridge keeps nothing alive)", async () => {
+  const { page } = await motorTestPage(1, -700);
+  await page.mouse.down();
+  await poll(() => wireIs(onlyOn(1, -700)), 5000, "thruster 1 at -700");
+  // The page's socket drops, the button still held: caracarad zeroes the connection that left,
+  // and the page, reconnected, sends no motor test until the button is pressed again.
+  const connects = await page.evaluate(() => window.cockpit.connects);
+  await page.evaluate(() => window.cockpit.client.close());
+  await poll(allZero, 2000, "zero once the page's connection dropped");
+  await page.waitForFunction((n) => window.cockpit.connects > n, { timeout: 5000 }, connects);
+  const since = wireNext();
+  await sleep(700);
+  assert.equal(nonZeroOrders(since).length, 0, "the motor test came back after the reconnect");
+  await page.mouse.up();
+  // Pressed again (the vehicle re-armed: the page that left was its last pilot), then the page
+  // closed while held.
+  await rearm();
+  await page.mouse.down();
+  await poll(() => wireIs(onlyOn(1, -700)), 5000, "thruster 1 at -700 again");
+  const sinceClose = wireNext();
+  const closedAt = process.hrtime.bigint();
+  await page.close();
+  const [zeroAt] = await poll(() => firstZeros(sinceClose, new Set([addrOf(1)])), 2000, "thruster 1 at zero");
+  const ms = Number(zeroAt - closedAt) / 1e6;
+  console.log(`# page closed during a motor test to the zero order: ${ms.toFixed(1)} ms`);
+  assert.ok(ms <= bound("CLIENT_LOSS_ZERO_MS_MAX"), `zeroed ${ms} ms after the close (bound ${bound("CLIENT_LOSS_ZERO_MS_MAX")} ms)`);
+  await poll(allZero, 2000, "every thruster at zero");
+});
+
+test("direction detection from the page: progress while it pulses, the reversed thruster in the result and in the fragment to copy", async () => {
+  await rearm();
+  const { page, log } = await open();
+  await page.waitForFunction(() => document.getElementById("state").textContent === "ready", { timeout: 20000 });
+  const origin = new URL(HTTP).origin;
+  await browser.defaultBrowserContext().overridePermissions(origin, ["clipboard-read", "clipboard-write", "clipboard-sanitized-write"]);
+  await toPanel(page);
+  const since = wireNext();
+  const started = Date.now();
+  await page.click("#detect-start");
+  await page.waitForFunction(() => /pulsing thruster \d/.test(document.getElementById("detect-status").textContent),
+    { timeout: 30000 });
+  assert.ok(await page.$eval("#detect-start", (e) => e.disabled), "start offered again while running");
+  await onScreen(page, "#kill");
+  await shotView(page, "detection-running");
+  await page.waitForFunction(() => document.getElementById("detect-status").dataset.phase !== "running", { timeout: 180000 });
+  console.log(`# direction detection from the page: ${((Date.now() - started) / 1000).toFixed(1)} s`);
+  assert.equal(await page.$eval("#detect-status", (e) => e.dataset.phase), "done", await text(page, "#detect-status"));
+  for (const row of await page.$$eval("#detect-result tbody tr", (rows) => rows.map((r) => r.innerText.replace(/\s+/g, " "))))
+    console.log(`# ${row}`);
+  const verdicts = await page.$$eval("#detect-result tbody tr", (rows) => rows.map((r) => r.dataset.verdict));
+  assert.deepEqual(verdicts, [...Array(MOTORS).keys()].map((i) => (i === REVERSED ? "reversed" : "ok")));
+  assert.equal(await text(page, "#detect-status"), `done: reversed ${REVERSED}`);
+  // The vehicle's side: each thruster pulsed alone, in turn, and all at zero at the end.
+  const pulsed = [];
+  for (const e of wireLog(since))
+    if (e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] !== ZERO) {
+      const i = DEFAULT_MT.indexOf(e.addr << 1);
+      if (i >= 0 && pulsed.at(-1) !== i) pulsed.push(i);
+    }
+  assert.deepEqual(pulsed, [...Array(MOTORS).keys()], "the pulses on the wire, one thruster after the other");
+  assert.ok(allZero());
+  // The fragment: eight [[thruster]] tables, only thruster 2's reversed flag flipped.
+  const fragment = await page.$eval("#detect-fragment", (e) => e.value);
+  const tables = fragment.split(/^\[\[thruster\]\]/m).slice(1); // the tables, not the comment naming them
+  assert.equal(tables.length, MOTORS);
+  tables.forEach((t, i) => assert.match(t, new RegExp(`reversed = ${i === REVERSED}\\n`), `table ${i}`));
+  await page.click("#detect-copy");
+  await page.waitForFunction(() => document.getElementById("detect-copied").textContent !== "", { timeout: 2000 });
+  assert.equal(await text(page, "#detect-copied"), "copied");
+  assert.equal(await page.evaluate(() => navigator.clipboard.readText()), fragment, "the clipboard holds the fragment");
+  await toPanel(page);
+  await shotView(page, "commissioning"); // docs/cockpit-commissioning.png
+  assert.deepEqual(log.errors, []);
+  await page.close();
 });
 
 test("a page whose connection drops shows it at once, with the age of the last message, and a kill it could not send", async () => {

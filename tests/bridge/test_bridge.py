@@ -83,6 +83,8 @@ def connect_as(path, *setpriv):
 class BridgeRig:
     """The rig, the bridge on a Unix socket (serving the cockpit's files from the source tree), the
     private sshd and an ssh -L forward to it at cls.port; shared with test_cockpit.py."""
+    SIM_CONFIG = {}     # caracara-sim's [sim] (test_cockpit.py: a thruster mounted reversed)
+    COMMISSIONING = {}  # caracarad's [commissioning] (test_cockpit.py: a short detection)
 
     @classmethod
     def setUpClass(cls):
@@ -97,7 +99,8 @@ class BridgeRig:
             "failsafe": {"pilot-lost": {"action": "kill", "persistence_ms": PILOT_LOST_MS},
                          "water-detect": {"action": "surface", "persistence_ms": 300},
                          "overtemp": {"action": "exclude", "persistence_ms": 300},
-                         "surface": {"heave": -0.5, "duration_ms": SURFACE_MS}}})
+                         "surface": {"heave": -0.5, "duration_ms": SURFACE_MS}},
+            **({"commissioning": cls.COMMISSIONING} if cls.COMMISSIONING else {})}, sim_config=cls.SIM_CONFIG)
         cls.procs = []
         cls.sshd = None
         try:

@@ -26,6 +26,11 @@ def ensure_chromium():
 
 
 class CockpitTest(BridgeRig, unittest.TestCase):
+    # The commissioning page's detection (cockpit.test.mjs): thruster 2 mounted reversed, a
+    # quiet sensor, and a short settle, so one run takes seconds, not a minute.
+    SIM_CONFIG = {"reversed_thrusters": [2]}
+    COMMISSIONING = {"detect_settle_ms": 700}
+
     @classmethod
     def setUpClass(cls):
         ensure_chromium()

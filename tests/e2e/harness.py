@@ -229,6 +229,9 @@ def dbus_signature(v):
     raise TypeError("unknown D-Bus value type %r" % (t,))
 
 
+# A noisy, drifting orientation sensor for caracara-sim's [sim] table (commissioning's tests).
+SIM_NOISE = {"orientation_noise_rad": 0.003, "yaw_drift_rad_s": 0.0005}
+
 WireEntry = namedtuple("WireEntry", "index time_ns transaction bus addr read data miso result")
 
 
@@ -356,8 +359,11 @@ class Rig:
 
     START_TIMEOUT = 30.0  # generous: sanitizer builds on slow machines start slowly
 
-    def __init__(self, control=None, gpio=True, extra_config=None, extra_toml="", bus_policy_extra=""):
+    def __init__(self, control=None, gpio=True, extra_config=None, extra_toml="", bus_policy_extra="", sim_config=None,
+                 sim_toml=""):
         self.control = dict(control or {})
+        self.sim_config = dict(sim_config or {})  # caracara-sim's own [sim] table (--config), when not empty
+        self.sim_toml = sim_toml  # appended to the simulator's file (e.g. [[thruster]] tables)
         self.gpio = gpio
         self.extra_config = dict(extra_config or {})
         self.extra_toml = extra_toml  # appended verbatim (e.g. [[thruster]] sections)
@@ -432,8 +438,13 @@ class Rig:
 
     def start_sim(self):
         """Starts caracara-sim (again, after a test ended it: the daemon is to pick it up)."""
-        self._spawn("caracara-sim", command("caracara-sim") + ["--socket", self.sim_socket,
-                                                               "--bus-address", self.address])
+        args = ["--socket", self.sim_socket, "--bus-address", self.address]
+        if self.sim_config or self.sim_toml:
+            path = os.path.join(self.dir, "sim.toml")
+            with open(path, "w") as f:
+                f.write(toml_dumps({"sim": self.sim_config}) + "\n" + self.sim_toml)
+            args += ["--config", path]
+        self._spawn("caracara-sim", command("caracara-sim") + args)
         poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,
              message="caracara-sim did not take its name")
         self._check_alive("caracara-sim")

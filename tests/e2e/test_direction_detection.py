@@ -11,34 +11,14 @@ import unittest
 
 import dbus
 
-from harness import (DEFAULT_MT, EMULATOR, ERR, MOTORS, SANITIZED, SIM, THRUSTER_IFACE, VEHICLE, ZERO, Rig, thruster_path, VehicleTestCase,
-                     command, error_name, poll, speed_byte, toml_dumps)
+from harness import (DEFAULT_MT, EMULATOR, ERR, MOTORS, SANITIZED, SIM_NOISE, THRUSTER_IFACE, VEHICLE, ZERO, Rig, thruster_path,
+                     VehicleTestCase, error_name, poll, speed_byte)
 
-SIM_NOISE = {"orientation_noise_rad": 0.003, "yaw_drift_rad_s": 0.0005}
 # Five runs in a row in the normal amd64 build (the issue's proof; about 30 s each, the vehicle
 # settling before every pulse). The sanitized, arm64 (qemu-user) and Debian 13 builds run the
 # same seeded vehicle twice: they look for memory errors, the other architecture and the other
 # toolchain, not for the statistics, and this test was the longest of each of their suites.
 DETECTION_RUNS = int(os.environ.get("CARACARA_DETECTION_RUNS") or (2 if SANITIZED or EMULATOR else 5))
-
-
-class SimConfiguredRig(Rig):
-    """A rig whose caracara-sim reads its own vehicle description (--config)."""
-
-    def __init__(self, sim_config, sim_toml="", **kwargs):
-        super().__init__(**kwargs)
-        self.sim_config = sim_config
-        self.sim_toml = sim_toml  # appended to the simulator's file (e.g. [[thruster]] tables)
-
-    def start_sim(self):
-        path = os.path.join(self.dir, "sim.toml")
-        with open(path, "w") as f:
-            f.write(toml_dumps({"sim": self.sim_config}) + "\n" + self.sim_toml)
-        self._spawn("caracara-sim", command("caracara-sim") + ["--socket", self.sim_socket, "--bus-address",
-                                                               self.address, "--config", path])
-        poll(lambda: self.conn.name_has_owner(SIM) or self._died("caracara-sim"), self.START_TIMEOUT,
-             message="caracara-sim did not take its name")
-        self._check_alive("caracara-sim")
 
 
 class DetectionCase(VehicleTestCase):
@@ -47,7 +27,7 @@ class DetectionCase(VehicleTestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.rig = SimConfiguredRig(cls.SIM_CONFIG, control=cls.CONTROL, extra_config=cls.EXTRA_CONFIG)
+        cls.rig = Rig(control=cls.CONTROL, extra_config=cls.EXTRA_CONFIG, sim_config=cls.SIM_CONFIG)
         cls.addClassCleanup(cls.rig.stop_checked)
         cls.rig.start()
         cls.rig.arm()

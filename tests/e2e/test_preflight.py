@@ -13,8 +13,7 @@ import unittest
 
 import dbus
 
-from harness import MOTORS, TEENSY_IFACE, TEENSY_PATH, VEHICLE, ZERO, VehicleTestCase, poll, pump_main_loop
-from test_direction_detection import SIM_NOISE, SimConfiguredRig
+from harness import MOTORS, SIM_NOISE, TEENSY_IFACE, TEENSY_PATH, VEHICLE, ZERO, Rig, VehicleTestCase, poll, pump_main_loop
 
 ITEMS = ["thruster-%d" % i for i in range(MOTORS)] + [
     "bus", "teensy", "kill-switch", "kill-output", "config", "recorder", "failsafes", "clock"]
@@ -43,8 +42,8 @@ class PreflightCase(VehicleTestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.rig = SimConfiguredRig(cls.SIM_CONFIG, sim_toml=cls.SIM_TOML, control=cls.CONTROL,
-                                   extra_config=cls.EXTRA_CONFIG)
+        cls.rig = Rig(control=cls.CONTROL, extra_config=cls.EXTRA_CONFIG, sim_config=cls.SIM_CONFIG,
+                      sim_toml=cls.SIM_TOML)
         cls.addClassCleanup(cls.rig.stop_checked)
         cls.rig.start()
         cls.rig.arm()

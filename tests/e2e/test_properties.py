@@ -41,6 +41,7 @@ class PropertiesTest(VehicleTestCase):
         self.assertEqual(p["CommandTimeoutMs"], 60000)
         self.assertEqual(p["ArmingDelayMs"], 300)
         self.assertEqual(p["LoopRateHz"], 50.0)
+        self.assertEqual(p["MotorTestLimit"], 1500)
         # Cycles count up with the control loop; CommandAgeMs grows while nobody commands.
         c0 = int(p["Cycles"])
         poll(lambda: int(self.rig.vget("Cycles")) >= c0 + 5, 10, message="Cycles does not advance")

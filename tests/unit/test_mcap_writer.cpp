@@ -250,16 +250,22 @@ TEST_CASE("the bridge's client protocol: commands only from advertised command t
     using caracara::bridge::ClientProtocol;
     ClientProtocol p(fg::channels().size());
     auto binary = [](uint32_t id, std::string body) {
-        std::vector<uint8_t> b = {1, uint8_t(id), uint8_t(id >> 8), uint8_t(id >> 16), uint8_t(id >> 24)};
-        b.insert(b.end(), body.begin(), body.end());
+        // Sized first: GCC 12's -Warray-bounds misjudges an insert after a 5-byte initializer list.
+        std::vector<uint8_t> b(5 + body.size());
+        b[0] = 1;
+        for (std::size_t i = 0; i < 4; ++i)
+            b[1 + i] = uint8_t(id >> (8 * i));
+        std::copy(body.begin(), body.end(), b.begin() + 5);
         return b;
     };
     CHECK_FALSE(p.on_binary(binary(5, R"({"x":0.5})")).command); // not advertised
     CHECK(p.on_text(R"({"op":"advertise","channels":[{"id":5,"topic":"/command/motion","encoding":"json"}]})").replies.empty());
     const auto o = p.on_binary(binary(5, R"({"x":0.5,"yaw":-1})"));
     REQUIRE(o.command);
-    CHECK(o.command->axes[0] == 0.5);
-    CHECK(o.command->axes[3] == -1);
+    REQUIRE(o.command->args.size() == 6);
+    CHECK(std::get<double>(o.command->args[0]) == 0.5);
+    CHECK(std::get<double>(o.command->args[3]) == -1);
+    CHECK(std::get<double>(o.command->args[1]) == 0); // an axis left out
     CHECK_FALSE(p.on_binary(binary(5, R"({"x":"fast"})")).command);
     CHECK_FALSE(p.on_binary(binary(5, "{")).command);
     CHECK(p.on_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":1},{"id":1,"channelId":2}]})").replies.size() == 1);
@@ -267,4 +273,20 @@ TEST_CASE("the bridge's client protocol: commands only from advertised command t
     CHECK(p.on_text(R"({"op":"unsubscribe","subscriptionIds":[1]})").replies.empty());
     CHECK(p.subscribers(1).empty());
     CHECK(p.on_text(R"({"op":"getParameters"})").replies.size() == 1);
+    // The commissioning commands: a motor test's (thruster, value), detection without arguments.
+    CHECK(p.on_text(R"({"op":"advertise","channels":[{"id":6,"topic":"/command/motor_test","encoding":"json"},)"
+                    R"({"id":7,"topic":"/command/detect_directions","encoding":"json"}]})").replies.empty());
+    const auto test = p.on_binary(binary(6, R"({"thruster":3,"value":-800})"));
+    REQUIRE(test.command);
+    CHECK(test.command->kind == caracara::bridge::CommandKind::MotorTest);
+    CHECK(test.command->args == std::vector<caracara::bridge::CommandArg>{int32_t{3}, int32_t{-800}});
+    const auto missing = p.on_binary(binary(6, R"({"thruster":3})"));
+    CHECK_FALSE(missing.command);
+    CHECK(missing.replies.at(0).find("/command/motor_test: motor_test needs 'value': an integer") != std::string::npos);
+    CHECK_FALSE(p.on_binary(binary(6, R"({"thruster":3,"value":1e12})")).command);
+    const auto detect = p.on_binary(binary(7, "{}"));
+    REQUIRE(detect.command);
+    CHECK(detect.command->args.empty());
+    CHECK(caracara::bridge::command_spec(caracara::bridge::CommandKind::DetectDirections).reply ==
+          caracara::bridge::CommandReply::Directions);
 }

@@ -17,9 +17,11 @@ bool is_u32(const json& v) { return v.is_number_unsigned() && v.get<uint64_t>() 
 
 } // namespace
 
-std::string status_json(int level, std::string_view message) {
-    return json{{"op", "status"}, {"level", level}, {"message", std::string(message)}}.dump(
-        -1, ' ', false, json::error_handler_t::replace);
+std::string status_json(int level, std::string_view message, std::string_view id) {
+    json j{{"op", "status"}, {"level", level}, {"message", std::string(message)}};
+    if (!id.empty())
+        j["id"] = std::string(id);
+    return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 const std::vector<uint32_t>& ClientProtocol::subscribers(uint32_t channel_id) const {

@@ -24,7 +24,8 @@
 namespace caracara::bridge {
 
 // A status message: {"op":"status","level":L,"message":M}; level 0 info, 1 warning, 2 error.
-std::string status_json(int level, std::string_view message);
+// With an id ({"id":I}): a command's answer, I its topic (docs/foxglove.md).
+std::string status_json(int level, std::string_view message, std::string_view id = {});
 
 struct Outcome {
     std::vector<std::string> replies;   // text frames to send (status messages)

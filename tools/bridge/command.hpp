@@ -1,35 +1,53 @@
 // A pilot's command published by a Foxglove client (clientPublish) on one of the command
-// topics (docs/foxglove.md), decoded from its JSON. Only the JSON's shape and the D-Bus wire
-// types are checked here; ranges are the daemon's business (it answers with named errors).
+// topics (docs/foxglove.md), decoded from its JSON into the D-Bus call's arguments. Only the
+// JSON's shape and the D-Bus wire types are checked here; ranges are the daemon's business (it
+// answers with named errors). Each command is one row of one table (command.cpp): its topic,
+// its argument parse, its D-Bus method and what its reply carries.
 #pragma once
 
-#include <array>
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 namespace caracara::bridge {
 
-enum class CommandKind : uint8_t { Motion, Thrust, Kill, ClearKill, Leds, Profile };
+enum class CommandKind : uint8_t { Motion, Thrust, Kill, ClearKill, Leds, Profile, MotorTest, DetectDirections };
 
-// "/command/motion" -> Motion, ...; nullopt for a topic that is no command.
-std::optional<CommandKind> command_topic(std::string_view topic);
-std::string_view command_topic_name(CommandKind kind);
+// What a successful reply carries back to the client that sent the command.
+enum class CommandReply : uint8_t {
+    None,       // nothing: only a refusal is told
+    Directions, // DetectDirections' a(sddddd)s, as JSON (docs/foxglove.md)
+};
+
+// One D-Bus argument: int32 'i', byte 'y', double 'd', string 's', int32 array 'ai'.
+using CommandArg = std::variant<int32_t, uint8_t, double, std::string, std::vector<int32_t>>;
 
 struct Command {
     CommandKind kind = CommandKind::Kill;
-    std::array<double, 6> axes{};     // Motion: x, y, z, yaw, pitch, roll
-    std::vector<int32_t> thrust;      // Thrust: the eight motor values
-    std::array<uint8_t, 3> rgb{};     // Leds
-    std::string profile;              // Profile
+    std::vector<CommandArg> args; // the D-Bus method's arguments, in its order
 };
 
 struct CommandParse {
     std::optional<Command> command;
     std::string error;                // why it was refused, when command is empty
 };
+
+struct CommandSpec {
+    CommandKind kind;
+    std::string_view topic;           // "/command/motion"
+    const char* member;               // the org.caracara.Vehicle1 method
+    CommandReply reply;
+    std::chrono::milliseconds timeout; // the reply's; 0: sd-bus's default (25 s)
+};
+
+// "/command/motion" -> Motion, ...; nullopt for a topic that is no command.
+std::optional<CommandKind> command_topic(std::string_view topic);
+const CommandSpec& command_spec(CommandKind kind);
+inline std::string_view command_topic_name(CommandKind kind) { return command_spec(kind).topic; }
 
 // Decodes the JSON payload of a message on a command topic.
 CommandParse parse_command(CommandKind kind, std::string_view json);

@@ -1,13 +1,49 @@
 #include "tools/bridge/command_link.hpp"
 
 #include "dbus/vehicle_names.hpp"
+#include "tools/client/client.hpp"
 
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 namespace caracara::bridge {
 
 namespace names = caracara::dbus;
+
+namespace {
+
+// Appends one argument by its type (CommandArg's D-Bus codes).
+struct Append {
+    sd_bus_message* m;
+    int operator()(int32_t v) const { return sd_bus_message_append_basic(m, 'i', &v); }
+    int operator()(uint8_t v) const { return sd_bus_message_append_basic(m, 'y', &v); }
+    int operator()(double v) const { return sd_bus_message_append_basic(m, 'd', &v); }
+    int operator()(const std::string& v) const { return sd_bus_message_append_basic(m, 's', v.c_str()); }
+    int operator()(const std::vector<int32_t>& v) const {
+        return sd_bus_message_append_array(m, 'i', v.data(), v.size() * sizeof(int32_t));
+    }
+};
+
+// DetectDirections' a(sddddd)s: {"thrusters":[{thruster, verdict, yaw, pitch, roll, along,
+// margin}], "fragment"}.
+std::string directions_json(sd_bus_message* m) {
+    namespace client = caracara::client;
+    const client::Value rows = client::read_value(m);
+    const client::Value fragment = client::read_value(m);
+    nlohmann::json out{{"thrusters", nlohmann::json::array()}, {"fragment", fragment.s}};
+    for (std::size_t i = 0; i < rows.items.size(); ++i) {
+        const auto& f = rows.items[i].items;
+        if (f.size() != 6)
+            throw client::Failure{client::kExitUnavailable, "a malformed row"};
+        out["thrusters"].push_back({{"thruster", i}, {"verdict", f[0].s}, {"yaw", f[1].number()},
+                                    {"pitch", f[2].number()}, {"roll", f[3].number()}, {"along", f[4].number()},
+                                    {"margin", f[5].number()}});
+    }
+    return out.dump();
+}
+
+} // namespace
 
 // What a reply needs to report a refusal; freed with the call's slot (sd-bus destroy callback).
 struct CommandLink::Pending {
@@ -16,8 +52,8 @@ struct CommandLink::Pending {
 };
 
 CommandLink::CommandLink(boost::asio::io_context& io, const caracara::dbus::BusChoice& bus, Refused on_refused,
-                         std::function<void()> on_lost)
-    : on_refused_(std::move(on_refused)) {
+                         Answered on_answered, std::function<void()> on_lost)
+    : on_refused_(std::move(on_refused)), on_answered_(std::move(on_answered)) {
     if (const int r = caracara::dbus::open_bus(bus, "caracara-bridge-pilot", bus_); r < 0)
         throw std::runtime_error(std::string("cannot connect to the bus: ") + std::strerror(-r));
     watch_ = std::make_unique<BusWatch>(io, bus_.get(), std::move(on_lost));
@@ -36,52 +72,44 @@ std::string CommandLink::unique_name() const {
 
 int CommandLink::on_reply(sd_bus_message* m, void* userdata, sd_bus_error*) {
     auto* p = static_cast<Pending*>(userdata);
+    const CommandSpec& spec = command_spec(p->kind);
     if (sd_bus_message_is_method_error(m, nullptr)) {
         const sd_bus_error* e = sd_bus_message_get_error(m);
-        p->link->on_refused_(command_topic_name(p->kind), e && e->name ? e->name : "",
-                             e && e->message ? e->message : "");
+        p->link->on_refused_(spec.topic, e && e->name ? e->name : "", e && e->message ? e->message : "");
+        return 0;
+    }
+    switch (spec.reply) {
+    case CommandReply::None: break;
+    case CommandReply::Directions:
+        try {
+            p->link->on_answered_(spec.topic, directions_json(m));
+        } catch (const caracara::client::Failure& f) {
+            p->link->on_refused_(spec.topic, "org.caracara.Bridge.Error.BadReply", f.message);
+        }
+        break;
     }
     return 0;
 }
 
 void CommandLink::send(const Command& c) {
-    const char* member = nullptr;
-    switch (c.kind) {
-    case CommandKind::Motion: member = "SetMotion"; break;
-    case CommandKind::Thrust: member = "SetThrust"; break;
-    case CommandKind::Kill: member = "Kill"; break;
-    case CommandKind::ClearKill: member = "ClearKill"; break;
-    case CommandKind::Leds: member = "SetLeds"; break;
-    case CommandKind::Profile: member = "SetProfile"; break;
-    }
+    const CommandSpec& spec = command_spec(c.kind);
     sd_bus_message* raw = nullptr;
     int r = sd_bus_message_new_method_call(bus_.get(), &raw, names::kBusName, names::kRootPath, names::kVehicleIface,
-                                           member);
+                                           spec.member);
     caracara::dbus::MessagePtr call(raw);
     if (r >= 0)
         r = sd_bus_message_set_auto_start(call.get(), 0);
-    if (r >= 0) {
-        switch (c.kind) {
-        case CommandKind::Motion:
-            r = sd_bus_message_append(call.get(), "dddddd", c.axes[0], c.axes[1], c.axes[2], c.axes[3], c.axes[4],
-                                      c.axes[5]);
-            break;
-        case CommandKind::Thrust:
-            r = sd_bus_message_append_array(call.get(), 'i', c.thrust.data(), c.thrust.size() * sizeof(int32_t));
-            break;
-        case CommandKind::Leds: r = sd_bus_message_append(call.get(), "yyy", c.rgb[0], c.rgb[1], c.rgb[2]); break;
-        case CommandKind::Profile: r = sd_bus_message_append(call.get(), "s", c.profile.c_str()); break;
-        case CommandKind::Kill:
-        case CommandKind::ClearKill: break;
-        }
-    }
+    for (const CommandArg& arg : c.args)
+        if (r >= 0)
+            r = std::visit(Append{call.get()}, arg);
     auto* pending = new Pending{this, c.kind};
     sd_bus_slot* slot = nullptr;
+    const auto timeout_us = static_cast<uint64_t>(std::chrono::microseconds(spec.timeout).count());
     if (r >= 0)
-        r = sd_bus_call_async(bus_.get(), &slot, call.get(), on_reply, pending, 0);
+        r = sd_bus_call_async(bus_.get(), &slot, call.get(), on_reply, pending, timeout_us);
     if (r < 0) {
         delete pending;
-        on_refused_(command_topic_name(c.kind), "org.caracara.Bridge.Error.SendFailed", std::strerror(-r));
+        on_refused_(spec.topic, "org.caracara.Bridge.Error.SendFailed", std::strerror(-r));
         return;
     }
     // The slot floats (the bus owns it: freed after the reply or with the bus) and frees

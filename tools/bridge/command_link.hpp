@@ -1,7 +1,8 @@
 // One pilot's own connection to caracarad: each WebSocket client gets one, so the daemon's
 // per-client rules hold per pilot (its thrust goes to zero when this connection closes; the
-// command timeout runs per client). Commands are sent asynchronously and in order; a refusal
-// comes back with the daemon's error name.
+// command timeout runs per client; a motor test stops when its keep-alives stop or this
+// connection closes). Commands are sent asynchronously and in order; a refusal comes back with
+// the daemon's error name, and a reply that carries something (command_spec's reply) as JSON.
 #pragma once
 
 #include "drivers/sdbus/sdbus.hpp"
@@ -17,12 +18,14 @@ namespace caracara::bridge {
 
 class CommandLink {
 public:
-    // on_refused(command topic, D-Bus error name, message); on_lost: the connection closed.
+    // on_refused(command topic, D-Bus error name, message); on_answered(command topic, the
+    // reply as JSON); on_lost: the connection closed.
     using Refused = std::function<void(std::string_view topic, const std::string& name, const std::string& message)>;
+    using Answered = std::function<void(std::string_view topic, const std::string& json)>;
 
     // Connects at once; throws std::runtime_error when the bus cannot be reached.
     CommandLink(boost::asio::io_context& io, const caracara::dbus::BusChoice& bus, Refused on_refused,
-                std::function<void()> on_lost);
+                Answered on_answered, std::function<void()> on_lost);
     ~CommandLink();
 
     void send(const Command& c);
@@ -36,6 +39,7 @@ private:
     caracara::dbus::BusPtr bus_;
     std::unique_ptr<BusWatch> watch_;
     Refused on_refused_;
+    Answered on_answered_;
 };
 
 } // namespace caracara::bridge

@@ -189,6 +189,7 @@ void Session::on_request(boost::system::error_code ec) {
             [this](std::string_view topic, const std::string& name, const std::string& message) {
                 send_text(status_json(2, std::string(topic) + " refused: " + name + (message.empty() ? "" : ": " + message)));
             },
+            [this](std::string_view topic, const std::string& json) { send_text(status_json(0, json, topic)); },
             // Not from inside the link's own processing: the session ends on the next turn.
             [this] { boost::asio::post(io_, [self = shared_from_this()] { self->end("the bus connection closed"); }); });
     } catch (const std::exception& e) {

@@ -331,6 +331,11 @@ void Telemetry::build(std::size_t channel, uint64_t now) {
         for (std::size_t i = 0; i < 3 && i < leds.items.size(); ++i)
             s.leds[i] = leds.items[i].integer();
         add_time_left(p, s);
+        if (const Value& test = get(p, "MotorTest"); test.items.size() == 2) {
+            s.motor_test_thruster = test.items[0].integer();
+            s.motor_test_value = test.items[1].integer();
+        }
+        s.motor_test_limit = get(p, "MotorTestLimit").integer();
         json = fg::to_json(s);
         break;
     }

@@ -7,7 +7,7 @@ const decoder = new TextDecoder();
 const encoder = new TextEncoder();
 
 export class FoxgloveClient {
-  // handlers: onOpen(), onMessage(topic, msg, timeNs), onStatus(level, text), onClose()
+  // handlers: onOpen(), onMessage(topic, msg, timeNs), onStatus(level, text, id), onClose()
   constructor(url, handlers) {
     this.handlers = handlers;
     this.channels = new Map(); // subscription id -> topic
@@ -27,7 +27,7 @@ export class FoxgloveClient {
       const m = JSON.parse(data);
       if (m.op === "serverInfo") this.handlers.onOpen?.(m);
       else if (m.op === "advertise") this.subscribe(m.channels);
-      else if (m.op === "status") this.handlers.onStatus?.(m.level, m.message);
+      else if (m.op === "status") this.handlers.onStatus?.(m.level, m.message, m.id);
       return;
     }
     const view = new DataView(data);

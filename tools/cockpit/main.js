@@ -4,6 +4,7 @@ import { FoxgloveClient } from "./foxglove.js";
 import { AXES, CLEAR_HOLD_MS, GAINS, loadMapping, sample, saveMapping, stepGain, validMapping } from "./gamepad.js";
 import { degrees, drawAttitude } from "./attitude.js";
 import { DiveList } from "./dives.js";
+import { Commissioning } from "./commissioning.js";
 import { banner, controllerWords, killSourceWords } from "./words.js";
 
 const MOTORS = 8, MOTOR_MAX = 8850;
@@ -26,6 +27,9 @@ const cockpit = { state: null, motors: null, thrusters: [], teensy: null, i2c: n
   stateAt: 0, pilotLostMs: null };
 window.cockpit = cockpit;  // for the tests and the curious
 const dives = new DiveList($("dives"), $("dive-plot"), token);
+const commissioning = new Commissioning((topic, obj) => client?.publish(topic, obj) ?? false,
+  (level, text) => logEvent(level, "cockpit", text, Date.now()));
+cockpit.commissioning = commissioning; // for the tests
 
 // Back to the start of arming: the pilot must release, centre and press again.
 function disarm() {
@@ -40,9 +44,10 @@ function connect() {
   client = new FoxgloveClient(wsUrl, {
     onOpen: () => { connected = true; retries = 0; cockpit.connects++; disarm(); },
     onMessage: (topic, msg) => { lastMessageAt = performance.now(); show(topic, msg); },
-    onStatus: (level, text) => bridgeStatus(level, text),
+    onStatus: (level, text, id) => bridgeStatus(level, text, id),
     onClose: () => {
       connected = false;
+      commissioning.lost();
       // What the vehicle is now is unknown: the old state is not kept as if it were current.
       cockpit.state = null;
       disarm();
@@ -55,7 +60,9 @@ function connect() {
 
 // A refusal of the bridge or the daemon: a motion command refused (a failsafe's ascent, a kill
 // on the way) stops the sending and makes one event, not one per command.
-function bridgeStatus(level, text) {
+function bridgeStatus(level, text, id) {
+  if (id && commissioning.answer(id, text)) return;
+  commissioning.refused(text); // shown in its panel, and logged below
   const refused = /^\/command\/(motion|thrust) refused: \S*?([A-Za-z]+)(?::|$)/.exec(text);
   if (refused) {
     const first = cockpit.refusal === null;
@@ -156,6 +163,7 @@ function showState(m) {
   $("saturated").textContent = m.saturated ? "SATURATED" : "not saturated";
   $("saturated").className = m.saturated ? "pill bad" : "pill ok";
   $("controller").textContent = controllerWords(m, driving);
+  commissioning.showState(m);
 }
 
 function thrusterRow(i) {
@@ -179,6 +187,7 @@ function setBar(el, value) {
 
 function showMotors(m) {
   cockpit.motors = m;
+  commissioning.showMotors(m);
   for (let i = 0; i < MOTORS; i++) {
     const row = thrusterRow(i);
     setBar(row.querySelector(".applied span"), m.applied[i]);
@@ -238,8 +247,9 @@ function logEvent(level, name, message, ms) {
 // --- kill ----------------------------------------------------------------------------------------
 function kill() {
   cockpit.kills++;
-  // The kill first: nothing of ours goes out ahead of it.
+  // The kill first: nothing of ours goes out ahead of it (nor after it: the motor test stops).
   const sent = client?.publish("/command/kill", {});
+  commissioning.stop();
   if (!sent) {
     cockpit.killNotSentAt = performance.now();
     logEvent(4, "cockpit", "kill NOT sent: no connection to the bridge (the vehicle zeroes a lost pilot's thrust)", Date.now());
@@ -354,9 +364,11 @@ function tick() {
   sendMotion(s.motion);
 }
 
-document.addEventListener("visibilitychange", () => { if (document.visibilityState !== "visible") stopDriving(); });
+document.addEventListener("visibilitychange", () => {
+  if (document.visibilityState !== "visible") { stopDriving(); commissioning.release(); }
+});
 window.addEventListener("gamepaddisconnected", () => stopDriving());
-window.addEventListener("pagehide", () => { stopDriving(); client?.close(); });
+window.addEventListener("pagehide", () => { stopDriving(); commissioning.release(); client?.close(); });
 
 function mappingForm() {
   const form = $("mapping");

@@ -78,6 +78,8 @@ export function banner({ state, up, lostMs, killNotSentMs, refusal, sinceStateMs
     else
       add("warning", "warn", `WARNING: ${conditionWords(f)}`);
   }
+  if (state.motor_test?.thruster >= 0)
+    add("motor-test", "warn", `MOTOR TEST: thruster ${state.motor_test.thruster} at ${state.motor_test.value}, the others held at zero`);
   if (refusal && state.state === "ready" && !(state.surfacing_ms >= 0))
     add("refused", "warn", `Motion refused (${refusal}): release the deadman, centre the sticks and press it again`);
   return out;

@@ -66,7 +66,12 @@ std::vector<ChannelInfo> make_channels() {
                            {"surfacing_ms", integer()},
                            {"ascent_left_ms", integer()},
                            {"pilot_lost_left_ms", integer()},
-                           {"pilot_lost_ms", integer()}})
+                           {"pilot_lost_ms", integer()},
+                           {"motor_test",
+                            {{"type", "object"},
+                             {"properties", {{"thruster", integer()}, {"value", integer()}}},
+                             {"required", {"thruster", "value"}}}},
+                           {"motor_test_limit", integer()}})
                        .dump()});
     out.push_back({ChannelKind::Motors, 0, "/vehicle/motors", "caracara.Motors",
                    object("caracara.Motors", {{"applied", fixed_array(integer(), kThrusters)},
@@ -172,7 +177,9 @@ std::string to_json(const VehicleState& m) {
                 {"surfacing_ms", m.surfacing_ms},
                 {"ascent_left_ms", m.ascent_left_ms},
                 {"pilot_lost_left_ms", m.pilot_lost_left_ms},
-                {"pilot_lost_ms", m.pilot_lost_ms}}
+                {"pilot_lost_ms", m.pilot_lost_ms},
+                {"motor_test", {{"thruster", m.motor_test_thruster}, {"value", m.motor_test_value}}},
+                {"motor_test_limit", m.motor_test_limit}}
         .dump();
 }
 

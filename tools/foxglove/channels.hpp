@@ -57,6 +57,9 @@ struct VehicleState {
     int64_t ascent_left_ms = -1; // the time left of that ascent, as the daemon has it; -1 none (or not recorded)
     int64_t pilot_lost_left_ms = -1; // the time left of the pilot-lost failsafe's countdown; -1 none
     int64_t pilot_lost_ms = -1;  // the configured pilot-lost persistence; -1 not known (not recorded)
+    // The motor test running (thruster -1 and value 0 when none; not recorded in a dive) and
+    // commissioning.motor_test_limit (0 when not known).
+    int64_t motor_test_thruster = -1, motor_test_value = 0, motor_test_limit = 0;
     // In the JSON also "excluded": the thrusters an exclude failsafe holds at zero (from failsafes).
 };
 
