@@ -9,8 +9,7 @@ import net from "node:net";
 import path from "node:path";
 import { armPad, launch, openCockpit, surge } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
-import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, SURFACE_MS, VEHICLE, X_AXIS, ZERO, busctl, firstZeros,
-         killEdges,
+import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, SURFACE_MS, VEHICLE, X_AXIS, ZERO, busctl, firstZeros, killEdges,
   hold, poll, rearm, simSpeeds, simThruster, sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
 
 const HTTP = process.env.CARACARA_HTTP_URL;
