@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <dirent.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -18,6 +19,17 @@ namespace {
 constexpr std::string_view kCold[] = {"libgcrypt.so", "libgpg-error.so", "libzstd.so", "liblz4.so",
                                       "liblzma.so", "libcap.so", "libtomlplusplus.so", "libm.so"};
 long (*const kHotInCold[])(double) = {&::lround};
+
+// Threads of this process (/proc/self/task): another one could run into a hidden mapping.
+int thread_count() {
+    int n = 0;
+    if (DIR* d = ::opendir("/proc/self/task")) {
+        while (const dirent* e = ::readdir(d))
+            n += e->d_name[0] != '.';
+        ::closedir(d);
+    }
+    return n;
+}
 
 } // namespace
 
@@ -63,8 +75,11 @@ void ColdLibraries::hide() {
     }
     close_mapping();
     std::fclose(f);
+    const bool alone = thread_count() == 1; // else only dropped after the lock
     for (std::size_t i = 0; i < count_; ++i)
-        if (cold_[i].hidden)
+        if (!alone)
+            cold_[i].hidden = false;
+        else if (cold_[i].hidden)
             mprotect(reinterpret_cast<void*>(cold_[i].start), cold_[i].end - cold_[i].start, PROT_NONE);
 }
 
