@@ -17,7 +17,7 @@ public:
     static bool cold(std::string_view path);
 
     // Before mlockall: the cold mappings found (/proc/self/smaps) and made inaccessible, which
-    // mlockall does not fault in. Only the calling thread may run meanwhile.
+    // mlockall does not fault in; none while another thread runs (it could run into one).
     void hide();
     // After mlockall: their access given back, unlocked, the pages they had dropped; the hot
     // functions in them locked. The KiB of mappings left unlocked.
