@@ -30,10 +30,12 @@ int read_ints(sd_bus_message* m, std::vector<int32_t>& out) {
 }
 
 int m_set_thrust(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    std::vector<int32_t> v;
-    if (int r = read_ints(m, v); r < 0)
+    // Read in place (the message keeps an int32 array aligned): no copy, no allocation per call.
+    const void* p = nullptr;
+    size_t n = 0;
+    if (int r = sd_bus_message_read_array(m, 'i', &p, &n); r < 0)
         return r;
-    return reply(m, vehicle(userdata).set_thrust(v, sender(m)));
+    return reply(m, vehicle(userdata).set_thrust({static_cast<const int32_t*>(p), n / sizeof(int32_t)}, sender(m)));
 }
 
 int m_set_motion(sd_bus_message* m, void* userdata, sd_bus_error*) {

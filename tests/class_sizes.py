@@ -32,9 +32,7 @@ EXCEPTIONS = {
 NOT_YET_SPLIT = {
     "daemon/teensy/teensy_connection": 313,  # the poll slots to a class of their own
     "daemon/commissioning/direction_detection": 306,  # DirectionFinding beside DirectionDetection
-    "daemon/control/bus_work_dispatch": 268,
     "daemon/bus/bus_worker": 266,
-    "daemon/vehicle/vehicle": 260,
     "tools/bridge/telemetry": 489,  # the channels' message builders to a class of their own
     "tools/caracaractl/caracaractl": 500,  # the command table and its commands (+3: check's include and table line)
 }

@@ -20,7 +20,7 @@ BusWorkDispatch::BusWorkDispatch(sd_event* event, ThrusterBus& bus, TeensyPort& 
       cycle_work_done_(std::move(cycle_work_done)),
       resumed_(std::move(resumed)),
       command_handed_over_(std::move(command_handed_over)),
-      schedule_(bus.size()) {}
+      orders_(bus) {}
 
 std::string BusWorkDispatch::start() {
     sd_event_source* s = nullptr;
@@ -114,7 +114,7 @@ void BusWorkDispatch::schedule_work() {
 }
 
 void BusWorkDispatch::start_cycle(uint32_t status_reads) {
-    schedule_.start_cycle(status_reads, teensy_.is_open());
+    orders_.start_cycle(status_reads, teensy_.is_open());
     // The cycle's transfers are handed to the bus worker right here (a few microseconds: no
     // transfer runs on this thread), not in another event-loop iteration; unless the work has
     // stepped aside for the announcements, when it resumes after them.
@@ -127,19 +127,9 @@ void BusWorkDispatch::start_cycle(uint32_t status_reads) {
 }
 
 BusWorkDispatch::Work BusWorkDispatch::work_one() {
-    // While the bus is closed for recovery nothing is due on it: the recovery re-sends every
-    // order when it is back (resend_orders), and the next cycle marks the rest again.
-    const bool bus_usable = !bus_.recovering();
-    if (!bus_usable)
-        schedule_.drop_bus_work();
-    const OrderSchedule::Item item = schedule_.next(bus_usable);
-    switch (item.kind) {
+    switch (orders_.hand_over_next()) {
     case OrderSchedule::Kind::Order:
-        bus_.send_order(item.index, orders_[item.index]);
-        return Work::Transfer;
-    case OrderSchedule::Kind::Status:
-        bus_.read_status(item.index);
-        return Work::Transfer;
+    case OrderSchedule::Kind::Status: return Work::Transfer;
     case OrderSchedule::Kind::Teensy:
         teensy_.poll();
         return Work::Other;
@@ -150,35 +140,10 @@ BusWorkDispatch::Work BusWorkDispatch::work_one() {
 }
 
 void BusWorkDispatch::demand_changed(const MotorValues& orders) {
-    bool any_due = false;
-    for (size_t i = 0; i < bus_.size() && i < kMotorCount; ++i)
-        if (orders[i] != orders_[i] || bus_.ordered_value(i) != orders[i]) {
-            schedule_.mark_order(i);
-            any_due = true;
-        }
-    orders_ = orders;
-    if (any_due) {
+    if (orders_.demand_changed(orders)) {
         command_out_ = true;
         schedule_work();
     }
-}
-
-void BusWorkDispatch::zero_all(ZeroOrder where) {
-    // Behind: a command the client had sent reaches the wire before its zeros, so a one-shot
-    // `busctl call` moves the thrusters for a moment, whether or not its disconnect arrives
-    // before the loop sent the orders.
-    if (where == ZeroOrder::Behind)
-        for (size_t i = 0; !bus_.recovering() && schedule_.pop_order(i);)
-            bus_.send_order(i, orders_[i]);
-    orders_.fill(0);
-    schedule_.drop_orders();
-    bus_.zero_all(where);
-    bus_.wake_when_done();
-}
-
-void BusWorkDispatch::resend_orders() {
-    for (size_t i = 0; i < bus_.size() && i < kMotorCount; ++i)
-        bus_.send_order(i, orders_[i]);
 }
 
 } // namespace caracara

@@ -1,14 +1,13 @@
-// The bus work of the control loop's cycles: the one owner of the order schedule and of the
-// orders standing now. Runs below D-Bus: each I2C transfer is handed to the bus worker's
+// The bus work of the control loop's cycles, from its StandingOrders (the order schedule and
+// the orders standing now). Runs below D-Bus: each I2C transfer is handed to the bus worker's
 // thread (one at a time, so a new command's order is next in line) and the loop goes on
 // serving D-Bus, the kill switch and the timers while it is on the wire. The work steps
 // aside after each burst of orders and at the end of a cycle, so what is below it (the
 // announcements) runs even when the bus never rests. ControlLoop says when a cycle starts.
 #pragma once
 
-#include "core/motor_demand.hpp"
-#include "core/order_schedule.hpp"
 #include "daemon/bus/thruster_bus.hpp"
+#include "daemon/control/standing_orders.hpp"
 #include "daemon/safety/safety_lines.hpp"
 #include "daemon/teensy/teensy_port.hpp"
 #include "daemon/interfaces/demand_listener.hpp"
@@ -49,12 +48,12 @@ public:
     // Off until schedule_work(), after what is below the work (the announcements).
     void step_aside();
     void pause(); // off until schedule_work()
-    bool order_due() const { return schedule_.any_order_due(); }
-    bool nothing_due() const { return schedule_.empty(); }
+    bool order_due() const { return orders_.order_due(); }
+    bool nothing_due() const { return orders_.nothing_due(); }
 
     void demand_changed(const MotorValues& orders);
-    void zero_all(ZeroOrder where);
-    void resend_orders();
+    void zero_all(ZeroOrder where) { orders_.zero_all(where); }
+    void resend_orders() { orders_.resend(); }
 
 private:
     // Transfer: handed to the bus worker; Waiting: the worker still has one; Other: done here.
@@ -73,8 +72,7 @@ private:
     std::function<void()> command_handed_over_;
     const InputProbe* input_ = nullptr;
 
-    OrderSchedule schedule_;
-    MotorValues orders_{}; // what each thruster is to be ordered (Vehicle's last demand_changed)
+    StandingOrders orders_;
     bool command_out_ = false; // changed orders are being handed over: the loop hears of them at once
 
     SourcePtr work_source_;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <climits>
+#include <utility>
+#include <vector>
 
 namespace caracara {
 
@@ -9,8 +11,11 @@ namespace {
 int16_t clamp16(int32_t v) { return static_cast<int16_t>(std::clamp<int32_t>(v, INT16_MIN + 1, INT16_MAX)); }
 } // namespace
 
-dive::Sample DiveSampler::sample(uint32_t t_100us) const {
-    dive::Sample s;
+const dive::Sample& DiveSampler::sample(uint32_t t_100us) {
+    dive::Sample& s = sample_;
+    std::vector<uint16_t> room = std::move(s.distances); // its capacity, kept from the last sample
+    s = {};
+    s.distances = std::move(room);
     s.t_100us = t_100us;
     for (std::size_t i = 0; i < dive::kThrusters; ++i) {
         s.requested[i] = clamp16(vehicle_.requested_values()[i]);

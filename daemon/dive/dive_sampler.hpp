@@ -16,13 +16,15 @@ class DiveSampler {
 public:
     DiveSampler(const Vehicle& vehicle, const ThrusterBus& bus, const TeensyPort& teensy)
         : vehicle_(vehicle), bus_(bus), teensy_(teensy) {}
-    // `t_100us`: the time since the dive began, in 100 us.
-    dive::Sample sample(uint32_t t_100us) const;
+    // `t_100us`: the time since the dive began, in 100 us. Filled in place, valid until the
+    // next call: one sample a cycle, and no allocation for it (its distances keep their room).
+    const dive::Sample& sample(uint32_t t_100us);
 
 private:
     const Vehicle& vehicle_;
     const ThrusterBus& bus_;
     const TeensyPort& teensy_;
+    dive::Sample sample_;
 };
 
 } // namespace caracara

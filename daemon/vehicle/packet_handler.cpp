@@ -2,6 +2,7 @@
 
 #include "core/packet.hpp"
 #include "core/status_of.hpp"
+#include "daemon/vehicle/vehicle_condition.hpp"
 
 #include <array>
 #include <string>
@@ -23,12 +24,12 @@ Result PacketHandler::apply(std::span<const int32_t> words, std::string_view cli
         // The seed: a non-zero killState stops the motors until a zero is sent. Kill first,
         // then a power-off the same packet asks for.
         if (p.power_off)
-            return vehicle_.power_off(Vehicle::kPowerOffConfirmation);
+            return vehicle_.power_off(VehicleCondition::kPowerOffConfirmation);
         teensy_.set_leds(p.red, p.green, p.blue, nullptr);
         return {};
     }
     if (p.power_off)
-        return vehicle_.power_off(Vehicle::kPowerOffConfirmation);
+        return vehicle_.power_off(VehicleCondition::kPowerOffConfirmation);
     if (vehicle_.safety().state() == SafetyState::Killed) {
         if (vehicle_.safety().kill_source() != KillSource::Packet)
             return vehicle_.state_error();

@@ -4,8 +4,6 @@
 #include "core/status_of.hpp"
 #include "daemon/loop/log.hpp"
 
-#include <utility>
-
 namespace caracara {
 
 static_assert(DeadlineTimer::kNever == SafetyMachine::kNoDeadline);
@@ -31,11 +29,7 @@ void Vehicle::handle(const SafetyAction& a, const Result* kill) {
     }
     if (safety_.kill_output_asserted())
         motors_.end_surfacing(); // a kill ends an ascent at once
-    // A line that fails under the sequence (SafetyLines tells device_lost) is killed for once
-    // this sequence is done, not inside it.
-    in_sequence_ = true;
-    actuator_.carry_out(a, safety_.kill_output_asserted(), kill);
-    in_sequence_ = false;
+    losses_.during([&] { actuator_.carry_out(a, safety_.kill_output_asserted(), kill); });
     if (a.state_changed)
         changes |= kChangeState;
     if (a.command_stale)
@@ -43,14 +37,12 @@ void Vehicle::handle(const SafetyAction& a, const Result* kill) {
                  static_cast<unsigned long long>(config_.control.command_timeout_ms));
     events_.changed(changes);
     arm_deadline();
-    if (!lost_in_sequence_.empty())
-        device_lost(std::exchange(lost_in_sequence_, {}));
+    if (const std::string why = losses_.take(); !why.empty())
+        device_lost(why);
 }
 
 void Vehicle::device_lost(std::string_view why) {
-    if (in_sequence_)
-        lost_in_sequence_ = why;
-    else
+    if (!losses_.defer(why))
         kill(KillSource::Device, why);
 }
 
@@ -88,9 +80,8 @@ Result Vehicle::clear() {
 }
 
 Result Vehicle::power_off(std::string_view confirmation) {
-    if (confirmation != kPowerOffConfirmation)
-        return {Status::ConfirmationRequired,
-                std::string("power-off is irreversible: pass the confirmation string \"") + kPowerOffConfirmation + "\""};
+    if (Result r = VehicleCondition::power_off_refusal(confirmation); !r.ok())
+        return r;
     SafetyAction a = safety_.power_off(monotonic_ns());
     if (a.error == SafetyError::PoweredOff)
         return {Status::PoweredOff, a.message};

@@ -21,6 +21,7 @@
 #include "daemon/teensy/teensy_port.hpp"
 #include "daemon/interfaces/command_gate.hpp"
 #include "daemon/interfaces/demand_listener.hpp"
+#include "daemon/vehicle/device_loss_deferral.hpp"
 #include "daemon/vehicle/motor_commands.hpp"
 #include "daemon/vehicle/pilot_watch.hpp"
 #include "daemon/vehicle/vehicle_condition.hpp"
@@ -52,7 +53,6 @@ public:
     Result clear_kill();
     // A packet's "all clear" (killState 0): clears a kill only the packet made.
     Result clear_packet_kill() { return clear(); }
-    static constexpr const char* kPowerOffConfirmation = "power-off";
     Result power_off(std::string_view confirmation);
     // A packet's motor values, as SetThrust's.
     Result drive(const MotorValues& values, std::string_view client) { return motors_.accept(values, false, client); }
@@ -128,8 +128,7 @@ private:
     VehicleCondition condition_;
     PilotWatch pilots_;
     FailsafeGate* failsafes_ = nullptr;
-    bool in_sequence_ = false;      // the actuator is carrying out an action
-    std::string lost_in_sequence_;  // a device lost meanwhile: killed once it is done
+    DeviceLossDeferral losses_;
 };
 
 } // namespace caracara

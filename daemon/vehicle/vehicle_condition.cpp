@@ -37,6 +37,13 @@ Result VehicleCondition::clear_kill_refusal() const {
     return {};
 }
 
+Result VehicleCondition::power_off_refusal(std::string_view confirmation) {
+    if (confirmation == kPowerOffConfirmation)
+        return {};
+    return {Status::ConfirmationRequired,
+            std::string("power-off is irreversible: pass the confirmation string \"") + kPowerOffConfirmation + "\""};
+}
+
 std::string_view VehicleCondition::state_name() const {
     // A vehicle that could run but reaches none of its thrusters is in fault, whatever it was asked.
     const SafetyState s = safety_.state();

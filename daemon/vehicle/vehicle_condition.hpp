@@ -1,6 +1,6 @@
 // The vehicle's condition as callers see it, read from the safety machine, the bus, the
-// safety lines and the failsafes: why a command is refused (state_error), why a ClearKill is
-// refused, the state's name (fault when no thruster can be reached). Owned by Vehicle.
+// safety lines and the failsafes: why a command is refused (state_error), why a ClearKill or a
+// PowerOff is refused, the state's name (fault when no thruster can be reached). Owned by Vehicle.
 #pragma once
 
 #include "core/safety.hpp"
@@ -25,6 +25,9 @@ public:
     // Ok when nothing keeps a kill from being cleared (the bus, a thruster, the kill output,
     // a failsafe); the safety machine has the last word.
     Result clear_kill_refusal() const;
+    // Ok when `confirmation` is the one PowerOff asks for: power-off is irreversible.
+    static constexpr const char* kPowerOffConfirmation = "power-off";
+    static Result power_off_refusal(std::string_view confirmation);
     std::string_view state_name() const;
     std::string_view kill_source_name() const;
     int64_t command_age_ms() const;

@@ -2,6 +2,7 @@
 out while the bus work never rests (loop rate 0, cycles longer than the tick).
 """
 
+import time
 import unittest
 
 import dbus
@@ -79,6 +80,45 @@ class PropertiesChangedTest(VehicleTestCase):
         self.assertIn("Transactions", seen[BUS_PATH])
         self.assertIn("Frames", seen[TEENSY_PATH])
         self.assertEqual(set(seen), set(expected_iface), "every object announced its changes")
+
+
+class CoalescingTest(VehicleTestCase):
+    """One batch, one PropertiesChanged per object with everything it changed; the documented
+    rates kept under a command stream: the vehicle's values at each command, each thruster's
+    telemetry at 5 Hz with its counters (1 Hz) in the same signals."""
+
+    def setUp(self):
+        self.rig.reset()
+
+    def test_a_stream_announced_once_per_object_and_batch(self):
+        events = []
+
+        def on_signal(iface, changed, invalidated, path=None):
+            events.append((time.monotonic(), str(path), set(changed)))
+
+        match = self.rig.conn.add_signal_receiver(on_signal, signal_name="PropertiesChanged", dbus_interface=PROPS,
+                                                  bus_name=VEHICLE, path_keyword="path")
+        commands = 40
+        try:
+            start = time.monotonic()
+            for i in range(commands):  # 20 Hz, every motor changing at each command
+                self.rig.thrust([3000] * MOTORS if i % 2 else [-2000] * MOTORS)
+                pump_main_loop(0.05)
+            pump_main_loop(0.3)
+            seconds = time.monotonic() - start
+        finally:
+            match.remove()
+        vehicle = [c for _, p, c in events if p == ROOT]
+        values = [c for c in vehicle if c & {"MotorValues", "RequestedValues"}]
+        self.assertTrue(values, "no command announced")
+        for c in values:
+            self.assertLessEqual({"MotorValues", "RequestedValues"}, c, "a command's values split over signals")
+        ticks = 5 * seconds + 2  # the telemetry ticks the window can hold
+        self.assertLessEqual(len(vehicle), commands + ticks, "the vehicle announced more than once per batch")
+        for i in range(MOTORS):
+            n = sum(1 for _, p, _ in events if p == thruster_path(i))
+            self.assertGreaterEqual(n, 2, "thruster %d's telemetry not announced" % i)
+            self.assertLessEqual(n, ticks, "thruster %d announced past its 5 Hz telemetry" % i)
 
 
 class AnnouncementsAtLoopRateZeroTest(VehicleTestCase):

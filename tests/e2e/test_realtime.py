@@ -35,6 +35,27 @@ def status_kib(pid, key):
     raise AssertionError("%s not in /proc/%d/status" % (key, pid))
 
 
+def mappings(pid):
+    """/proc/<pid>/smaps as [{path, perms, size, rss (KiB), locked (VmFlags lo)}]."""
+    out = []
+    with open("/proc/%d/smaps" % pid) as f:
+        for line in f:
+            head = line.split()
+            if "-" in head[0] and len(head) >= 5 and ":" not in head[0]:
+                lo, hi = (int(x, 16) for x in head[0].split("-"))
+                out.append({"path": head[5] if len(head) > 5 else "", "perms": head[1], "size": (hi - lo) // 1024,
+                            "rss": 0, "locked": False})
+            elif head[0] == "Rss:":
+                out[-1]["rss"] = int(head[1])
+            elif head[0] == "VmFlags:":
+                out[-1]["locked"] = "lo" in head[1:]
+    return out
+
+
+def library(m, stem):
+    return os.path.basename(m["path"]).startswith(stem + ".so")
+
+
 def may_lock_memory():
     """As the daemon judges it (ThreadSchedule::lock_memory): RLIMIT_MEMLOCK unlimited, or
     CAP_IPC_LOCK (bit 14 of CapEff). Not so in a container that holds the limit (the Debian 13
@@ -107,6 +128,7 @@ class RealtimeTest(unittest.TestCase):
         elif may_lock_memory():
             self.assertGreater(status_kib(pid, "VmLck"), 1024, "memory not locked")
             self.assertIn("realtime: memory locked", rig.log())
+            self.check_cold_libraries_unlocked(rig, pid)
         else:
             self.assertEqual(status_kib(pid, "VmLck"), 0, "memory locked past RLIMIT_MEMLOCK")
             self.assertIn("realtime: memory not locked: RLIMIT_MEMLOCK", rig.log(),
@@ -116,6 +138,29 @@ class RealtimeTest(unittest.TestCase):
         rig.arm()
         rig.vcall("Kill")
         poll(lambda: rig.sim_get("KillOutput"), 5)
+
+    def check_cold_libraries_unlocked(self, rig, pid):
+        # The hot path's code (the daemon, libc, libstdc++, libsystemd) locked and resident
+        # whole; libsystemd's journal-file dependencies and the TOML parser neither locked nor
+        # faulted in; of libm, only the pages of lround() (docs/realtime.md).
+        maps = mappings(pid)
+        exe = os.path.realpath("/proc/%d/exe" % pid)
+        for stem in ("libc", "libstdc++", "libsystemd", exe):
+            text = [m for m in maps if (m["path"] == stem or library(m, stem)) and m["perms"] == "r-xp"]
+            self.assertTrue(text, "%s not mapped" % stem)
+            for m in text:
+                self.assertTrue(m["locked"] and m["rss"] == m["size"], "%s's code not locked whole: %r" % (stem, m))
+        cold = [m for m in maps if any(library(m, s) for s in ("libgcrypt", "libzstd", "libtomlplusplus"))
+                and m["perms"] == "r-xp"]
+        self.assertTrue(cold, "no cold library mapped: %r" % sorted({m["path"] for m in maps}))
+        for m in cold:
+            self.assertFalse(m["locked"], "a cold library locked: %r" % m)
+            self.assertLess(m["rss"], m["size"] // 2, "a cold library faulted in: %r" % m)
+        libm = [m for m in maps if library(m, "libm") and m["perms"] == "r-xp"]
+        two_pages = 2 * os.sysconf("SC_PAGE_SIZE") // 1024
+        self.assertEqual([(m["size"], m["rss"]) for m in libm if m["locked"]], [(two_pages, two_pages)],
+                         "lround's two pages of libm, locked: %r" % libm)
+        self.assertIn("KiB of libraries off the hot path left unlocked", rig.log())
 
     def test_configured_policy_and_priorities(self):
         rig = Rig(extra_config={"realtime": {"policy": "rr", "loop_priority": 21, "bus_priority": 12,
