@@ -36,7 +36,6 @@ NOT_YET_SPLIT = {
     "daemon/bus/bus_worker": 266,
     "daemon/vehicle/vehicle": 260,
     "tools/bridge/telemetry": 489,  # the channels' message builders to a class of their own
-    "tools/caracaractl/caracaractl": 497,  # the command table and its commands
 }
 
 survey = int(sys.argv[1]) if len(sys.argv) > 1 else None
