@@ -35,7 +35,6 @@ NOT_YET_SPLIT = {
     "daemon/control/bus_work_dispatch": 268,
     "daemon/bus/bus_worker": 266,
     "daemon/vehicle/vehicle": 260,
-    "tools/bridge/telemetry": 489,  # the channels' message builders to a class of their own
 }
 
 survey = int(sys.argv[1]) if len(sys.argv) > 1 else None
