@@ -32,7 +32,6 @@ EXCEPTIONS = {
 NOT_YET_SPLIT = {
     "daemon/commissioning/direction_detection": 306,  # DirectionFinding beside DirectionDetection
     "daemon/control/bus_work_dispatch": 268,
-    "daemon/bus/bus_worker": 266,
     "daemon/vehicle/vehicle": 260,
 }
 
