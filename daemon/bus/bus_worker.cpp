@@ -1,14 +1,12 @@
 #include "daemon/bus/bus_worker.hpp"
 
-#include <unistd.h>
-
 namespace caracara {
 
 namespace {
 constexpr std::size_t kWakeEvery = 16;
 } // namespace
 
-BusWorker::BusWorker(std::vector<std::unique_ptr<ThrusterDriver>>& drivers) : drivers_(drivers) {
+BusWorker::BusWorker(std::vector<std::unique_ptr<ThrusterDriver>>& drivers) : drivers_(drivers), transfer_(drivers) {
     for (const auto& d : drivers_) {
         views_.push_back(*d);
         published_.push_back(*d);
@@ -33,10 +31,10 @@ void BusWorker::stop() {
 
 void BusWorker::submit(const BusJob& in, bool replace) {
     BusJob job = in;
-    job.epoch = epoch_.load();
+    job.epoch = transfer_.epoch();
     if (!running()) {
         // Before the thread starts or after it stopped: on the caller's thread.
-        const BusJobDone d = transfer(job);
+        const BusJobDone d = transfer_.run(job);
         views_[job.index] = published_[job.index] = *drivers_[job.index];
         if (on_done_)
             on_done_(d);
@@ -68,7 +66,7 @@ void BusWorker::submit_first(std::span<const BusJob> jobs) {
     }
     {
         std::lock_guard lk(thread_.mutex());
-        outstanding_ -= queue_.replace_all(jobs, epoch_.load());
+        outstanding_ -= queue_.replace_all(jobs, transfer_.epoch());
     }
     outstanding_ += jobs.size();
     thread_.notify();
@@ -83,7 +81,7 @@ bool BusWorker::run_job(std::unique_lock<std::mutex>& lk) {
     const BusJob job = queue_.pop();
     busy_ = true;
     lk.unlock();
-    const BusJobDone d = transfer(job); // nothing held
+    const BusJobDone d = transfer_.run(job); // nothing held
     lk.lock();
     published_[job.index] = *drivers_[job.index];
     done_.push_back(d);
@@ -108,22 +106,6 @@ void BusWorker::wake_when_done() {
     owed_ = true;
     if (!done_.empty() && queue_.empty() && !busy_)
         thread_.wake_loop();
-}
-
-BusJobDone BusWorker::transfer(const BusJob& job) {
-    // A non-zero order from before the last kill is dropped here, at the last moment.
-    if (job.kind == BusJobKind::Order && job.value != 0 && job.epoch != epoch_.load())
-        return {job, IoError::None, true};
-    BusGate* gate = gate_.load();
-    // The thread's id, taken once: gettid() is a system call, and this runs for every transfer.
-    thread_local const pid_t self = ::gettid();
-    if (gate && !gate->enter(self))
-        return {job, IoError::None, true}; // the crash handler has the bus; the process is ending
-    ThrusterDriver& d = *drivers_[job.index];
-    const IoError e = job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
-    if (gate)
-        gate->leave();
-    return {job, e, false};
 }
 
 void BusWorker::deliver() {

@@ -7,12 +7,12 @@
 #pragma once
 
 #include "daemon/bus/bus_job_queue.hpp"
+#include "daemon/bus/bus_transfer.hpp"
 #include "daemon/loop/worker_thread.hpp"
 #include "drivers/devices/bus_gate.hpp"
 #include "drivers/devices/thruster_driver.hpp"
 #include "drivers/platform/event_loop.hpp"
 
-#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -51,13 +51,9 @@ public:
     void submit_first(std::span<const BusJob> jobs);
     // Drops what is queued but not yet on the wire (the bus is closed for recovery).
     void drop_queued();
-    // From now on, a non-zero order handed over before this call is not sent: a kill calls it
-    // before it writes the kill output, so no such order can follow the kill output onto the
-    // wire once the worker has seen it (at most the one whose transfer had already begun).
-    void hold_orders() { epoch_.fetch_add(1); }
-    // Every transfer enters `gate` (the emergency stop's), so a crash handler on another thread
-    // can keep this one off the wire while it sends its zeros. Null: no gate.
-    void set_gate(BusGate* gate) { gate_.store(gate); }
+    // A kill's fence and the emergency stop's gate: see BusTransfer.
+    void hold_orders() { transfer_.hold_orders(); }
+    void set_gate(BusGate* gate) { transfer_.set_gate(gate); }
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
     bool idle() const { return outstanding_ == 0; }
     // At once (the default): the loop is woken as soon as a batch is over. Otherwise it takes the
@@ -78,8 +74,6 @@ private:
     bool has_job() const override { return !queue_.empty(); }
     bool run_job(std::unique_lock<std::mutex>& lk) override;
     void deliver() override;
-    // The job's transfer, unless a kill overtook it (`skipped`) or the gate is closed.
-    BusJobDone transfer(const BusJob& job);
 
     std::vector<std::unique_ptr<ThrusterDriver>>& drivers_;
     std::vector<ThrusterDriver> views_;     // loop thread
@@ -87,8 +81,7 @@ private:
     std::size_t outstanding_ = 0;           // loop thread
     bool holding_wakeups_ = false;          // loop thread
     bool wakeup_owed_ = false;              // loop thread: a job was submitted while holding
-    std::atomic<uint64_t> epoch_{0};
-    std::atomic<BusGate*> gate_{nullptr};
+    BusTransfer transfer_;
 
     std::condition_variable finished_; // wait_idle: a job finished
     BusJobQueue queue_;                // under the lock

@@ -45,7 +45,7 @@ public:
     void zero_all(ZeroOrder where = ZeroOrder::First);
     // Before a kill's kill output: no non-zero order handed over earlier goes out after it.
     void hold_orders() { worker_.hold_orders(); }
-    // The emergency stop's gate: see BusWorker::set_gate.
+    // The emergency stop's gate: see BusTransfer::set_gate.
     void set_crash_gate(BusGate* gate) { worker_.set_gate(gate); }
     // Blocks until the worker is idle: at start-up and shutdown, where the zeros must be on the
     // wire before the daemon goes on.

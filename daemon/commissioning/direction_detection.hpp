@@ -11,8 +11,9 @@
 #pragma once
 
 #include "core/config.hpp"
-#include "core/direction_judgement.hpp"
 #include "core/status.hpp"
+#include "daemon/commissioning/attitude_samples.hpp"
+#include "daemon/commissioning/direction_findings.hpp"
 #include "daemon/failsafe/failsafe_monitor.hpp"
 #include "daemon/loop/completion.hpp"
 #include "daemon/loop/deadline_timer.hpp"
@@ -24,15 +25,8 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
-#include <vector>
 
 namespace caracara {
-
-// One thruster's finding: the judgement and the attitude change (yaw, pitch, roll, rad) it is on.
-struct DirectionFinding {
-    DirectionJudgement judgement;
-    std::array<double, 3> change{};
-};
 
 class DirectionDetection final {
 public:
@@ -47,15 +41,11 @@ public:
     bool running() const { return phase_ != Phase::Idle; }
     // The thruster being pulsed now, or -1.
     int32_t pulsing() const { return phase_ == Phase::Pulse ? static_cast<int32_t>(motor_) : -1; }
-    const std::array<DirectionFinding, kMotorCount>& findings() const { return findings_; }
-    std::string fragment() const;
+    const std::array<DirectionFinding, kMotorCount>& findings() const { return findings_.all(); }
+    std::string fragment() const { return findings_.fragment(); }
 
 private:
     enum class Phase : uint8_t { Idle, Settle, Pulse };
-    struct Sample {
-        uint64_t t_ns;
-        std::array<double, 3> att;
-    };
 
     void step();
     void settle_step(uint64_t now);
@@ -75,9 +65,9 @@ private:
     std::string client_;
     Completion done_;
     uint64_t phase_start_ns_ = 0;
-    std::vector<Sample> samples_;
-    std::array<double, 3> baseline_{}; // rad: the still window's mean
-    std::array<DirectionFinding, kMotorCount> findings_{};
+    AttitudeSamples samples_;
+    AttitudeSamples::Attitude baseline_{}; // rad: the still window's mean
+    DirectionFindings findings_;
 };
 
 } // namespace caracara

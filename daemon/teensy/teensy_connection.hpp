@@ -1,16 +1,19 @@
 // The connection to the Teensy over SPI: the node, the link and the TeensyWorker whose thread
-// carries every frame, so a slow or hung Teensy never holds the loop. Polls orientation and
-// distances one frame per cycle; hands a command's frame over and gives its Result back later.
-// The link is lost (told to its CommandGate: the failsafes kill, as teensy-link-lost) when the
-// device goes away (ENODEV: asked for again once a second), when a fitted Teensy is absent at
-// start, or when no valid frame came back for [spi] silence_ms of asking (busy for ever, no
-// answer, garbage); it is back at the next valid frame. The commands themselves are TeensyPort's, the Turn handshake TeensyTurn's.
+// carries every frame, so a slow or hung Teensy never holds the loop. Its TeensyPoll asks one
+// frame a cycle; a command's frame is handed over and its Result given back later. The link is
+// lost (told to its CommandGate: the failsafes kill, as teensy-link-lost) when the device goes
+// away (ENODEV: its TeensyReopen asks for it again once a second), when a fitted Teensy is absent
+// at start, or when no valid frame came back for [spi] silence_ms of asking (busy for ever, no
+// answer, garbage); it is back at the next valid frame. The commands themselves are TeensyPort's,
+// the Turn handshake TeensyTurn's.
 #pragma once
 
 #include "core/config.hpp"
 #include "core/status.hpp"
 #include "daemon/loop/completion.hpp"
 #include "daemon/teensy/teensy_link_watch.hpp"
+#include "daemon/teensy/teensy_poll.hpp"
+#include "daemon/teensy/teensy_reopen.hpp"
 #include "daemon/teensy/teensy_telemetry.hpp"
 #include "daemon/teensy/teensy_worker.hpp"
 #include "daemon/interfaces/command_gate.hpp"
@@ -20,17 +23,11 @@
 #include "drivers/platform/spi_dev.hpp"
 #include "drivers/protocol/teensy_codec.hpp"
 
-#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
-#include <string_view>
-#include <vector>
 
 namespace caracara {
-
-// The link's error as a Result naming the frame (`what`).
-Result teensy_result(teensy::TeensyError e, std::string_view what);
 
 class TeensyConnection {
 public:
@@ -51,8 +48,7 @@ public:
     bool link_lost() const { return watch_.loss() != TeensyLoss::None; }
     TeensyLoss loss() const { return watch_.loss(); }
 
-    // One frame: the three orientation axes, then one distance sensor, in turn; handed to the
-    // worker unless the last one is still out (a slow Teensy is polled as fast as it answers).
+    // The cycle's poll frame (TeensyPoll), unless the last one is still out.
     void poll();
     // Hands `frame` (run on the worker, returning the link's error) over; `done` gets its Result.
     void command(std::function<teensy::TeensyError()> frame, std::string what, Completion done);
@@ -64,15 +60,7 @@ public:
     const TeensyLinkCounters& counters() const { return worker_.counters(); }
 
 private:
-    struct PollResult {
-        unsigned slot = 0;
-        unsigned sensor = 0;
-        bool ok = false;
-        double value = 0;
-        int err = 0;
-    };
-    static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
-    void poll_done();
+    void polled(TeensyPoll::Outcome outcome);
     // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, told to the
     // gate (the wheels cannot be stopped: the failsafes kill), and asked for again once a second.
     void lose_link();
@@ -81,7 +69,8 @@ private:
     int io_errno(teensy::TeensyError e) const; // the worker's: the failed transfer's errno, or 0
     // A valid frame came back (`now`): a lost link is back.
     void heard(uint64_t now);
-    void schedule_reopen();
+    // The device opened again after it was gone or absent.
+    void reopened();
 
     sd_event* event_;
     CommandGate& gate_;
@@ -91,10 +80,8 @@ private:
     bool open_ = false; // loop thread: the SPI node is open (as far as the loop knows)
     TeensyLinkWatch watch_; // loop thread
     TeensyTelemetry tm_;
-    unsigned poll_index_ = 0;
-    bool poll_out_ = false;
-    PollResult poll_; // the worker's while a poll is out
-    SourcePtr reopen_timer_;
+    TeensyPoll poll_;
+    TeensyReopen reopen_;
     std::function<void()> on_lost_;
     std::function<void()> on_back_;
 };

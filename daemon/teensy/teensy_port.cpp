@@ -74,7 +74,7 @@ Result TeensyPort::set_speed(int left, int right, std::string_view client, Compl
             return r;
         // Range first: a refused command changes nothing, not even who commands.
         if (auto e = teensy::encode_set_speed(left, right).error; e != teensy::TeensyError::None)
-            return teensy_result(e, "Set Speed");
+            return teensy::result_of(e, "Set Speed");
         if (Result r = gate_.accept_command(client); !r.ok())
             return r;
     }

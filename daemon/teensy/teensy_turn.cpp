@@ -65,10 +65,10 @@ void TeensyTurn::step() {
                                     case teensy::ConfirmHandshake::Action::Send: // advance() never stops on a Send
                                     case teensy::ConfirmHandshake::Action::Failed:
                                     case teensy::ConfirmHandshake::Action::Idle:
-                                        finish(teensy_result(step_.error == teensy::TeensyError::None
-                                                                 ? teensy::TeensyError::LinkError
-                                                                 : step_.error,
-                                                             "turn confirmation"));
+                                        finish(teensy::result_of(step_.error == teensy::TeensyError::None
+                                                                     ? teensy::TeensyError::LinkError
+                                                                     : step_.error,
+                                                                 "turn confirmation"));
                                         return;
                                     }
                                 });

@@ -215,4 +215,10 @@ Status status_of(TeensyError e) {
     return Status::LinkError;
 }
 
+Result result_of(TeensyError e, std::string_view what) {
+    if (e == TeensyError::None)
+        return {};
+    return {status_of(e), std::string(what) + ": " + std::string(teensy_error_name(e))};
+}
+
 } // namespace caracara::teensy

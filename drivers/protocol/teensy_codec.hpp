@@ -116,6 +116,8 @@ namespace caracara::teensy {
 inline std::string_view teensy_error_name(TeensyError v) { return name_of(v); }
 // The Status a caller gets for it (core/status.cpp names it).
 Status status_of(TeensyError e);
+// The Result a caller gets for a frame (`what`) that ended in `e`: its status, "<what>: <error>".
+Result result_of(TeensyError e, std::string_view what);
 
 // A value or the reason there is none. (std::expected is C++23.)
 template <typename T>

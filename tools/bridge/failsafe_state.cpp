@@ -6,10 +6,7 @@ namespace caracara::bridge {
 
 namespace {
 
-uint64_t unsigned_of(const client::Props& p, const char* name) {
-    const auto it = p.find(name);
-    return it == p.end() ? 0 : it->second.unsigned_integer();
-}
+uint64_t unsigned_of(const client::Props& p, const char* name) { return client::property(p, name).unsigned_integer(); }
 
 // Milliseconds from `now_us` to `until_us`, rounded up so that a running countdown never reads
 // 0 before its end; 0 once due, -1 when `until_us` is 0 (none runs).
@@ -23,11 +20,9 @@ int64_t left_ms(uint64_t until_us, uint64_t now_us) {
 
 std::vector<foxglove::ActiveFailsafe> failsafes(const client::Props& root) {
     std::vector<foxglove::ActiveFailsafe> out;
-    const auto it = root.find("Failsafes");
-    if (it != root.end())
-        for (const client::Value& f : it->second.items)
-            if (f.items.size() == 3)
-                out.push_back({f.items[0].s, f.items[1].s, f.items[2].integer()});
+    for (const client::Value& f : client::property(root, "Failsafes").items)
+        if (f.items.size() == 3)
+            out.push_back({f.items[0].s, f.items[1].s, f.items[2].integer()});
     return out;
 }
 

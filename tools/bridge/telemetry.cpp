@@ -1,7 +1,5 @@
 #include "tools/bridge/telemetry.hpp"
 
-#include "drivers/protocol/seabotix.hpp"
-#include "tools/bridge/failsafe_state.hpp"
 #include "tools/foxglove/channels.hpp"
 
 #include <boost/asio/post.hpp>
@@ -13,6 +11,7 @@
 namespace caracara::bridge {
 
 namespace fg = caracara::foxglove;
+using client::property;
 using client::Props;
 using client::Value;
 using fg::ChannelKind;
@@ -26,22 +25,6 @@ uint64_t now_ns() {
     timespec t{};
     clock_gettime(CLOCK_REALTIME, &t);
     return static_cast<uint64_t>(t.tv_sec) * 1'000'000'000u + static_cast<uint64_t>(t.tv_nsec);
-}
-
-const Value kNone;
-
-const Value& get(const Props& p, const char* name) {
-    const auto it = p.find(name);
-    return it == p.end() ? kNone : it->second;
-}
-
-std::string text(const Props& p, const char* name) { return get(p, name).s; }
-
-std::vector<int64_t> integers(const Value& v) {
-    std::vector<int64_t> out;
-    for (const Value& item : v.items)
-        out.push_back(item.integer());
-    return out;
 }
 
 // The thruster number of an object path, or -1.
@@ -96,8 +79,8 @@ Telemetry::~Telemetry() {
 
 void Telemetry::loaded() {
     const Props& root = props(kRoot, caracara::dbus::kVehicleIface);
-    follow_surfacing(root);
-    name_controller(text(root, "Controller"));
+    messages_.follow_surfacing(root, now_ns());
+    name_controller(property(root, "Controller").s);
 }
 
 void Telemetry::start() {
@@ -209,26 +192,26 @@ void Telemetry::changed(const std::string& path, const std::string& iface, const
             mark(fg::channel_position(ChannelKind::Motors));
         if (state)
             mark(fg::channel_position(ChannelKind::VehicleState));
-        follow_surfacing(stored);
+        messages_.follow_surfacing(stored, now_ns());
         if (changes.contains("Controller"))
-            name_controller(text(stored, "Controller"));
-        if (changes.contains("State") && text(before, "State") != text(stored, "State")) {
-            const std::string s = text(stored, "State");
-            const std::string source = text(stored, "KillSource");
+            name_controller(property(stored, "Controller").s);
+        if (changes.contains("State") && property(before, "State").s != property(stored, "State").s) {
+            const std::string s = property(stored, "State").s;
+            const std::string source = property(stored, "KillSource").s;
             const int level = s == "killed" || s == "powered-off" ? 3 : s == "fault" ? 4 : 2;
             log(level, s == "killed" ? "kill" : s == "arming" ? "arming" : "state",
                 s + (source.empty() ? "" : " (" + source + ")"));
         }
-        if (changes.contains("Profile") && text(before, "Profile") != text(stored, "Profile"))
-            log(2, "profile", "profile " + text(stored, "Profile"));
+        if (changes.contains("Profile") && property(before, "Profile").s != property(stored, "Profile").s)
+            log(2, "profile", "profile " + property(stored, "Profile").s);
     } else if (const int t = thruster_of(path); t >= 0) {
         mark(fg::channel_position(ChannelKind::Thruster, static_cast<unsigned>(t)));
         if (changes.contains("Faults")) {
             std::string list;
-            for (const Value& f : get(stored, "Faults").items)
+            for (const Value& f : property(stored, "Faults").items)
                 list += (list.empty() ? "" : ",") + f.s;
             std::string old;
-            for (const Value& f : get(before, "Faults").items)
+            for (const Value& f : property(before, "Faults").items)
                 old += (old.empty() ? "" : ",") + f.s;
             if (list != old)
                 log(list.empty() ? 2 : 4, "fault", "thruster " + std::to_string(t) + " faults: " + (list.empty() ? "none" : list));
@@ -239,26 +222,14 @@ void Telemetry::changed(const std::string& path, const std::string& iface, const
             mark(fg::channel_position(ChannelKind::Attitude));
     } else if (path == caracara::dbus::kBusPath) {
         mark(fg::channel_position(ChannelKind::I2cBus));
-        if (changes.contains("Recoveries") && get(before, "Recoveries").unsigned_integer() !=
-                                                   get(stored, "Recoveries").unsigned_integer())
-            log(2, "recovery", "I2C bus recoveries: " + std::to_string(get(stored, "Recoveries").unsigned_integer()));
+        if (changes.contains("Recoveries") && property(before, "Recoveries").unsigned_integer() !=
+                                                   property(stored, "Recoveries").unsigned_integer())
+            log(2, "recovery", "I2C bus recoveries: " + std::to_string(property(stored, "Recoveries").unsigned_integer()));
     }
 }
 
-void Telemetry::follow_surfacing(const Props& root) {
-    const std::string state = text(root, "State");
-    bool surfacing = false;
-    if (state != "killed" && state != "powered-off")
-        for (const fg::ActiveFailsafe& f : failsafes(root))
-            surfacing = surfacing || f.action == "surface";
-    if (!surfacing)
-        surfacing_since_ = 0;
-    else if (!surfacing_since_)
-        surfacing_since_ = now_ns();
-}
-
 void Telemetry::name_controller(const std::string& unique_name) {
-    controller_ = {unique_name, ""};
+    messages_.controller_changed(unique_name);
     controller_slot_.reset();
     if (unique_name.empty() || !client_)
         return;
@@ -279,9 +250,10 @@ int Telemetry::on_controller_pid(sd_bus_message* m, void* userdata, sd_bus_error
         return 0;
     const std::string name = process_name(pid);
     // Each browser tab or Foxglove client of this bridge commands through a connection of its own.
-    self->controller_.words = pid == static_cast<uint32_t>(getpid()) ? "a cockpit or Foxglove client of this bridge"
-                              : name.empty()                          ? "process " + std::to_string(pid)
-                                                                      : name + " (pid " + std::to_string(pid) + ")";
+    self->messages_.describe_controller(pid == static_cast<uint32_t>(getpid())
+                                            ? "a cockpit or Foxglove client of this bridge"
+                                        : name.empty() ? "process " + std::to_string(pid)
+                                                       : name + " (pid " + std::to_string(pid) + ")");
     self->mark(fg::channel_position(ChannelKind::VehicleState));
     return 0;
 }
@@ -311,101 +283,13 @@ void Telemetry::flush() {
     const uint64_t now = now_ns();
     const std::set<std::size_t> dirty = std::move(dirty_);
     dirty_.clear();
-    for (const std::size_t c : dirty)
-        build(c, now);
-}
-
-void Telemetry::build(std::size_t channel, uint64_t now) {
-    const fg::ChannelInfo& info = fg::channels()[channel];
-    std::string json;
-    switch (info.kind) {
-    case ChannelKind::VehicleState: {
-        const Props& p = props(kRoot, caracara::dbus::kVehicleIface);
-        const std::string controller = text(p, "Controller");
-        fg::VehicleState s{text(p, "State"), text(p, "KillSource"), text(p, "Profile"),
-                           get(p, "ProfileFactor").number(), get(p, "BudgetLimit").integer(),
-                           get(p, "Saturated").boolean(), get(p, "CommandAgeMs").integer(), controller,
-                           controller == controller_.unique_name ? controller_.words : "", {}, failsafes(p),
-                           surfacing_since_ ? static_cast<int64_t>((now - surfacing_since_) / 1'000'000u) : -1};
-        const Value& leds = get(p, "Leds");
-        for (std::size_t i = 0; i < 3 && i < leds.items.size(); ++i)
-            s.leds[i] = leds.items[i].integer();
-        add_time_left(p, s);
-        if (const Value& test = get(p, "MotorTest"); test.items.size() == 2) {
-            s.motor_test_thruster = test.items[0].integer();
-            s.motor_test_value = test.items[1].integer();
-        }
-        s.motor_test_limit = get(p, "MotorTestLimit").integer();
-        json = fg::to_json(s);
-        break;
+    for (const std::size_t c : dirty) {
+        std::optional<std::string> json = messages_.build(c, now);
+        if (!json)
+            continue;
+        latest_[c] = std::make_shared<const std::string>(std::move(*json));
+        publish_(c, now, latest_[c]);
     }
-    case ChannelKind::Motors: {
-        const Props& p = props(kRoot, caracara::dbus::kVehicleIface);
-        fg::Motors m;
-        const auto applied = integers(get(p, "MotorValues")), requested = integers(get(p, "RequestedValues"));
-        for (std::size_t i = 0; i < fg::kThrusters; ++i) {
-            m.applied[i] = i < applied.size() ? applied[i] : 0;
-            m.requested[i] = i < requested.size() ? requested[i] : 0;
-        }
-        json = fg::to_json(m);
-        break;
-    }
-    case ChannelKind::Thruster: {
-        const Props& p = props(kThrusterPrefix + std::to_string(info.index), caracara::dbus::kThrusterIface);
-        fg::Thruster t;
-        t.index = info.index;
-        t.reachable = get(p, "Online").boolean();
-        const auto speed = caracara::speed_to_motor(static_cast<uint8_t>(get(p, "ActualSpeed").unsigned_integer()));
-        t.speed = speed ? *speed : 0;
-        t.ordered_value = get(p, "OrderedValue").integer();
-        t.current = get(p, "Current").number();
-        t.temperature = get(p, "Temperature").number();
-        for (const Value& f : get(p, "Faults").items) {
-            t.faults.push_back(f.s);
-            for (const auto fault : caracara::kAllFaults)
-                if (caracara::fault_name(fault) == f.s)
-                    t.fault_bits |= 1u << static_cast<unsigned>(fault);
-        }
-        json = fg::to_json(t);
-        break;
-    }
-    case ChannelKind::Teensy:
-    case ChannelKind::Attitude: {
-        const Props& p = props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface);
-        fg::Teensy t;
-        const Value& o = get(p, "Orientation");
-        if (o.items.size() == 3) {
-            t.yaw = o.items[0].number();
-            t.pitch = o.items[1].number();
-            t.roll = o.items[2].number();
-        }
-        if (info.kind == ChannelKind::Attitude) {
-            json = fg::attitude_json(now, t.yaw, t.pitch, t.roll);
-            break;
-        }
-        t.online = get(p, "Online").boolean();
-        t.distances = integers(get(p, "Distances"));
-        t.servos = integers(get(p, "Servos"));
-        t.task = text(p, "Task");
-        t.frames = get(p, "Frames").unsigned_integer();
-        t.busy_retries = get(p, "BusyRetries").unsigned_integer();
-        t.link_errors = get(p, "LinkErrors").unsigned_integer();
-        json = fg::to_json(t);
-        break;
-    }
-    case ChannelKind::I2cBus: {
-        const Props& p = props(caracara::dbus::kBusPath, caracara::dbus::kBusIface);
-        fg::I2cBus b{text(p, "State"), get(p, "Transactions").unsigned_integer(), get(p, "Errors").unsigned_integer(),
-                     get(p, "Recoveries").unsigned_integer(), get(p, "RecoveryFailures").unsigned_integer(),
-                     text(p, "LastError")};
-        json = fg::to_json(b);
-        break;
-    }
-    case ChannelKind::Events:
-        return;
-    }
-    latest_[channel] = std::make_shared<const std::string>(std::move(json));
-    publish_(channel, now, latest_[channel]);
 }
 
 } // namespace caracara::bridge

@@ -1,12 +1,13 @@
 // The bridge's one reading connection to caracarad: the vehicle's objects (GetManagedObjects),
 // kept current by PropertiesChanged and turned into the Foxglove channels' messages
-// (tools/foxglove/channels.hpp) as they change, which is at the daemon's telemetry rate for
-// the telemetry properties. Kills, faults, bus losses and recoveries, arming and failsafes
+// (tools/bridge/channel_message_builder.hpp) as they change, which is at the daemon's telemetry
+// rate for the telemetry properties. Kills, faults, bus losses and recoveries, arming and failsafes
 // become foxglove.Log messages on /events. Reading needs no privilege; commands go through each
 // client's own connection (tools/bridge/command_link.hpp).
 #pragma once
 
 #include "tools/bridge/bus_watch.hpp"
+#include "tools/bridge/channel_message_builder.hpp"
 #include "tools/client/client.hpp"
 #include "tools/client/object_mirror.hpp"
 
@@ -38,8 +39,6 @@ public:
 private:
     static int on_vehicle_signal(sd_bus_message* m, void* userdata, sd_bus_error* error);
     static int on_controller_pid(sd_bus_message* m, void* userdata, sd_bus_error* error);
-    // When a surface failsafe's ascent began (surfacing_ms in the state), from the root's properties.
-    void follow_surfacing(const client::Props& root);
     // The controller in words: its process, asked of the bus daemon (controller_name in the state).
     void name_controller(const std::string& unique_name);
     void reload();
@@ -50,7 +49,6 @@ private:
                  const client::Props& before);
     void mark(std::size_t channel);
     void flush();
-    void build(std::size_t channel, uint64_t now);
     void log(int level, const std::string& name, const std::string& message);
     const client::Props& props(const std::string& path, const char* iface) const { return mirror_.props(path, iface); }
 
@@ -64,11 +62,8 @@ private:
     client::ObjectMirror mirror_;
     std::set<std::size_t> dirty_;
     bool flush_posted_ = false;
+    ChannelMessageBuilder messages_{mirror_};
     std::vector<Payload> latest_;
-    uint64_t surfacing_since_ = 0; // CLOCK_REALTIME ns; 0 not surfacing
-    struct ControllerName {
-        std::string unique_name, words;
-    } controller_;
     caracara::dbus::SlotPtr controller_slot_;
     std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

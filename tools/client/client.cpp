@@ -134,6 +134,12 @@ Props to_props(const Value& dict) {
     return props;
 }
 
+const Value& property(const Props& props, const std::string& name) {
+    static const Value none;
+    const auto it = props.find(name);
+    return it == props.end() ? none : it->second;
+}
+
 sd_bus* Client::bus() {
     if (!bus_) {
         const bool remote = choice_.kind == caracara::dbus::BusChoice::Kind::Remote;

@@ -70,6 +70,8 @@ using Objects = std::map<std::string, Interfaces>;         // object path -> int
 Value read_value(sd_bus_message* m);
 // Turns a decoded a{sv} into a map.
 Props to_props(const Value& dict);
+// The property `name` of `props`, a None value when there is none.
+const Value& property(const Props& props, const std::string& name);
 
 class Client {
 public:

@@ -1,0 +1,14 @@
+// caracaractl's held motion commands: thrust, motion and packet, kept alive by re-sending
+// (tools/caracaractl/hold.hpp) until ^C, --for or --once. Each is a Command's run.
+#pragma once
+
+#include "tools/caracaractl/command.hpp"
+
+namespace caracara::ctl {
+
+CommandRun cmd_thrust;
+CommandRun cmd_motion;
+// A packet that kills or powers off is sent once, whatever --for says.
+CommandRun cmd_packet;
+
+} // namespace caracara::ctl
