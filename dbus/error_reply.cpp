@@ -19,16 +19,26 @@ int reply(sd_bus_message* call, const Result& result) {
     return r;
 }
 
-int new_method_return(sd_bus_message* call, MessagePtr& out) {
-    sd_bus_message* m = nullptr;
-    const int r = sd_bus_message_new_method_return(call, &m);
-    out.reset(r < 0 ? nullptr : m);
-    return r;
-}
-
 Completion reply_later(sd_bus_message* call) {
     auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(call), sd_bus_message_unref);
     return [held](const Result& result) { reply(held.get(), result); };
+}
+
+Completion reply_filled_later(sd_bus_message* call, std::function<int(sd_bus_message* out)> fill) {
+    auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(call), sd_bus_message_unref);
+    return [held, fill = std::move(fill)](const Result& result) {
+        if (!result.ok()) {
+            reply(held.get(), result);
+            return;
+        }
+        sd_bus_message* m = nullptr;
+        int r = sd_bus_message_new_method_return(held.get(), &m);
+        MessagePtr out(r < 0 ? nullptr : m);
+        if (r >= 0)
+            r = fill(out.get());
+        if (r < 0 || sd_bus_send(nullptr, out.get(), nullptr) < 0)
+            reply(held.get(), Result{Status::Hardware, "cannot build the reply"});
+    };
 }
 
 } // namespace caracara::dbus

@@ -6,6 +6,7 @@
 #include "daemon/loop/completion.hpp"
 #include "drivers/sdbus/sdbus.hpp"
 
+#include <functional>
 #include <string>
 #include <systemd/sd-bus.h>
 
@@ -23,7 +24,8 @@ int reply(sd_bus_message* call, const Result& result);
 // The reply to `call` as a Completion, for the daemon to hand the result back later; the
 // handler then returns 1 (the reply is on its way).
 Completion reply_later(sd_bus_message* call);
-// An empty method return for `call`, to be filled and sent (DetectDirections, Preflight): 0 or -errno.
-int new_method_return(sd_bus_message* call, MessagePtr& out);
+// The reply to `call` as a Completion whose success carries values: `fill` appends them to the
+// method return (0 or -errno); a failure, or a reply that cannot be built, is the error.
+Completion reply_filled_later(sd_bus_message* call, std::function<int(sd_bus_message* out)> fill);
 
 } // namespace caracara::dbus

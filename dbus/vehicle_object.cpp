@@ -1,6 +1,7 @@
 #include "dbus/vehicle_object.hpp"
 
 #include "dbus/announcer.hpp"
+#include "dbus/directions_reply.hpp"
 #include "dbus/error_reply.hpp"
 #include "dbus/preflight_reply.hpp"
 #include "dbus/vehicle_names.hpp"
@@ -107,35 +108,8 @@ int m_motor_test(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return reply(m, static_cast<Parts*>(userdata)->motor_test.run(thruster, value, sender(m)));
 }
 
-// Replied to when the detection ends: each thruster's (verdict, yaw, pitch, roll change, change
-// along its row, margin) and the fragment, or the error that ended it.
-int reply_directions(sd_bus_message* call, const DirectionDetection& d) {
-    MessagePtr out;
-    int r = new_method_return(call, out);
-    if (r < 0)
-        return r;
-    sd_bus_message* m = out.get();
-    if ((r = sd_bus_message_open_container(m, 'a', "(sddddd)")) < 0)
-        return r;
-    for (const DirectionFinding& f : d.findings()) {
-        const std::string verdict(verdict_name(f.judgement.verdict));
-        if ((r = sd_bus_message_append(m, "(sddddd)", verdict.c_str(), f.change[0], f.change[1], f.change[2],
-                                       f.judgement.along, f.judgement.margin)) < 0)
-            return r;
-    }
-    if ((r = sd_bus_message_close_container(m)) < 0 || (r = sd_bus_message_append(m, "s", d.fragment().c_str())) < 0)
-        return r;
-    return sd_bus_send(nullptr, m, nullptr);
-}
-
 int m_detect_directions(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    DirectionDetection& d = static_cast<Parts*>(userdata)->directions;
-    auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
-    d.run(sender(m), [held, &d](const Result& r) {
-        if (!r.ok() || reply_directions(held.get(), d) < 0)
-            reply(held.get(), r.ok() ? Result{Status::Hardware, "cannot build the reply"} : r);
-    });
-    return 1;
+    return run_detection(m, static_cast<Parts*>(userdata)->directions, sender(m));
 }
 
 int m_preflight(sd_bus_message* m, void* userdata, sd_bus_error*) {
