@@ -78,7 +78,8 @@ std::string VehicleDaemon::start() {
         dive_writer_ = std::make_unique<DiveWriter>(config_.recorder.directory,
                                                     uint64_t(config_.recorder.max_total_mb) << 20);
         dive_writer_->start();
-        recorder_ = std::make_unique<DiveRecorder>(config_, vehicle_, bus_, teensy_, events_, *dive_writer_);
+        recorder_ = std::make_unique<DiveRecorder>(config_, vehicle_, bus_, teensy_, events_, *dive_writer_,
+                                                   motor_test_, directions_);
         events_.attach_recorder(recorder_.get());
         recorder_->start();
     }

@@ -25,8 +25,10 @@ uint64_t unix_ms() {
 } // namespace
 
 DiveRecorder::DiveRecorder(const DaemonConfig& config, const Vehicle& vehicle, const ThrusterBus& bus,
-                           const TeensyPort& teensy, const VehicleEvents& events, DiveWriter& writer)
-    : config_(config), vehicle_(vehicle), bus_(bus), events_(events), writer_(writer), sampler_(vehicle, bus, teensy) {}
+                           const TeensyPort& teensy, const VehicleEvents& events, DiveWriter& writer,
+                           const MotorTest& motor_test, const DirectionDetection& detection)
+    : config_(config), vehicle_(vehicle), bus_(bus), events_(events), writer_(writer), sampler_(vehicle, bus, teensy),
+      commissioning_(vehicle, motor_test, detection) {}
 
 void DiveRecorder::start() {
     started_ = true;
@@ -61,6 +63,7 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
     writer_.open(dive_file_name(wall), dive::encode_header(h));
     for (std::size_t i = 0; i < faults_.size() && i < bus_.size(); ++i)
         faults_[i] = bus_.health().faults(i).bits;
+    commissioning_.reset();
     // The state it starts in, with who asked for it.
     dive::Event e;
     e.kind = dive::EventKind::State;
@@ -71,6 +74,8 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
 }
 
 void DiveRecorder::finish(uint64_t now_ns, const std::string& reason) {
+    commissioning_.close(pending_);
+    add_commissioning(now_ns);
     dive::encode_sample(records_, sampler_.sample(since_start(now_ns))); // the zeros the dive ends with
     dive::encode_end(records_, {since_start(now_ns), reason});
     flush();
@@ -87,6 +92,12 @@ void DiveRecorder::flush() {
 void DiveRecorder::add_event(dive::Event e, uint64_t now_ns) {
     e.t_100us = since_start(now_ns);
     dive::encode_event(records_, e);
+}
+
+void DiveRecorder::add_commissioning(uint64_t now_ns) {
+    for (dive::Event& e : pending_)
+        add_event(std::move(e), now_ns);
+    pending_.clear();
 }
 
 void DiveRecorder::vehicle_changed(uint32_t changes) {
@@ -170,6 +181,8 @@ void DiveRecorder::bus_restored(uint32_t pulses, double milliseconds) {
 void DiveRecorder::cycle(uint64_t now_ns) {
     if (!recording_)
         return;
+    commissioning_.poll(pending_);
+    add_commissioning(now_ns);
     dive::encode_sample(records_, sampler_.sample(since_start(now_ns)));
     if (now_ns - last_flush_ns_ >= kFlushPeriodNs || records_.size() >= kFlushBytes) {
         last_flush_ns_ = now_ns;

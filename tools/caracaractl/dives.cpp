@@ -1,5 +1,6 @@
 #include "tools/caracaractl/dives.hpp"
 
+#include "core/direction_judgement.hpp"
 #include "core/dive_format.hpp"
 #include "core/safety.hpp"
 #include "drivers/platform/dive_files.hpp"
@@ -159,6 +160,16 @@ std::string describe(const dive::Event& e) {
     case dive::EventKind::Failsafe:
         return strf("%s %s%s", e.text.c_str(), (e.value & dive::kFailsafeRaised) ? "raised" : "cleared",
                     (e.value & dive::kFailsafeVehicle) ? "" : strf(" thruster=%u", e.thruster).c_str());
+    case dive::EventKind::MotorTest:
+    case dive::EventKind::DetectionPulse:
+        return (e.value & dive::kOn) ? strf("thruster=%u value=%.0f", e.thruster, e.number)
+                                     : strf("thruster=%u stopped", e.thruster);
+    case dive::EventKind::Detection:
+        return (e.value & dive::kOn) ? std::string("started") : strf("ended judged=%.0f", e.number);
+    case dive::EventKind::DetectionResult:
+        return strf("thruster=%u verdict=%s margin=%.2f %s", e.thruster,
+                    std::string(caracara::verdict_name(static_cast<caracara::DirectionVerdict>(e.value))).c_str(),
+                    e.number, e.text.c_str());
     }
     return "";
 }
