@@ -30,3 +30,13 @@ set_tests_properties(e2e_dives PROPERTIES
                      ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
                      TIMEOUT 600
                      LABELS e2e)
+
+# Motor tests and a direction detection run in the dive, at the wire's times, and the detection's
+# plot (tests/dives/test_commissioning_dive.py).
+add_test(NAME e2e_commissioning_dive
+         COMMAND /usr/bin/python3 -m unittest -v test_commissioning_dive
+         WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR}/../dives)
+set_tests_properties(e2e_commissioning_dive PROPERTIES
+                     ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
+                     TIMEOUT 600
+                     LABELS e2e)
