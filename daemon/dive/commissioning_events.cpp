@@ -31,6 +31,7 @@ void CommissioningEvents::poll(std::vector<dive::Event>& out) {
 }
 
 void CommissioningEvents::close(std::vector<dive::Event>& out) {
+    poll(out); // what changed since the last cycle (a run that ended just before the kill)
     if (test_thruster_ >= 0)
         out.push_back(event(dive::EventKind::MotorTest, test_thruster_, 0, 0));
     test_thruster_ = -1;
