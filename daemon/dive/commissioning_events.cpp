@@ -17,6 +17,10 @@ dive::Event event(dive::EventKind kind, int32_t thruster, uint32_t value, double
 
 } // namespace
 
+CommissioningEvents::CommissioningEvents(const Vehicle& vehicle, const MotorTest& motor_test,
+                                         const DirectionDetection& detection)
+    : vehicle_(vehicle), motor_test_(motor_test), detection_(detection) {}
+
 void CommissioningEvents::reset() {
     test_thruster_ = -1;
     test_value_ = 0;

@@ -19,8 +19,7 @@ namespace caracara {
 
 class CommissioningEvents {
 public:
-    CommissioningEvents(const Vehicle& vehicle, const MotorTest& motor_test, const DirectionDetection& detection)
-        : vehicle_(vehicle), motor_test_(motor_test), detection_(detection) {}
+    CommissioningEvents(const Vehicle& vehicle, const MotorTest& motor_test, const DirectionDetection& detection);
 
     // A dive begins: what runs now is news to it.
     void reset();

@@ -22,21 +22,15 @@ endforeach()
 set_tests_properties(e2e_direction_detection PROPERTIES TIMEOUT 1200)
 
 # The dive recorder: a dive listed and plotted, bad dive files refused, and the regression dives
-# of tests/dives replayed against their expected output (tests/dives/test_dives.py).
-add_test(NAME e2e_dives
-         COMMAND /usr/bin/python3 -m unittest -v test_dives
-         WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR}/../dives)
-set_tests_properties(e2e_dives PROPERTIES
-                     ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
-                     TIMEOUT 600
-                     LABELS e2e)
-
-# Motor tests and a direction detection run in the dive, at the wire's times, and the detection's
-# plot (tests/dives/test_commissioning_dive.py).
-add_test(NAME e2e_commissioning_dive
-         COMMAND /usr/bin/python3 -m unittest -v test_commissioning_dive
-         WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR}/../dives)
-set_tests_properties(e2e_commissioning_dive PROPERTIES
-                     ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
-                     TIMEOUT 600
-                     LABELS e2e)
+# of tests/dives replayed against their expected output (tests/dives/test_dives.py); motor tests
+# and a direction detection run in the dive at the wire's times, and the detection's plot
+# (tests/dives/test_commissioning_dive.py).
+foreach(name dives commissioning_dive)
+  add_test(NAME e2e_${name}
+           COMMAND /usr/bin/python3 -m unittest -v test_${name}
+           WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR}/../dives)
+  set_tests_properties(e2e_${name} PROPERTIES
+                       ENVIRONMENT "CARACARA_BUILD_DIR=${CMAKE_BINARY_DIR};PYTHONDONTWRITEBYTECODE=1;${CARACARA_TEST_ENV}"
+                       TIMEOUT 600
+                       LABELS e2e)
+endforeach()

@@ -176,12 +176,10 @@ def main():
         Image.open(buf).convert("RGB").quantize(colors=64).save(a.out, optimize=True)
     else:
         fig.savefig(a.out)
-    return 0
 
 
 if __name__ == "__main__":
     try:
-        sys.exit(main())
+        main()
     except (OSError, ValueError, KeyError) as e:
-        print("plot_detection.py: %s" % e, file=sys.stderr)
-        sys.exit(1)
+        sys.exit("plot_detection.py: %s" % e)  # status 1, the problem on stderr
