@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace caracara {
@@ -23,17 +24,20 @@ public:
 
     // A dive begins: what runs now is news to it.
     void reset();
-    // What changed since the last call, in the order it happened (times left for the caller).
-    void poll(std::vector<dive::Event>& out);
+    // Encodes into `records` what changed since the last call, in the order it happened, stamped
+    // `t_100us` (the dive's time now).
+    void record(std::vector<uint8_t>& records, uint32_t t_100us);
     // The dive ends: whatever still runs is recorded as ended with it (a kill's zeros end it,
     // though the detection hears of them only at its next step).
-    void close(std::vector<dive::Event>& out);
+    void close(std::vector<uint8_t>& records, uint32_t t_100us);
 
 private:
-    void motor_test_events(std::vector<dive::Event>& out);
-    void detection_events(std::vector<dive::Event>& out);
-    void pulse_off(std::vector<dive::Event>& out);
-    void detection_end(std::vector<dive::Event>& out);
+    void emit(dive::EventKind kind, int32_t thruster, uint32_t value, double number, std::string text = {},
+              std::string client = {});
+    void motor_test_events();
+    void detection_events();
+    void pulse_off();
+    void detection_end();
 
     const Vehicle& vehicle_;
     const MotorTest& motor_test_;
@@ -43,6 +47,8 @@ private:
     bool detecting_ = false;
     int32_t pulsing_ = -1;
     std::size_t judged_ = 0;
+    std::vector<uint8_t>* records_ = nullptr; // during record() and close()
+    uint32_t t_100us_ = 0;
 };
 
 } // namespace caracara

@@ -74,8 +74,7 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
 }
 
 void DiveRecorder::finish(uint64_t now_ns, const std::string& reason) {
-    commissioning_.close(pending_);
-    add_commissioning(now_ns);
+    commissioning_.close(records_, since_start(now_ns));
     dive::encode_sample(records_, sampler_.sample(since_start(now_ns))); // the zeros the dive ends with
     dive::encode_end(records_, {since_start(now_ns), reason});
     flush();
@@ -92,12 +91,6 @@ void DiveRecorder::flush() {
 void DiveRecorder::add_event(dive::Event e, uint64_t now_ns) {
     e.t_100us = since_start(now_ns);
     dive::encode_event(records_, e);
-}
-
-void DiveRecorder::add_commissioning(uint64_t now_ns) {
-    for (dive::Event& e : pending_)
-        add_event(std::move(e), now_ns);
-    pending_.clear();
 }
 
 void DiveRecorder::vehicle_changed(uint32_t changes) {
@@ -162,27 +155,20 @@ void DiveRecorder::failsafe(const ActiveFailsafe& f, bool raised) {
 void DiveRecorder::bus_lost(const std::string& reason) {
     if (!recording_)
         return;
-    dive::Event e;
-    e.kind = dive::EventKind::BusLost;
-    e.text = reason;
-    add_event(std::move(e), monotonic_ns());
+    add_event({0, dive::EventKind::BusLost, 0, 0, 0, 0, 0, reason, ""}, monotonic_ns());
 }
 
 void DiveRecorder::bus_restored(uint32_t pulses, double milliseconds) {
     if (!recording_)
         return;
-    dive::Event e;
-    e.kind = dive::EventKind::BusRestored;
-    e.value = pulses;
-    e.number = static_cast<float>(milliseconds);
-    add_event(std::move(e), monotonic_ns());
+    add_event({0, dive::EventKind::BusRestored, 0, 0, 0, pulses, static_cast<float>(milliseconds), "", ""},
+              monotonic_ns());
 }
 
 void DiveRecorder::cycle(uint64_t now_ns) {
     if (!recording_)
         return;
-    commissioning_.poll(pending_);
-    add_commissioning(now_ns);
+    commissioning_.record(records_, since_start(now_ns));
     dive::encode_sample(records_, sampler_.sample(since_start(now_ns)));
     if (now_ns - last_flush_ns_ >= kFlushPeriodNs || records_.size() >= kFlushBytes) {
         last_flush_ns_ = now_ns;

@@ -1,17 +1,16 @@
 // The dive recorder (docs/dive-format.md): a VehicleObserver that opens a dive when the
 // vehicle arms, takes a sample of the whole vehicle every control-loop cycle and an event for
 // every state change (with its kill source, reason and calling client), fault change, bus loss
-// and recovery, profile switch, motor test and direction detection step, and closes the dive at the next kill or power-off. Samples
-// (its DiveSampler's) are encoded into memory on the loop (a few hundred bytes, no system
-// call) and handed to the DiveWriter's thread once a second, so a crash loses at most the
-// last second, and at 64 KiB (a loop running flat out fills megabytes a second).
+// and recovery, profile switch, motor test and direction detection step (its
+// CommissioningEvents'), and closes the dive at the next kill or power-off. Samples (its
+// DiveSampler's) are encoded into memory on the loop (a few hundred bytes, no system call) and
+// handed to the DiveWriter's thread once a second, so a crash loses at most the last second,
+// and at 64 KiB (a loop running flat out fills megabytes a second).
 #pragma once
 
 #include "core/config.hpp"
 #include "core/dive_format.hpp"
 #include "daemon/bus/thruster_bus.hpp"
-#include "daemon/commissioning/direction_detection.hpp"
-#include "daemon/commissioning/motor_test.hpp"
 #include "daemon/dive/commissioning_events.hpp"
 #include "daemon/dive/dive_sampler.hpp"
 #include "daemon/dive/dive_writer.hpp"
@@ -52,7 +51,6 @@ private:
     void flush();
     uint32_t since_start(uint64_t now_ns) const;
     void add_event(dive::Event e, uint64_t now_ns);
-    void add_commissioning(uint64_t now_ns);
 
     const DaemonConfig& config_;
     const Vehicle& vehicle_;
@@ -61,7 +59,6 @@ private:
     DiveWriter& writer_;
     DiveSampler sampler_;
     CommissioningEvents commissioning_;
-    std::vector<dive::Event> pending_; // commissioning_'s news, reused
 
     bool recording_ = false;
     bool started_ = false;
