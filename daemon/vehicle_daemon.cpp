@@ -20,7 +20,7 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
       status_(event, vehicle_, bus_, loop_),
       failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); },
                  [this] { return vehicle_conditions(); }, vehicle_, events_),
-      motor_test_(config_, vehicle_),
+      motor_test_(config_, vehicle_, events_),
       directions_(config_, vehicle_, teensy_, failsafes_) {
     vehicle_.set_demand_listener(&loop_);
     bus_.monitor().set_listener(&recovery_);

@@ -49,9 +49,17 @@ void CommissioningEvents::close(std::vector<uint8_t>& records, uint32_t t_100us)
     records_ = nullptr;
 }
 
-void CommissioningEvents::motor_test_events() {
-    const int32_t thruster = motor_test_.active_thruster();
-    const int32_t value = motor_test_.value();
+void CommissioningEvents::motor_test(std::vector<uint8_t>& records, uint32_t t_100us, int32_t thruster, int32_t value) {
+    records_ = &records;
+    t_100us_ = t_100us;
+    test_now(thruster, value);
+    records_ = nullptr;
+}
+
+// A test that stops shows only here (a kill, a pilot's command, its caller leaving, the keep-alive).
+void CommissioningEvents::motor_test_events() { test_now(motor_test_.active_thruster(), motor_test_.value()); }
+
+void CommissioningEvents::test_now(int32_t thruster, int32_t value) {
     if (thruster == test_thruster_ && value == test_value_)
         return;
     // A test moved to another thruster: the first one stopped.

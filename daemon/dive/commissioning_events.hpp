@@ -30,11 +30,15 @@ public:
     // The dive ends: whatever still runs is recorded as ended with it (a kill's zeros end it,
     // though the detection hears of them only at its next step).
     void close(std::vector<uint8_t>& records, uint32_t t_100us);
+    // A motor test's order accepted now (MotorTest tells it at once: a test replaced within a
+    // cycle is in the dive too); the same test repeated (its keep-alive) records nothing.
+    void motor_test(std::vector<uint8_t>& records, uint32_t t_100us, int32_t thruster, int32_t value);
 
 private:
     void emit(dive::EventKind kind, int32_t thruster, uint32_t value, double number, std::string text = {},
               std::string client = {});
     void motor_test_events();
+    void test_now(int32_t thruster, int32_t value);
     void detection_events();
     void pulse_off();
     void detection_end();

@@ -128,14 +128,9 @@ void DiveRecorder::vehicle_changed(uint32_t changes) {
             add_event(std::move(e), now);
         }
     }
-    if (changes & kChangeProfile) {
-        dive::Event e;
-        e.kind = dive::EventKind::Profile;
-        e.text = vehicle_.profile().name;
-        e.number = static_cast<float>(vehicle_.profile().factor);
-        e.client = events_.caller();
-        add_event(std::move(e), now);
-    }
+    if (changes & kChangeProfile)
+        add_event({0, dive::EventKind::Profile, 0, 0, 0, 0, static_cast<float>(vehicle_.profile().factor),
+                   vehicle_.profile().name, events_.caller()}, now);
     if ((changes & kChangeState) && !driving)
         finish(now, s == SafetyState::PoweredOff ? "powered-off"
                                                  : "killed (" + std::string(vehicle_.kill_source_name()) + ")");
@@ -150,6 +145,11 @@ void DiveRecorder::failsafe(const ActiveFailsafe& f, bool raised) {
     e.value = (raised ? dive::kFailsafeRaised : 0u) | (f.thruster < 0 ? dive::kFailsafeVehicle : 0u);
     e.text = std::string(condition_name(f.condition)) + " " + std::string(action_name(f.effective()));
     add_event(std::move(e), monotonic_ns());
+}
+
+void DiveRecorder::motor_test(int32_t thruster, int32_t value) {
+    if (recording_)
+        commissioning_.motor_test(records_, since_start(monotonic_ns()), thruster, value);
 }
 
 void DiveRecorder::bus_lost(const std::string& reason) {

@@ -39,11 +39,11 @@ public:
     bool recording() const { return recording_; }
 
     void vehicle_changed(uint32_t changes) override;
-    void telemetry() override {}
     void bus_lost(const std::string& reason) override;
     void bus_restored(uint32_t pulses, double milliseconds) override;
     void cycle(uint64_t now_ns) override;
     void failsafe(const ActiveFailsafe& f, bool raised) override;
+    void motor_test(int32_t thruster, int32_t value) override;
 
 private:
     void begin(uint64_t now_ns, const char* reason);
