@@ -1,9 +1,9 @@
 // The commissioning steps as dive events (docs/dive-format.md): a motor test starting, changing
 // and stopping, a direction detection run starting and ending, each of its pulses and each
-// thruster's verdict. Read from MotorTest and DirectionDetection at every control-loop cycle
-// (no hook in them): a motor test also ends by a pilot's command, a kill or its caller leaving,
-// and only its state at the cycle says so. An event is stamped at the cycle that saw it, at most
-// one loop period after the order it describes went to the bus.
+// thruster's verdict. Read from MotorTest and DirectionDetection at every control-loop cycle: a
+// motor test also ends by a pilot's command, a kill or its caller leaving, and only its state at
+// the cycle says so; such an event is stamped at the cycle that saw it, at most one loop period
+// after the order it describes went to the bus. A motor test's start MotorTest tells at once.
 #pragma once
 
 #include "core/dive_format.hpp"
