@@ -61,9 +61,11 @@ bool read_event(ByteReader& r, Event& e) {
     e.number = r.f32();
     e.text = r.str(kMaxText);
     e.client = r.str(kMaxText);
-    if (r.failed() || kind < 1 || kind > static_cast<uint8_t>(EventKind::Failsafe))
+    if (r.failed() || kind < 1 || kind > static_cast<uint8_t>(EventKind::DetectionResult))
         return false;
     e.kind = static_cast<EventKind>(kind);
+    if (e.kind == EventKind::DetectionResult && e.value > kMaxVerdict)
+        return false;
     return e.state <= kMaxSafetyState && e.kill_source <= kMaxKillSource && e.thruster < kThrusters &&
            std::isfinite(e.number);
 }

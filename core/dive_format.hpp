@@ -94,7 +94,15 @@ enum class EventKind : uint8_t {
     BusRestored = 4,  // value = SCL pulses, number = milliseconds
     Profile = 5,      // text = name, number = factor
     Failsafe = 6,     // text = "<condition> <action>", thruster, value = kFailsafe* bits
+    MotorTest = 7,    // thruster, value = kOn (started or changed; else stopped), number = its value, client
+    Detection = 8,    // a direction detection run: value = kOn (started; else ended), number = thrusters judged, client
+    DetectionPulse = 9,   // thruster, value = kOn (pulse ordered; else ordered zero), number = the pulse's value
+    DetectionResult = 10, // thruster, value = the verdict (DirectionVerdict), number = margin,
+                          // text = "yaw=... pitch=... roll=... along=..." (rad)
 };
+// A motor test's, detection's or pulse's value bit.
+inline constexpr uint32_t kOn = 1u << 0;
+inline constexpr uint32_t kMaxVerdict = 2; // DirectionVerdict::Inconclusive
 // A failsafe event's value bits.
 inline constexpr uint32_t kFailsafeRaised = 1u << 0;  // raised (else cleared)
 inline constexpr uint32_t kFailsafeVehicle = 1u << 1; // the vehicle's own, not `thruster`'s
@@ -102,13 +110,17 @@ inline constexpr uint32_t kFailsafeVehicle = 1u << 1; // the vehicle's own, not 
 namespace caracara {
 template <>
 struct EnumNames<dive::EventKind> {
-    static constexpr std::array<EnumName<dive::EventKind>, 6> table{{
+    static constexpr std::array<EnumName<dive::EventKind>, 10> table{{
         {dive::EventKind::State, "state"},
         {dive::EventKind::Fault, "fault"},
         {dive::EventKind::BusLost, "bus-lost"},
         {dive::EventKind::BusRestored, "bus-restored"},
         {dive::EventKind::Profile, "profile"},
         {dive::EventKind::Failsafe, "failsafe"},
+        {dive::EventKind::MotorTest, "motor-test"},
+        {dive::EventKind::Detection, "detection"},
+        {dive::EventKind::DetectionPulse, "detection-pulse"},
+        {dive::EventKind::DetectionResult, "detection-result"},
     }};
 };
 } // namespace caracara

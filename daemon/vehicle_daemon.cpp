@@ -20,7 +20,7 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
       status_(event, vehicle_, bus_, loop_),
       failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); },
                  [this] { return vehicle_conditions(); }, vehicle_, events_),
-      motor_test_(config_, vehicle_),
+      motor_test_(config_, vehicle_, events_),
       directions_(config_, vehicle_, teensy_, failsafes_),
       preflight_(config_, bus_, teensy_, lines_) {
     vehicle_.set_demand_listener(&loop_);
@@ -79,7 +79,8 @@ std::string VehicleDaemon::start() {
         dive_writer_ = std::make_unique<DiveWriter>(config_.recorder.directory,
                                                     uint64_t(config_.recorder.max_total_mb) << 20);
         dive_writer_->start();
-        recorder_ = std::make_unique<DiveRecorder>(config_, vehicle_, bus_, teensy_, events_, *dive_writer_);
+        recorder_ = std::make_unique<DiveRecorder>(config_, vehicle_, bus_, teensy_, events_, *dive_writer_,
+                                                   motor_test_, directions_);
         events_.attach_recorder(recorder_.get());
         recorder_->start();
     }

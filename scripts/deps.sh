@@ -9,7 +9,7 @@ catch2=libcatch2-dev
 [ "$(. /etc/os-release && echo "${VERSION_CODENAME:-}")" = bookworm ] && catch2=catch2
 pkgs=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev "$catch2" libtomlplusplus-dev
       dbus python3 python3-dbus python3-gi systemd debootstrap systemd-container valgrind stress-ng
-      clang libclang-rt-dev python3-matplotlib ccache libboost-dev nlohmann-json3-dev openssh-client)
+      clang libclang-rt-dev python3-matplotlib python3-pil ccache libboost-dev nlohmann-json3-dev openssh-client)
 # caracara-ros (tools/ros): Cyclone DDS and its IDL compiler; its tests' second DDS vendor, Fast DDS
 # with fastddsgen (tests/ros), and iproute2 for the private network namespace.
 pkgs+=(cyclonedds-dev cyclonedds-tools libfastrtps-dev fastddsgen iproute2)

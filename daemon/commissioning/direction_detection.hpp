@@ -42,6 +42,8 @@ public:
     // The thruster being pulsed now, or -1.
     int32_t pulsing() const { return phase_ == Phase::Pulse ? static_cast<int32_t>(motor_) : -1; }
     const std::array<DirectionFinding, kMotorCount>& findings() const { return findings_.all(); }
+    // How many thrusters this run (or the last) judged: findings()[0, judged()) are its verdicts.
+    std::size_t judged() const { return motor_; }
     std::string fragment() const { return findings_.fragment(); }
 
 private:

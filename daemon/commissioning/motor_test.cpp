@@ -5,8 +5,8 @@
 
 namespace caracara {
 
-MotorTest::MotorTest(const DaemonConfig& config, Vehicle& vehicle)
-    : config_(config), vehicle_(vehicle), keepalive_([this] { expired(); }) {}
+MotorTest::MotorTest(const DaemonConfig& config, Vehicle& vehicle, VehicleEvents& events)
+    : config_(config), vehicle_(vehicle), events_(events), keepalive_([this] { expired(); }) {}
 
 std::string MotorTest::start(sd_event* event) { return keepalive_.start(event); }
 
@@ -30,6 +30,7 @@ Result MotorTest::run(int32_t thruster, int32_t value, std::string_view client) 
     // The same path as SetThrust: budget, state (armed only), commanding client, the wire.
     if (Result r = vehicle_.drive(m, client); !r.ok())
         return r;
+    events_.motor_test(thruster, value);
     if (!running_ || thruster != thruster_ || client != client_)
         log_notice("motor test: thruster %d at %d for %s", thruster, value, std::string(client).c_str());
     running_ = true;

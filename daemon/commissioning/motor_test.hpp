@@ -10,6 +10,7 @@
 #include "core/config.hpp"
 #include "core/motor.hpp"
 #include "core/status.hpp"
+#include "daemon/interfaces/vehicle_events.hpp"
 #include "daemon/loop/deadline_timer.hpp"
 #include "daemon/vehicle/vehicle.hpp"
 #include "drivers/platform/event_loop.hpp"
@@ -22,7 +23,7 @@ namespace caracara {
 
 class MotorTest final {
 public:
-    MotorTest(const DaemonConfig& config, Vehicle& vehicle);
+    MotorTest(const DaemonConfig& config, Vehicle& vehicle, VehicleEvents& events);
     // Makes the keep-alive timer. "" or why it could not.
     std::string start(sd_event* event);
     void stop() { keepalive_.stop(); }
@@ -43,6 +44,7 @@ private:
 
     const DaemonConfig& config_;
     Vehicle& vehicle_;
+    VehicleEvents& events_; // each accepted order, for the dive
     DeadlineTimer keepalive_;
     bool running_ = false;
     int32_t thruster_ = -1;

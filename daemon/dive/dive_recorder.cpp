@@ -25,8 +25,10 @@ uint64_t unix_ms() {
 } // namespace
 
 DiveRecorder::DiveRecorder(const DaemonConfig& config, const Vehicle& vehicle, const ThrusterBus& bus,
-                           const TeensyPort& teensy, const VehicleEvents& events, DiveWriter& writer)
-    : config_(config), vehicle_(vehicle), bus_(bus), events_(events), writer_(writer), sampler_(vehicle, bus, teensy) {}
+                           const TeensyPort& teensy, const VehicleEvents& events, DiveWriter& writer,
+                           const MotorTest& motor_test, const DirectionDetection& detection)
+    : config_(config), vehicle_(vehicle), bus_(bus), events_(events), writer_(writer), sampler_(vehicle, bus, teensy),
+      commissioning_(vehicle, motor_test, detection) {}
 
 void DiveRecorder::start() {
     started_ = true;
@@ -61,6 +63,7 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
     writer_.open(dive_file_name(wall), dive::encode_header(h));
     for (std::size_t i = 0; i < faults_.size() && i < bus_.size(); ++i)
         faults_[i] = bus_.health().faults(i).bits;
+    commissioning_.reset();
     // The state it starts in, with who asked for it.
     dive::Event e;
     e.kind = dive::EventKind::State;
@@ -71,6 +74,7 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
 }
 
 void DiveRecorder::finish(uint64_t now_ns, const std::string& reason) {
+    commissioning_.close(records_, since_start(now_ns));
     dive::encode_sample(records_, sampler_.sample(since_start(now_ns))); // the zeros the dive ends with
     dive::encode_end(records_, {since_start(now_ns), reason});
     flush();
@@ -124,14 +128,9 @@ void DiveRecorder::vehicle_changed(uint32_t changes) {
             add_event(std::move(e), now);
         }
     }
-    if (changes & kChangeProfile) {
-        dive::Event e;
-        e.kind = dive::EventKind::Profile;
-        e.text = vehicle_.profile().name;
-        e.number = static_cast<float>(vehicle_.profile().factor);
-        e.client = events_.caller();
-        add_event(std::move(e), now);
-    }
+    if (changes & kChangeProfile)
+        add_event({0, dive::EventKind::Profile, 0, 0, 0, 0, static_cast<float>(vehicle_.profile().factor),
+                   vehicle_.profile().name, events_.caller()}, now);
     if ((changes & kChangeState) && !driving)
         finish(now, s == SafetyState::PoweredOff ? "powered-off"
                                                  : "killed (" + std::string(vehicle_.kill_source_name()) + ")");
@@ -148,28 +147,28 @@ void DiveRecorder::failsafe(const ActiveFailsafe& f, bool raised) {
     add_event(std::move(e), monotonic_ns());
 }
 
+void DiveRecorder::motor_test(int32_t thruster, int32_t value) {
+    if (recording_)
+        commissioning_.motor_test(records_, since_start(monotonic_ns()), thruster, value);
+}
+
 void DiveRecorder::bus_lost(const std::string& reason) {
     if (!recording_)
         return;
-    dive::Event e;
-    e.kind = dive::EventKind::BusLost;
-    e.text = reason;
-    add_event(std::move(e), monotonic_ns());
+    add_event({0, dive::EventKind::BusLost, 0, 0, 0, 0, 0, reason, ""}, monotonic_ns());
 }
 
 void DiveRecorder::bus_restored(uint32_t pulses, double milliseconds) {
     if (!recording_)
         return;
-    dive::Event e;
-    e.kind = dive::EventKind::BusRestored;
-    e.value = pulses;
-    e.number = static_cast<float>(milliseconds);
-    add_event(std::move(e), monotonic_ns());
+    add_event({0, dive::EventKind::BusRestored, 0, 0, 0, pulses, static_cast<float>(milliseconds), "", ""},
+              monotonic_ns());
 }
 
 void DiveRecorder::cycle(uint64_t now_ns) {
     if (!recording_)
         return;
+    commissioning_.record(records_, since_start(now_ns));
     dive::encode_sample(records_, sampler_.sample(since_start(now_ns)));
     if (now_ns - last_flush_ns_ >= kFlushPeriodNs || records_.size() >= kFlushBytes) {
         last_flush_ns_ = now_ns;

@@ -1,15 +1,17 @@
 // The dive recorder (docs/dive-format.md): a VehicleObserver that opens a dive when the
 // vehicle arms, takes a sample of the whole vehicle every control-loop cycle and an event for
 // every state change (with its kill source, reason and calling client), fault change, bus loss
-// and recovery and profile switch, and closes the dive at the next kill or power-off. Samples
-// (its DiveSampler's) are encoded into memory on the loop (a few hundred bytes, no system
-// call) and handed to the DiveWriter's thread once a second, so a crash loses at most the
-// last second, and at 64 KiB (a loop running flat out fills megabytes a second).
+// and recovery, profile switch, motor test and direction detection step (its
+// CommissioningEvents'), and closes the dive at the next kill or power-off. Samples (its
+// DiveSampler's) are encoded into memory on the loop (a few hundred bytes, no system call) and
+// handed to the DiveWriter's thread once a second, so a crash loses at most the last second,
+// and at 64 KiB (a loop running flat out fills megabytes a second).
 #pragma once
 
 #include "core/config.hpp"
 #include "core/dive_format.hpp"
 #include "daemon/bus/thruster_bus.hpp"
+#include "daemon/dive/commissioning_events.hpp"
 #include "daemon/dive/dive_sampler.hpp"
 #include "daemon/dive/dive_writer.hpp"
 #include "daemon/teensy/teensy_port.hpp"
@@ -27,7 +29,8 @@ namespace caracara {
 class DiveRecorder final : public VehicleObserver {
 public:
     DiveRecorder(const DaemonConfig& config, const Vehicle& vehicle, const ThrusterBus& bus, const TeensyPort& teensy,
-                 const VehicleEvents& events, DiveWriter& writer);
+                 const VehicleEvents& events, DiveWriter& writer, const MotorTest& motor_test,
+                 const DirectionDetection& detection);
 
     // Opens a dive at once if the vehicle is already arming (control.arm_at_start).
     void start();
@@ -36,11 +39,11 @@ public:
     bool recording() const { return recording_; }
 
     void vehicle_changed(uint32_t changes) override;
-    void telemetry() override {}
     void bus_lost(const std::string& reason) override;
     void bus_restored(uint32_t pulses, double milliseconds) override;
     void cycle(uint64_t now_ns) override;
     void failsafe(const ActiveFailsafe& f, bool raised) override;
+    void motor_test(int32_t thruster, int32_t value) override;
 
 private:
     void begin(uint64_t now_ns, const char* reason);
@@ -55,6 +58,7 @@ private:
     const VehicleEvents& events_;
     DiveWriter& writer_;
     DiveSampler sampler_;
+    CommissioningEvents commissioning_;
 
     bool recording_ = false;
     bool started_ = false;

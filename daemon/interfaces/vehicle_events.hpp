@@ -45,6 +45,11 @@ public:
                 o->bus_restored(pulses, milliseconds);
     }
 
+    void motor_test(int32_t thruster, int32_t value) {
+        if (recorder_)
+            recorder_->motor_test(thruster, value);
+    }
+
     void failsafe(const ActiveFailsafe& f, bool raised) {
         for (VehicleObserver* o : {recorder_, observer_})
             if (o)

@@ -39,6 +39,9 @@ public:
     virtual void orders_in_flight(bool /*in_flight*/) {}
     // A failsafe was raised or its condition cleared (daemon/failsafe_monitor).
     virtual void failsafe(const ActiveFailsafe& /*f*/, bool /*raised*/) {}
+    // A motor test's order was accepted (daemon/commissioning/motor_test): told at once, so the
+    // dive has a test shorter than a loop cycle too. Its end shows in MotorTest itself.
+    virtual void motor_test(int32_t /*thruster*/, int32_t /*value*/) {}
 };
 
 } // namespace caracara

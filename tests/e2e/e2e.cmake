@@ -23,5 +23,9 @@ foreach(case reversed:ReversedThrustersTest fragment:WrittenFragmentTest disconn
 endforeach()
 
 # The dive recorder: a dive listed and plotted, bad dive files refused, and the regression dives
-# of tests/dives replayed against their expected output (tests/dives/test_dives.py).
-caracara_python_test(e2e_dives test_dives ${CMAKE_CURRENT_LIST_DIR}/../dives)
+# of tests/dives replayed against their expected output (tests/dives/test_dives.py); motor tests
+# and a direction detection run in the dive at the wire's times, and the detection's plot
+# (tests/dives/test_commissioning_dive.py).
+foreach(name dives commissioning_dive)
+  caracara_python_test(e2e_${name} test_${name} ${CMAKE_CURRENT_LIST_DIR}/../dives)
+endforeach()

@@ -222,9 +222,43 @@ TEST_CASE("a failsafe event and the failsafe kill source read back; a kind beyon
     std::vector<uint8_t> records;
     dive::Event bad = d.events[4];
     dive::encode_event(records, bad);
-    records[1 + 2 + 4] = static_cast<uint8_t>(dive::EventKind::Failsafe) + 1; // kind, after the record header and t
+    records[1 + 2 + 4] = static_cast<uint8_t>(dive::EventKind::DetectionResult) + 1; // kind, after the record header and t
     std::vector<uint8_t> file = dive::encode_header(d.header);
     const auto blk = dive::seal_block(records);
     file.insert(file.end(), blk.begin(), blk.end());
     CHECK_FALSE(dive::decode(file).ok());
+}
+
+// One dive's worth of commissioning events before the kill at 23800.
+void add_commissioning(dive::Dive& d) {
+    const std::vector<dive::Event> c = {
+        {21000, dive::EventKind::MotorTest, 0, 0, 3, dive::kOn, 1500, "", ":1.9"},
+        {21500, dive::EventKind::MotorTest, 0, 0, 3, 0, 0, "", ""},
+        {22000, dive::EventKind::Detection, 0, 0, 0, dive::kOn, 0, "", ":1.9"},
+        {22100, dive::EventKind::DetectionPulse, 0, 0, 0, dive::kOn, 3000, "", ""},
+        {22900, dive::EventKind::DetectionPulse, 0, 0, 0, 0, 0, "", ""},
+        {22900, dive::EventKind::DetectionResult, 0, 0, 0, 1, 1.9f, "yaw=-0.0190 pitch=+0.0000 roll=-0.0010 along=-0.0190", ""},
+        {23800, dive::EventKind::Detection, 0, 0, 0, 0, 1, "", ""},
+    };
+    d.events.insert(d.events.end() - 1, c.begin(), c.end());
+}
+
+TEST_CASE("motor test and direction detection events read back; a verdict out of range is refused") {
+    dive::Dive d = sample_dive();
+    add_commissioning(d);
+    const dive::Dive r = dive::decode(encode(d));
+    REQUIRE(r.ok());
+    CHECK(r.events == d.events);
+    CHECK(dive::event_kind_name(r.events[3].kind) == "motor-test");
+    CHECK(dive::event_kind_name(r.events[5].kind) == "detection");
+    CHECK(dive::event_kind_name(r.events[6].kind) == "detection-pulse");
+    CHECK(dive::event_kind_name(r.events[8].kind) == "detection-result");
+
+    dive::Dive bad = sample_dive();
+    add_commissioning(bad);
+    bad.events[8].value = 3; // beyond inconclusive
+    const dive::Dive rb = dive::decode(encode(bad));
+    CHECK_FALSE(rb.ok());
+    CHECK(rb.error == dive::ReadError::Malformed);
+    CHECK(rb.message.find("event record") != std::string::npos);
 }

@@ -238,6 +238,28 @@ TEST_CASE("a dive exported to MCAP: the state's failsafes, excluded thrusters an
     CHECK(bytes.find(R"j("message":"water-detect -> surface (thruster 3)")j") != std::string::npos);
 }
 
+TEST_CASE("a dive exported to MCAP: motor tests and a detection run on /events", "[foxglove]") {
+    namespace dive = caracara::dive;
+    dive::Dive d;
+    d.header.start_unix_ms = 1'700'000'000'000;
+    dive::Sample s;
+    d.samples = {s};
+    d.events = {{100, dive::EventKind::MotorTest, 0, 0, 3, dive::kOn, 1500, "", ":1.4"},
+                {200, dive::EventKind::MotorTest, 0, 0, 3, 0, 0, "", ""},
+                {300, dive::EventKind::Detection, 0, 0, 0, dive::kOn, 0, "", ":1.4"},
+                {400, dive::EventKind::DetectionPulse, 0, 0, 2, dive::kOn, 3000, "", ""},
+                {500, dive::EventKind::DetectionResult, 0, 0, 2, 1, 1.8f, "yaw=-0.0180", ""},
+                {600, dive::EventKind::Detection, 0, 0, 0, 0, 1, "", ""}};
+    const std::vector<uint8_t> f = fg::dive_to_mcap(d);
+    const std::string bytes(f.begin(), f.end());
+    for (const char* m : {"motor test: thruster 3 at 1500", "motor test: thruster 3 stopped", "direction detection started",
+                          "detection pulse: thruster 2 at 3000", "direction detection: thruster 2 reversed (yaw=-0.0180)",
+                          "direction detection ended, 1 thrusters judged"}) {
+        INFO(m);
+        CHECK(bytes.find(std::string(R"("message":")") + m + "\"") != std::string::npos);
+    }
+}
+
 TEST_CASE("the attitude quaternion: identity at rest, yaw clockwise from above is a turn about -z", "[foxglove]") {
     const auto rest = nlohmann::json::parse(fg::attitude_json(0, 0, 0, 0))["rotation"];
     CHECK(rest["w"].get<double>() == Approx(1.0));

@@ -1,5 +1,6 @@
 #include "tools/caracaractl/dives.hpp"
 
+#include "core/direction_judgement.hpp"
 #include "core/dive_format.hpp"
 #include "core/safety.hpp"
 #include "drivers/platform/dive_files.hpp"
@@ -43,6 +44,9 @@ struct DiveOptions {
     bool partial = false;
     bool mcap = false;          // export --format mcap
     bool cdr = false;           // --encoding cdr: the ROS 2 topics for rosbag2 (docs/ros2.md)
+    bool detection = false;     // plot --detection: one direction detection run (plot_detection.py)
+    std::string wire;           // plot --detection --wire FILE: the simulator's orders, time_ns,thruster,speed
+    std::string run = "-1";     // plot --detection --run N: which run of the dive (-1 the last)
     std::vector<std::string> positional;
 };
 
@@ -63,6 +67,17 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
             o.out = value("--out");
         else if (a == "--events" && name == "export")
             o.events = true;
+        else if (a == "--detection" && name == "plot")
+            o.detection = true;
+        else if (a == "--wire" && name == "plot")
+            o.wire = value("--wire");
+        else if (a == "--run" && name == "plot") {
+            o.run = value("--run");
+            char* end = nullptr;
+            (void)std::strtol(o.run.c_str(), &end, 10);
+            if (o.run.empty() || *end != '\0')
+                usage("--run takes a number, not '" + o.run + "'");
+        }
         else if (a == "--format" && name == "export") {
             const std::string f = value("--format");
             if (f != "csv" && f != "mcap")
@@ -88,6 +103,8 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
         usage("--encoding applies to --format mcap");
     if (name == "export" && !o.mcap && !o.out.empty())
         usage("--out applies to --format mcap");
+    if (name == "plot" && !o.detection && (!o.wire.empty() || o.run != "-1"))
+        usage("--wire and --run apply to plot --detection");
     const std::size_t want = name == "dives" ? 0 : 1;
     if (o.positional.size() != want)
         usage(strf("%s takes %zu argument%s, got %zu", name.c_str(), want, want == 1 ? "" : "s", o.positional.size()));
@@ -159,6 +176,16 @@ std::string describe(const dive::Event& e) {
     case dive::EventKind::Failsafe:
         return strf("%s %s%s", e.text.c_str(), (e.value & dive::kFailsafeRaised) ? "raised" : "cleared",
                     (e.value & dive::kFailsafeVehicle) ? "" : strf(" thruster=%u", e.thruster).c_str());
+    case dive::EventKind::MotorTest:
+    case dive::EventKind::DetectionPulse:
+        return (e.value & dive::kOn) ? strf("thruster=%u value=%.0f", e.thruster, e.number)
+                                     : strf("thruster=%u stopped", e.thruster);
+    case dive::EventKind::Detection:
+        return (e.value & dive::kOn) ? std::string("started") : strf("ended judged=%.0f", e.number);
+    case dive::EventKind::DetectionResult:
+        return strf("thruster=%u verdict=%s margin=%.2f %s", e.thruster,
+                    std::string(caracara::verdict_name(static_cast<caracara::DirectionVerdict>(e.value))).c_str(),
+                    e.number, e.text.c_str());
     }
     return "";
 }
@@ -271,19 +298,20 @@ int cmd_export(const DiveOptions& o) {
     return kExitOk;
 }
 
-// tools/caracaractl/plot_dive.py: $CARACARA_PLOT_SCRIPT, beside this program (a build tree), or installed.
-std::string plot_script() {
-    if (const char* env = std::getenv("CARACARA_PLOT_SCRIPT"); env && *env)
+// tools/caracaractl/plot_dive.py (or plot_detection.py): $CARACARA_PLOT_SCRIPT (plot_dive.py's),
+// beside this program (a build tree), or installed.
+std::string plot_script(const std::string& name) {
+    if (const char* env = std::getenv("CARACARA_PLOT_SCRIPT"); env && *env && name == "plot_dive.py")
         return env;
     char self[4096];
     const ssize_t n = ::readlink("/proc/self/exe", self, sizeof self - 1);
     if (n > 0) {
         std::string dir(self, static_cast<std::size_t>(n));
         dir = dir.substr(0, dir.rfind('/'));
-        if (::access((dir + "/plot_dive.py").c_str(), R_OK) == 0)
-            return dir + "/plot_dive.py";
+        if (::access((dir + "/" + name).c_str(), R_OK) == 0)
+            return dir + "/" + name;
     }
-    return std::string(CARACARA_DATADIR) + "/caracara/plot_dive.py";
+    return std::string(CARACARA_DATADIR) + "/caracara/" + name;
 }
 
 int cmd_plot(const DiveOptions& o) {
@@ -298,8 +326,8 @@ int cmd_plot(const DiveOptions& o) {
             base.resize(base.size() - std::strlen(caracara::kDiveSuffix));
         out = base + ".png";
     }
-    if (!out.ends_with(".png") && !out.ends_with(".svg") && !out.ends_with(".html"))
-        usage("--out must end in .png, .svg or .html, not '" + out + "'");
+    if (!out.ends_with(".png") && !out.ends_with(".svg") && (o.detection || !out.ends_with(".html")))
+        usage(std::string("--out must end in .png, .svg") + (o.detection ? "" : " or .html") + ", not '" + out + "'");
     char tmpl[] = "/tmp/caracara-plot.XXXXXX";
     if (!::mkdtemp(tmpl))
         throw Failure{kExitRefused, std::string("mkdtemp: ") + std::strerror(errno)};
@@ -309,15 +337,26 @@ int cmd_plot(const DiveOptions& o) {
         write_samples(s, d);
         write_events(e, d);
     }
-    const std::string script = plot_script();
+    const std::string script = plot_script(o.detection ? "plot_detection.py" : "plot_dive.py");
     const std::string title = path.substr(path.rfind('/') + 1) + "  (" + local_time(d.header.start_unix_ms) +
-                              ", ended: " + caracara::foxglove::dive_end(d) + ")";
+                              (o.detection ? ", direction detection" : ", ended: " + caracara::foxglove::dive_end(d)) + ")";
+    std::vector<std::string> argv = {kPython, script, "--samples", tmp + "/samples.csv", "--events", tmp + "/events.csv",
+                                     "--title", title, "--out", out};
+    if (o.detection) {
+        // The dive's start on CLOCK_MONOTONIC: where the simulator's wire log meets the dive's times.
+        argv.insert(argv.end(), {"--start-mono-ns", std::to_string(d.header.start_mono_ns), "--run", o.run});
+        if (!o.wire.empty())
+            argv.insert(argv.end(), {"--wire", o.wire});
+    }
+    std::vector<char*> cargv;
+    for (std::string& a : argv)
+        cargv.push_back(a.data());
+    cargv.push_back(nullptr);
     const pid_t pid = ::fork();
     if (pid == 0) {
         // Debian's interpreter, the one python3-matplotlib is installed for (not a python3
         // that happens to come first in PATH).
-        ::execl(kPython, kPython, script.c_str(), "--samples", (tmp + "/samples.csv").c_str(), "--events",
-                 (tmp + "/events.csv").c_str(), "--title", title.c_str(), "--out", out.c_str(), nullptr);
+        ::execv(kPython, cargv.data());
         std::fprintf(stderr, "caracaractl: cannot run %s: %s\n", kPython, std::strerror(errno));
         ::_exit(127);
     }
@@ -353,6 +392,11 @@ const char* dive_help() {
            "                                   Plot motor values, currents, temperatures and\n"
            "                                   orientation with kills, faults and bus recoveries\n"
            "                                   marked; FILE ends in .png (default), .svg or .html\n"
+           "  plot DIVE --detection [--wire FILE] [--run N] [--out FILE]\n"
+           "                                   Plot one direction detection run (the last, or run\n"
+           "                                   N from 0): each thruster's pulse and the attitude\n"
+           "                                   change it caused, with its verdict; --wire adds the\n"
+           "                                   simulator's orders (CSV time_ns,thruster,speed)\n"
            "  export DIVE [--events] [--dir DIR] [--partial]\n"
            "                                   Print the samples (or the events) as CSV\n"
            "  export DIVE --format mcap [--out FILE] [--dir DIR] [--partial]\n"

@@ -1,5 +1,6 @@
 #include "tools/foxglove/dive_mcap.hpp"
 
+#include "core/direction_judgement.hpp"
 #include "core/safety.hpp"
 #include "tools/foxglove/channels.hpp"
 #include "tools/foxglove/mcap_writer.hpp"
@@ -67,6 +68,26 @@ LogEvent log_of(const dive::Event& e, uint64_t time_ns, VehicleState& state) {
         state.profile = e.text;
         state.profile_factor = e.number;
         log.message = "profile " + e.text;
+        break;
+    case dive::EventKind::MotorTest:
+    case dive::EventKind::DetectionPulse: {
+        const bool on = e.value & dive::kOn;
+        char text[96];
+        std::snprintf(text, sizeof text, on ? "%s: thruster %u at %.0f" : "%s: thruster %u stopped",
+                      e.kind == dive::EventKind::MotorTest ? "motor test" : "detection pulse", e.thruster,
+                      static_cast<double>(e.number));
+        log.message = text;
+        break;
+    }
+    case dive::EventKind::Detection:
+        log.message = e.value & dive::kOn ? "direction detection started"
+                                          : "direction detection ended, " + std::to_string(int(e.number)) +
+                                                " thrusters judged";
+        break;
+    case dive::EventKind::DetectionResult:
+        log.level = static_cast<DirectionVerdict>(e.value) == DirectionVerdict::Ok ? LogLevel::Info : LogLevel::Warning;
+        log.message = "direction detection: thruster " + std::to_string(e.thruster) + " " +
+                      std::string(verdict_name(static_cast<DirectionVerdict>(e.value))) + " (" + e.text + ")";
         break;
     }
     return log;
