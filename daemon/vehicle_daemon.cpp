@@ -21,7 +21,8 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
       failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); },
                  [this] { return vehicle_conditions(); }, vehicle_, events_),
       motor_test_(config_, vehicle_),
-      directions_(config_, vehicle_, teensy_, failsafes_) {
+      directions_(config_, vehicle_, teensy_, failsafes_),
+      bus_scan_(config_, vehicle_, bus_) {
     vehicle_.set_demand_listener(&loop_);
     bus_.monitor().set_listener(&recovery_);
     events_.attach_status(&status_);
@@ -115,6 +116,7 @@ void VehicleDaemon::shutdown() {
     failsafes_.stop();
     motor_test_.stop();
     directions_.stop();
+    bus_scan_.stop();
     if (recorder_) {
         recorder_->stop(); // the dive ends here, before the zeros of the way out
         events_.attach_recorder(nullptr);

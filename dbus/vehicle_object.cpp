@@ -136,6 +136,45 @@ int m_detect_directions(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return 1;
 }
 
+// Replied to when the scan ends: the devices that answered and a verdict per configured thruster.
+int reply_scan(sd_bus_message* call, const BusScanReport& report) {
+    MessagePtr out;
+    sd_bus_message* m = nullptr;
+    int r = sd_bus_message_new_method_return(call, &m);
+    if (r < 0)
+        return r;
+    out.reset(m);
+    if ((r = sd_bus_message_open_container(m, 'a', "(qiysyi)")) < 0)
+        return r;
+    for (const ScanDevice& d : report.devices) {
+        const std::string variant = d.variant ? std::string(variant_name(*d.variant)) : std::string();
+        if ((r = sd_bus_message_append(m, "(qiysyi)", uint16_t(d.segment ? d.segment->addr7 : 0),
+                                       int32_t(d.segment ? d.segment->channel : -1), d.mt, variant.c_str(), d.revision,
+                                       d.thruster)) < 0)
+            return r;
+    }
+    if ((r = sd_bus_message_close_container(m)) < 0 || (r = sd_bus_message_open_container(m, 'a', "(ss)")) < 0)
+        return r;
+    for (const ThrusterScan& t : report.thrusters) {
+        const std::string verdict(scan_verdict_name(t.verdict));
+        if ((r = sd_bus_message_append(m, "(ss)", verdict.c_str(), t.advice.c_str())) < 0)
+            return r;
+    }
+    if ((r = sd_bus_message_close_container(m)) < 0)
+        return r;
+    return sd_bus_send(nullptr, m, nullptr);
+}
+
+int m_scan_bus(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    BusScan& s = static_cast<Parts*>(userdata)->bus_scan;
+    auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
+    s.run([held, &s](const Result& r) {
+        if (!r.ok() || reply_scan(held.get(), s.report()) < 0)
+            reply(held.get(), r.ok() ? Result{Status::Hardware, "cannot build the reply"} : r);
+    });
+    return 1;
+}
+
 const ControlSettings& control(D d) { return d.control; }
 
 constexpr Member kMembers[] = {
@@ -154,6 +193,8 @@ constexpr Member kMembers[] = {
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("DetectDirections", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(sddddd)", thrusters, "s", fragment),
                                    m_detect_directions, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("ScanBus", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(qiysyi)", devices, "a(ss)", thrusters),
+                                   m_scan_bus, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetProfile", SD_BUS_ARGS("s", name), SD_BUS_NO_RESULT, m_set_profile, kUnpriv)),

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/commissioning/bus_scan.hpp"
 #include "daemon/commissioning/direction_detection.hpp"
 #include "daemon/commissioning/motor_test.hpp"
 #include "daemon/failsafe/failsafe_monitor.hpp"
@@ -16,8 +17,8 @@ namespace caracara::dbus {
 class VehicleObject {
 public:
     // What the object drives and shows: the vehicle, its legacy packet, the Teensy's LEDs, the loop's cycle
-    // count, the control settings, the failsafes (active ones, ClearKillOverride), the motor test and
-    // direction detection.
+    // count, the control settings, the failsafes (active ones, ClearKillOverride), the motor test,
+    // direction detection and the bus scan.
     struct Parts {
         Vehicle& vehicle;
         PacketHandler& packets;
@@ -27,6 +28,7 @@ public:
         FailsafeMonitor& failsafes;
         MotorTest& motor_test;
         DirectionDetection& directions;
+        BusScan& bus_scan;
     };
     VehicleObject(sd_bus* bus, const Parts& parts);
     VehicleObject(const VehicleObject&) = delete;

@@ -120,7 +120,8 @@ BusJobDone BusWorker::transfer(const BusJob& job) {
     if (gate && !gate->enter(self))
         return {job, IoError::None, true}; // the crash handler has the bus; the process is ending
     ThrusterDriver& d = *drivers_[job.index];
-    const IoError e = job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
+    const IoError e = job.kind == BusJobKind::Probe   ? prober_->probe(static_cast<uint32_t>(job.value))
+                      : job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
     if (gate)
         gate->leave();
     return {job, e, false};

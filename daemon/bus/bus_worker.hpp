@@ -7,6 +7,7 @@
 #pragma once
 
 #include "daemon/bus/bus_job_queue.hpp"
+#include "daemon/bus/bus_prober.hpp"
 #include "daemon/loop/worker_thread.hpp"
 #include "drivers/devices/bus_gate.hpp"
 #include "drivers/devices/thruster_driver.hpp"
@@ -58,6 +59,7 @@ public:
     // Every transfer enters `gate` (the emergency stop's), so a crash handler on another thread
     // can keep this one off the wire while it sends its zeros. Null: no gate.
     void set_gate(BusGate* gate) { gate_.store(gate); }
+    void set_prober(BusProber* prober) { prober_ = prober; } // runs the Probe jobs; set while idle
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
     bool idle() const { return outstanding_ == 0; }
     // At once (the default): the loop is woken as soon as a batch is over. Otherwise it takes the
@@ -98,6 +100,7 @@ private:
     bool wake_at_once_ = true;                // under the lock
     bool owed_ = false;                // under the lock: the loop must hear of this batch (a failure)
     DoneFn on_done_;
+    BusProber* prober_ = nullptr;
     WorkerThread thread_{*this}; // last: joined before the rest goes
 };
 

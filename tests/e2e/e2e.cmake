@@ -9,7 +9,7 @@ foreach(name properties announcements thrusters bus_recovery budget motion packe
              introspection caracaractl mission faults gpio_lines dive_crash failsafes
              packet_kill fault_reports wheels bus_lost vanished_lines adapter_limits start_killed
              command_timeout_timer thrust_profiles zero_thrusters_step realtime teensy_silence motor_test
-             direction_detection)
+             direction_detection bus_scan)
   add_test(NAME e2e_${name}
            COMMAND /usr/bin/python3 -m unittest -v test_${name}
            WORKING_DIRECTORY ${CARACARA_E2E_DIR})
