@@ -1,6 +1,7 @@
 #include "dbus/vehicle_object.hpp"
 
 #include "dbus/announcer.hpp"
+#include "dbus/bus_scan_reply.hpp"
 #include "dbus/error_reply.hpp"
 #include "dbus/vehicle_names.hpp"
 
@@ -136,43 +137,8 @@ int m_detect_directions(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return 1;
 }
 
-// Replied to when the scan ends: the devices that answered and a verdict per configured thruster.
-int reply_scan(sd_bus_message* call, const BusScanReport& report) {
-    MessagePtr out;
-    sd_bus_message* m = nullptr;
-    int r = sd_bus_message_new_method_return(call, &m);
-    if (r < 0)
-        return r;
-    out.reset(m);
-    if ((r = sd_bus_message_open_container(m, 'a', "(qiysyi)")) < 0)
-        return r;
-    for (const ScanDevice& d : report.devices) {
-        const std::string variant = d.variant ? std::string(variant_name(*d.variant)) : std::string();
-        if ((r = sd_bus_message_append(m, "(qiysyi)", uint16_t(d.segment ? d.segment->addr7 : 0),
-                                       int32_t(d.segment ? d.segment->channel : -1), d.mt, variant.c_str(), d.revision,
-                                       d.thruster)) < 0)
-            return r;
-    }
-    if ((r = sd_bus_message_close_container(m)) < 0 || (r = sd_bus_message_open_container(m, 'a', "(ss)")) < 0)
-        return r;
-    for (const ThrusterScan& t : report.thrusters) {
-        const std::string verdict(scan_verdict_name(t.verdict));
-        if ((r = sd_bus_message_append(m, "(ss)", verdict.c_str(), t.advice.c_str())) < 0)
-            return r;
-    }
-    if ((r = sd_bus_message_close_container(m)) < 0)
-        return r;
-    return sd_bus_send(nullptr, m, nullptr);
-}
-
 int m_scan_bus(sd_bus_message* m, void* userdata, sd_bus_error*) {
-    BusScan& s = static_cast<Parts*>(userdata)->bus_scan;
-    auto held = std::shared_ptr<sd_bus_message>(sd_bus_message_ref(m), sd_bus_message_unref);
-    s.run([held, &s](const Result& r) {
-        if (!r.ok() || reply_scan(held.get(), s.report()) < 0)
-            reply(held.get(), r.ok() ? Result{Status::Hardware, "cannot build the reply"} : r);
-    });
-    return 1;
+    return scan_bus(m, static_cast<Parts*>(userdata)->bus_scan);
 }
 
 const ControlSettings& control(D d) { return d.control; }
