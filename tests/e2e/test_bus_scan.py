@@ -11,7 +11,6 @@ import subprocess
 import time
 import unittest
 
-
 from bounds import SCAN_KILL_REPLY_MS_MAX
 from harness import (DEFAULT_MT, ERR, MOTORS, SIM, ZERO, Rig, VehicleTestCase, command, error_name, poll,
                      toml_value)
@@ -53,29 +52,35 @@ class SimLayoutRig(Rig):
         self._check_alive("caracara-sim")
 
 
-def mux_writes(entries):
-    return [e for e in entries if e.bus == "i2c" and e.addr == MUX and not e.read]
-
-
 def orders(entries):
     return [e for e in entries if e.bus == "i2c" and not e.read and e.addr != MUX and len(e.data) == 3]
 
 
-def probes(entries):
+def with_channels(rig, since):
+    """[(entry, mux channel then: -1 all off, None unknown)] of the wire log from `since`; the
+    channel followed from the log's start (the mux keeps what was written before `since`)."""
+    out = []
+    channel = None
+    for e in rig.wire_log(0)[1]:
+        if e.bus == "i2c" and e.addr == MUX and not e.read and e.data and e.result == "ack":
+            channel = e.data[0] & 0x03 if e.data[0] & 0x04 else -1
+        if e.index >= since:
+            out.append((e, channel))
+    return out
+
+
+def probes(walk):
     """The transfers only a scan makes: reads while every mux channel is off (the trunk), reads
     at an address no thruster is configured at, reads on a channel where the configuration puts
     no thruster at that address; and the control writes that switch every channel off."""
     routine = {(DEFAULT_MT[i] >> 1, CHANNEL[i]) for i in range(MOTORS)}
     out = []
-    channel = None  # unknown until the log shows a control write
-    for e in entries:
+    for e, channel in walk:
         if e.bus != "i2c":
             continue
-        if e.addr == MUX and not e.read and e.data:
-            channel = e.data[0] & 0x03 if e.data[0] & 0x04 else -1
-            if channel == -1:
-                out.append(e)
-        elif e.read and channel is not None and (e.addr, channel) not in routine:
+        if e.addr == MUX and not e.read and e.data[:1] == bytes([0]):
+            out.append(e)
+        elif e.read and e.addr != MUX and channel is not None and (e.addr, channel) not in routine:
             out.append(e)
     return out
 
@@ -107,18 +112,13 @@ class ScanCase(VehicleTestCase):
               + "\n" + "\n".join("thruster %d %s %s" % (i, v, a) for i, (v, a) in enumerate(thrusters)))
         return devices, thrusters
 
-    def assert_scan_on_wire(self, entries):
+    def assert_scan_on_wire(self, walk):
         """Every probe address on the trunk and on every channel; zeros only; the kill output held."""
+        entries = [e for e, _ in walk]
         self.assertEqual(set(o.data[0] for o in orders(entries)) - {ZERO}, set(),
                          "a non-zero order went out during the scan")
         self.assertEqual([e for e in entries if e.bus == "gpio"], [], "a safety line changed during the scan")
-        seen = set()
-        channel = None
-        for e in entries:
-            if e.bus == "i2c" and e.addr == MUX and not e.read and e.data:
-                channel = e.data[0] & 0x03 if e.data[0] & 0x04 else -1
-            elif e.bus == "i2c" and e.read and channel is not None:
-                seen.add((channel, e.addr))
+        seen = {(channel, e.addr) for e, channel in walk if e.bus == "i2c" and e.read}
         wanted = {(ch, mt >> 1) for ch in (-1, 0, 1, 2, 3) for mt in set(DEFAULT_MT) | {0x52, LEGACY_MT}}
         self.assertEqual(wanted - seen, set(), "addresses the scan did not probe (channel, addr7)")
 
@@ -130,12 +130,12 @@ class MatchingBusTest(ScanCase):
         rig = self.rig
         since = rig.wire_next()
         devices, thrusters = self.scan()
-        entries = rig.wire_log(since)[1]
+        walk = with_channels(rig, since)
         self.assertEqual(rig.state(), "killed")
         self.assertEqual(thrusters, [("ok", "")] * MOTORS)
         self.assertEqual(sorted((d[0], d[1], d[2], d[3], d[5]) for d in devices),
                          sorted((MUX, CHANNEL[i], DEFAULT_MT[i], "seabotix", i) for i in range(MOTORS)))
-        self.assert_scan_on_wire(entries)
+        self.assert_scan_on_wire(walk)
         # Afterwards the orders reach every thruster again, each through its own channel (the sim
         # NACKs an address whose channel is not selected).
         after = rig.wire_next()
@@ -160,8 +160,7 @@ class MatchingBusTest(ScanCase):
         self.assertEqual(p.returncode, 1)
         self.assertIn("NotKilled", p.stderr)
         rig.wait_orders_refreshed(count=2)
-        entries = rig.wire_log(since)[1]
-        self.assertEqual(probes(entries), [], "a refused scan probed")
+        self.assertEqual(probes(with_channels(rig, since)), [], "a refused scan probed")
         self.assertEqual(rig.state(), "ready")
 
 class KillDuringScanTest(ScanCase):
@@ -174,7 +173,7 @@ class KillDuringScanTest(ScanCase):
         scan = subprocess.Popen(command("caracaractl") + ["--bus-address", rig.address, "scan"],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         # Kill once the scan has started probing.
-        poll(lambda: probes(rig.wire_log(since)[1]), 10, interval=0.001, message="the scan never started probing")
+        poll(lambda: probes(with_channels(rig, since)), 10, interval=0.001, message="the scan never started probing")
         busy = error_name(rig.vcall, "ScanBus")
         t_kill = time.monotonic_ns()
         rig.vcall("Kill")
@@ -186,12 +185,13 @@ class KillDuringScanTest(ScanCase):
         self.assertEqual(scan.returncode, 1, "the scan was not ended by the kill: %s" % out)
         self.assertIn("Killed", err)
         self.assertEqual(busy, ERR + "Busy")
-        entries = rig.wire_log(since)[1]
+        walk = with_channels(rig, since)
+        entries = [e for e, _ in walk]
         # The kill's zeros went out; after them, no probe (at most the one on the wire at the kill).
         zeros_after = [e for e in orders(entries) if e.time_ns >= t_kill]
         self.assertTrue(zeros_after)
         self.assertEqual({e.data[0] for e in zeros_after}, {ZERO})
-        late_probes = [e for e in probes(entries) if e.time_ns > t_reply]
+        late_probes = [e for e in probes(walk) if e.time_ns > t_reply]
         self.assertLessEqual(len(late_probes), 1, "probes after the kill's reply: %s" % late_probes)
         # A new scan runs to its end.
         self.assertEqual(self.scan()[1], [("ok", "")] * MOTORS)
@@ -203,11 +203,19 @@ class MismatchedBusTest(ScanCase):
     SIM_LAYOUT = ([CONFIGURED[i] for i in (0, 1, 2, 4)] + [(DEFAULT_MT[5], "seabotix", 2), (DEFAULT_MT[6], "legacy", 1),
                                                            CONFIGURED[7], (LEGACY_MT, "legacy", 3)])
 
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        # The thrusters that do not answer as configured raise the thruster-unreachable failsafe,
+        # whose kill (the vehicle is killed already: its zeros) would end a scan begun before it.
+        poll(lambda: any(str(f[0]) == "thruster-unreachable" for f in cls.rig.vget("Failsafes")), 20,
+             message="the thruster-unreachable failsafe never fired")
+
     def test_scan_reports_missing_moved_wrong_variant_and_unexpected(self):
         rig = self.rig
         since = rig.wire_next()
         devices, thrusters = self.scan()
-        entries = rig.wire_log(since)[1]
+        walk = with_channels(rig, since)
         verdicts = [v for v, _ in thrusters]
         self.assertEqual(verdicts, ["ok", "ok", "ok", "missing", "ok", "moved", "wrong-variant", "ok"])
         by_thruster = {d[5]: d for d in devices}
@@ -217,7 +225,7 @@ class MismatchedBusTest(ScanCase):
         self.assertIn("channel 2", thrusters[5][1])
         self.assertIn("legacy", thrusters[6][1])
         self.assertIn("cable", thrusters[3][1])
-        self.assert_scan_on_wire(entries)
+        self.assert_scan_on_wire(walk)
 
     def test_caracaractl_scan_exits_1_and_says_what_to_do(self):
         p = self.rig.ctl("scan")

@@ -460,15 +460,15 @@ def sc_bus_scan(rig):
     check("the bus matches the configuration" in p.stdout, "no match in %r" % p.stdout)
     for i in MUXED:
         check("0x70/%d     0x%02x" % (MUXED[i], DEFAULT_MT[i]) in p.stdout, "thruster %d not on its channel" % i)
-    entries = [e for e in rig.wire_log(since)[1] if e.bus == "i2c"]
-    check(not [e for e in entries if not e.read and e.addr != MUX and e.data[:1] != bytes([ZERO])],
+    entries = [e for e in rig.wire_log(0)[1] if e.bus == "i2c"]  # the mux's channel from the start on
+    check(not [e for e in entries if e.index >= since and not e.read and e.addr != MUX and e.data[:1] != bytes([ZERO])],
           "a non-zero order during the scan")
     channels = set()
     channel = None
     for e in entries:
-        if e.addr == MUX and not e.read and e.data:
+        if e.addr == MUX and not e.read and e.data and e.result == "ack":
             channel = e.data[-1] & 0x03 if e.data[-1] & 0x04 else -1
-        elif e.read and e.addr == 0x54 >> 1 and channel is not None:
+        elif e.index >= since and e.read and e.addr == 0x54 >> 1 and channel is not None:
             check(e.result == "nack", "the empty legacy address answered: %s" % (e,))
             channels.add(channel)
     check(channels == {-1, 0, 1, 2, 3}, "0x54 probed on %s, not the trunk and channels 0-3" % sorted(channels))
