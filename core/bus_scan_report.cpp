@@ -71,6 +71,15 @@ std::vector<ScanSegment> scan_segments(std::span<const ThrusterConfig> thrusters
     return out;
 }
 
+bool add_scan_device(BusScanReport& report, const ScanDevice& device) {
+    if (device.segment && std::any_of(report.devices.begin(), report.devices.end(), [&](const ScanDevice& d) {
+            return !d.segment && d.mt == device.mt;
+        }))
+        return false;
+    report.devices.push_back(device);
+    return true;
+}
+
 void judge_bus_scan(std::span<const ThrusterConfig> thrusters, BusScanReport& report) {
     report.thrusters.assign(thrusters.size(), {});
     for (ScanDevice& d : report.devices)

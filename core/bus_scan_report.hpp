@@ -64,6 +64,11 @@ std::vector<uint8_t> scan_addresses(std::span<const ThrusterConfig> thrusters);
 // The segments probed: the trunk, then the four channels of each mux the configuration names.
 std::vector<ScanSegment> scan_segments(std::span<const ThrusterConfig> thrusters);
 
+// Adds a device that answered, unless it is one that answered on the trunk: with a channel
+// enabled the trunk is on the bus too, so a trunk device answers on every channel. The trunk is
+// probed first. False when it was left out.
+bool add_scan_device(BusScanReport& report, const ScanDevice& device);
+
 // Fills report.thrusters (one per configured thruster) and each device's `thruster`: a device
 // at a thruster's segment and address is that thruster (ok, or wrong variant); a thruster not
 // found there is taken to be an unclaimed device at its address on another segment (moved), or

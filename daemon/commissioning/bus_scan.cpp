@@ -85,7 +85,7 @@ void BusScan::probed(const BusJobDone& d) {
     const uint32_t i = job & 0xFFFF;
     const Step& step = steps_[i];
     if (step.error == IoError::None && !step.restore)
-        report_.devices.push_back({step.segment, step.mt, step.answer.variant, step.answer.revision});
+        add_scan_device(report_, {step.segment, step.mt, step.answer.variant, step.answer.revision, -1});
     else if (step.error != IoError::None && step.error != IoError::Nack) {
         // Not an empty address: the bus failed. The routine transfers will see it too.
         end({Status::Hardware, std::string(step.restore ? "putting the mux back" : "probing " + segment_text(step.segment)) +

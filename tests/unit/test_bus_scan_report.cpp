@@ -88,6 +88,17 @@ TEST_CASE("a moved thruster does not take the place of one where configured") {
     CHECK(r.thrusters[0].device == 1);
 }
 
+TEST_CASE("a trunk device answers on every channel too: counted once, on the trunk") {
+    BusScanReport r;
+    CHECK(add_scan_device(r, {std::nullopt, 0x52, Variant::SeaBotix, 0, -1}));
+    CHECK_FALSE(add_scan_device(r, found(0x52, 1)));
+    CHECK(add_scan_device(r, found(0x56, 1)));
+    REQUIRE(r.devices.size() == 2);
+    ThrusterConfig trunk;
+    judge_bus_scan(std::vector<ThrusterConfig>{trunk, at(0x56, 1)}, r);
+    CHECK(r.matches());
+}
+
 TEST_CASE("a probe's reply: SeaBotix by its 7 bytes, legacy by its 4, else no thruster") {
     const auto sb = encode_seabotix_status(0x52, 0x32, 0, 0, 0x80, 20); // revision 3, brushless
     ProbeAnswer a = classify_probe_reply(0x52, sb);
