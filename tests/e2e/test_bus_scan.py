@@ -129,7 +129,9 @@ class MatchingBusTest(ScanCase):
     def test_scan_while_killed_finds_every_thruster_where_configured(self):
         rig = self.rig
         since = rig.wire_next()
+        t0 = time.monotonic()
         devices, thrusters = self.scan()
+        print("a scan of %d probes took %.0f ms" % (len(set(DEFAULT_MT) | {LEGACY_MT}) * 5, (time.monotonic() - t0) * 1e3))
         walk = with_channels(rig, since)
         self.assertEqual(rig.state(), "killed")
         self.assertEqual(thrusters, [("ok", "")] * MOTORS)
