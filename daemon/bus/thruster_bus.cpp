@@ -41,13 +41,15 @@ void ThrusterBus::zero_all(ZeroOrder where) {
     }
     // While recovering, the adapter is closed or about to be: the zeros go out when it is
     // back (BusRecovery::finish), not as failures that would hold the bus clear up.
-    if (where == ZeroOrder::First && prober_)
-        prober_->dropped(); // a kill ends a scan, whether or not its next step was queued
+    if (recovering() && where == ZeroOrder::First && prober_)
+        prober_->dropped();
     if (recovering())
         return;
-    if (where == ZeroOrder::First)
+    if (where == ZeroOrder::First) {
         worker_.submit_first(std::span<const BusJob>(zeros).first(n));
-    else
+        if (prober_)
+            prober_->dropped(); // after the zeros: a kill ends a scan, its next step queued or not
+    } else
         for (std::size_t i = 0; i < n; ++i)
             worker_.submit(zeros[i], false); // behind what is queued, not instead of it
 }
