@@ -169,13 +169,32 @@ class KillDuringScanTest(ScanCase):
     """The wire really waited, at 10 kHz: a scan lasts long enough to be killed in the middle."""
     SIM_ARGS = ("--realistic-timing", "--clock-hz", "10000")
 
+    def start_scan(self, since):
+        """caracaractl scan, running; returned once its probes are on the wire."""
+        scan = subprocess.Popen(command("caracaractl") + ["--bus-address", self.rig.address, "scan"],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        poll(lambda: probes(with_channels(self.rig, since)), 10, interval=0.001, message="the scan never started probing")
+        return scan
+
+    def test_a_clear_kill_during_a_scan_ends_it(self):
+        rig = self.rig
+        since = rig.wire_next()
+        scan = self.start_scan(since)
+        rig.vcall("ClearKill")
+        t_reply = time.monotonic_ns()
+        out, err = scan.communicate(timeout=30)
+        self.assertEqual(scan.returncode, 1, "the scan went on after ClearKill: %s" % out)
+        self.assertIn("NotKilled", err)
+        # At most the one probe already handed to the bus follows the ClearKill (its mux write and
+        # its read, logged with the time its end is due); then none.
+        late = [e for e in probes(with_channels(rig, since)) if e.read and e.time_ns > t_reply]
+        self.assertLessEqual(len(late), 1, "probes after ClearKill: %s" % late)
+        rig.wait_state("ready")
+
     def test_a_second_scan_while_one_runs_is_busy_and_a_kill_ends_it(self):
         rig = self.rig
         since = rig.wire_next()
-        scan = subprocess.Popen(command("caracaractl") + ["--bus-address", rig.address, "scan"],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        # Kill once the scan has started probing.
-        poll(lambda: probes(with_channels(rig, since)), 10, interval=0.001, message="the scan never started probing")
+        scan = self.start_scan(since)  # killed once it has started probing
         busy = error_name(rig.vcall, "ScanBus")
         t_kill = time.monotonic_ns()
         rig.vcall("Kill")
@@ -193,7 +212,7 @@ class KillDuringScanTest(ScanCase):
         zeros_after = [e for e in orders(entries) if e.time_ns >= t_kill]
         self.assertTrue(zeros_after)
         self.assertEqual({e.data[0] for e in zeros_after}, {ZERO})
-        late_probes = [e for e in probes(walk) if e.time_ns > t_reply]
+        late_probes = [e for e in probes(walk) if e.read and e.time_ns > t_reply]
         self.assertLessEqual(len(late_probes), 1, "probes after the kill's reply: %s" % late_probes)
         # A new scan runs to its end.
         self.assertEqual(self.scan()[1], [("ok", "")] * MOTORS)
