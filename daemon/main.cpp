@@ -189,7 +189,7 @@ int main(int argc, char** argv) {
     // Each D-Bus object gets the parts it shows and drives, not the whole daemon.
     dbus::VehicleService service(bus.get(), {{daemon.vehicle(), daemon.packets(), daemon.teensy(), daemon.loop(),
                                               daemon.config().control, daemon.failsafes(), daemon.motor_test(),
-                                              daemon.directions(), daemon.preflight()},
+                                              daemon.directions(), daemon.preflight(), daemon.bus_scan()},
                                              daemon.bus(), daemon.bus().monitor(), daemon.teensy(), daemon.events()});
     daemon.events().attach(&service);
     if (int r = service.start(); r < 0) {

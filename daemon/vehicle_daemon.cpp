@@ -22,7 +22,8 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
                  [this] { return vehicle_conditions(); }, vehicle_, events_),
       motor_test_(config_, vehicle_, events_),
       directions_(config_, vehicle_, teensy_, failsafes_),
-      preflight_(config_, bus_, teensy_, lines_) {
+      preflight_(config_, bus_, teensy_, lines_),
+      bus_scan_(config_, vehicle_, bus_) {
     vehicle_.set_demand_listener(&loop_);
     bus_.monitor().set_listener(&recovery_);
     events_.attach_status(&status_);
@@ -120,6 +121,7 @@ void VehicleDaemon::shutdown() {
     motor_test_.stop();
     directions_.stop();
     preflight_.stop();
+    bus_scan_.stop();
     if (recorder_) {
         recorder_->stop(); // the dive ends here, before the zeros of the way out
         events_.attach_recorder(nullptr);

@@ -5,6 +5,7 @@
 
 #include "core/config.hpp"
 #include "daemon/bus/thruster_bus.hpp"
+#include "daemon/commissioning/bus_scan.hpp"
 #include "daemon/commissioning/direction_detection.hpp"
 #include "daemon/commissioning/motor_test.hpp"
 #include "daemon/commissioning/preflight.hpp"
@@ -64,6 +65,7 @@ public:
     const MotorTest& motor_test() const { return motor_test_; }
     DirectionDetection& directions() { return directions_; }
     Preflight& preflight() { return preflight_; }
+    BusScan& bus_scan() { return bus_scan_; }
     FailsafeMonitor& failsafes() { return failsafes_; }
     const FailsafeMonitor& failsafes() const { return failsafes_; }
     // The dive recorder, or nullptr when recorder.enabled is false.
@@ -91,6 +93,7 @@ private:
     MotorTest motor_test_;
     DirectionDetection directions_;
     Preflight preflight_;
+    BusScan bus_scan_;
     std::unique_ptr<DiveWriter> dive_writer_;
     std::unique_ptr<DiveRecorder> recorder_;
     bool started_ = false;

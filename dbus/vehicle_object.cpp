@@ -2,6 +2,7 @@
 
 #include "dbus/announcer.hpp"
 #include "dbus/directions_reply.hpp"
+#include "dbus/bus_scan_reply.hpp"
 #include "dbus/error_reply.hpp"
 #include "dbus/preflight_reply.hpp"
 #include "dbus/vehicle_names.hpp"
@@ -116,6 +117,10 @@ int m_preflight(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return run_preflight(m, static_cast<Parts*>(userdata)->preflight);
 }
 
+int m_scan_bus(sd_bus_message* m, void* userdata, sd_bus_error*) {
+    return scan_bus(m, static_cast<Parts*>(userdata)->bus_scan);
+}
+
 const ControlSettings& control(D d) { return d.control; }
 
 constexpr Member kMembers[] = {
@@ -135,6 +140,8 @@ constexpr Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("DetectDirections", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(sddddd)", thrusters, "s", fragment),
                                    m_detect_directions, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("Preflight", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(sbss)", items), m_preflight, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("ScanBus", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(qiysyi)", devices, "a(ss)", thrusters),
+                                   m_scan_bus, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetProfile", SD_BUS_ARGS("s", name), SD_BUS_NO_RESULT, m_set_profile, kUnpriv)),

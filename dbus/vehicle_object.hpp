@@ -2,6 +2,7 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/commissioning/bus_scan.hpp"
 #include "daemon/commissioning/direction_detection.hpp"
 #include "daemon/commissioning/motor_test.hpp"
 #include "daemon/commissioning/preflight.hpp"
@@ -18,7 +19,7 @@ class VehicleObject {
 public:
     // What the object drives and shows: the vehicle, its legacy packet, the Teensy's LEDs, the loop's cycle
     // count, the control settings, the failsafes (active ones, ClearKillOverride), the motor test,
-    // direction detection and the preflight.
+    // direction detection, the preflight and the bus scan.
     struct Parts {
         Vehicle& vehicle;
         PacketHandler& packets;
@@ -29,6 +30,7 @@ public:
         MotorTest& motor_test;
         DirectionDetection& directions;
         Preflight& preflight;
+        BusScan& bus_scan;
     };
     VehicleObject(sd_bus* bus, const Parts& parts);
     VehicleObject(const VehicleObject&) = delete;

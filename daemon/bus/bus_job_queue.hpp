@@ -16,12 +16,16 @@
 
 namespace caracara {
 
-enum class BusJobKind : uint8_t { Order, Status };
+// Probe: a bus scan's step (BusProber; index 0, value the step), queued as a status read is:
+// behind every order, and dropped by a kill's zeros as they are.
+// Probe: a bus scan's step (BusProber; index 0, value the step), queued as a status read is:
+// behind every order, and dropped by a kill's zeros as everything queued is.
+enum class BusJobKind : uint8_t { Order, Status, Probe };
 
 struct BusJob {
     BusJobKind kind = BusJobKind::Order;
     uint32_t index = 0;
-    int32_t value = 0;  // the motor value of an order
+    int32_t value = 0;  // the motor value of an order; a probe's step
     uint64_t epoch = 0; // hold_orders() count when it was handed over (set by submit)
 };
 

@@ -13,8 +13,9 @@ BusJobDone BusTransfer::run(const BusJob& job) {
     thread_local const pid_t self = ::gettid();
     if (gate && !gate->enter(self))
         return {job, IoError::None, true}; // the crash handler has the bus; the process is ending
-    ThrusterDriver& d = *drivers_[job.index];
-    const IoError e = job.kind == BusJobKind::Order ? d.send_order(job.value) : d.read_status();
+    const IoError e = job.kind == BusJobKind::Probe   ? prober_->probe(static_cast<uint32_t>(job.value))
+                      : job.kind == BusJobKind::Order ? drivers_[job.index]->send_order(job.value)
+                                                      : drivers_[job.index]->read_status();
     if (gate)
         gate->leave();
     return {job, e, false};

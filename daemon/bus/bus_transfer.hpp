@@ -4,6 +4,7 @@
 #pragma once
 
 #include "daemon/bus/bus_job_queue.hpp"
+#include "daemon/bus/bus_prober.hpp"
 #include "drivers/devices/bus_gate.hpp"
 #include "drivers/devices/thruster_driver.hpp"
 
@@ -27,6 +28,7 @@ public:
     // Every transfer enters `gate` (the emergency stop's), so a crash handler on another thread
     // can keep this one off the wire while it sends its zeros. Null: no gate.
     void set_gate(BusGate* gate) { gate_.store(gate); }
+    void set_prober(BusProber* prober) { prober_ = prober; } // runs the Probe jobs; set while idle
 
     // The job's transfer, unless a kill overtook it or the gate is closed (`skipped`).
     BusJobDone run(const BusJob& job);
@@ -35,6 +37,7 @@ private:
     std::vector<std::unique_ptr<ThrusterDriver>>& drivers_; // the worker's thread's while it runs
     std::atomic<uint64_t> epoch_{0};
     std::atomic<BusGate*> gate_{nullptr};
+    BusProber* prober_ = nullptr;
 };
 
 } // namespace caracara

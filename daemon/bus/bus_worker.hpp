@@ -54,6 +54,7 @@ public:
     // A kill's fence and the emergency stop's gate: see BusTransfer.
     void hold_orders() { transfer_.hold_orders(); }
     void set_gate(BusGate* gate) { transfer_.set_gate(gate); }
+    void set_prober(BusProber* prober) { transfer_.set_prober(prober); } // runs the Probe jobs; set while idle
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
     bool idle() const { return outstanding_ == 0; }
     // At once (the default): the loop is woken as soon as a batch is over. Otherwise it takes the

@@ -41,17 +41,29 @@ void ThrusterBus::zero_all(ZeroOrder where) {
     }
     // While recovering, the adapter is closed or about to be: the zeros go out when it is
     // back (BusRecovery::finish), not as failures that would hold the bus clear up.
+    if (recovering() && where == ZeroOrder::First && prober_)
+        prober_->dropped();
     if (recovering())
         return;
-    if (where == ZeroOrder::First)
+    if (where == ZeroOrder::First) {
         worker_.submit_first(std::span<const BusJob>(zeros).first(n));
-    else
+        if (prober_)
+            prober_->dropped(); // after the zeros: a kill ends a scan, its next step queued or not
+    } else
         for (std::size_t i = 0; i < n; ++i)
             worker_.submit(zeros[i], false); // behind what is queued, not instead of it
 }
 
 void ThrusterBus::read_status(std::size_t i) {
     worker_.submit({BusJobKind::Status, static_cast<uint32_t>(i), 0});
+}
+
+void ThrusterBus::submit_probe(BusProber& prober, uint32_t step) {
+    if (prober_ != &prober)
+        worker_.set_prober(&prober); // before the job: submit() hands both to the thread
+    prober_ = &prober;
+    worker_.submit({BusJobKind::Probe, 0, static_cast<int32_t>(step)}, false);
+    worker_.wake_when_done();
 }
 
 void ThrusterBus::when_idle(std::function<void()> fn) {
@@ -71,7 +83,10 @@ void ThrusterBus::update_wake_at_once() {
 }
 
 void ThrusterBus::done(const BusJobDone& d) {
-    if (!d.skipped) {
+    // A probe's NACK is an empty address, not a failing bus: the scan judges it.
+    if (d.job.kind == BusJobKind::Probe && prober_)
+        prober_->probed(d);
+    else if (!d.skipped) {
         monitor_.note(d.error);
         health_.note(d.job.index, d.error, monitor_.healthy());
     }
@@ -90,8 +105,11 @@ void ThrusterBus::done(const BusJobDone& d) {
 
 void ThrusterBus::set_recovering(bool r) {
     monitor_.set_recovering(r);
-    if (r)
+    if (r) {
         worker_.drop_queued(); // the adapter is about to close; what is on the wire finishes
+        if (prober_)
+            prober_->dropped();
+    }
     update_wake_at_once();
 }
 

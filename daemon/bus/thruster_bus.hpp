@@ -38,6 +38,9 @@ public:
     // Each hands one transfer to the worker; its outcome arrives later through done().
     void send_order(std::size_t i, int32_t value);
     void read_status(std::size_t i);
+    // One step of a bus scan, run on the worker's thread behind every order (BusProber);
+    // `prober` hears of it on the loop thread, at once.
+    void submit_probe(BusProber& prober, uint32_t step);
     // The transfers handed over in between wake the worker once (see BusWorker).
     void hold_wakeups() { worker_.hold_wakeups(); }
     void release_wakeups() { worker_.release_wakeups(); }
@@ -69,6 +72,8 @@ public:
     void set_recovering(bool r);
     bool recovering() const { return monitor_.recovering(); }
     MuxTracker& mux() { return mux_; }
+    // The adapter, for the worker's thread only (a probe step).
+    I2cDev& i2c() { return i2c_; }
     bool any_online() const;
 
     std::size_t size() const { return thrusters_.size(); }
@@ -95,6 +100,7 @@ private:
     std::function<void(const BusJob&)> on_done_;
     std::vector<std::function<void()>> when_idle_;
     bool results_at_tick_ = false;
+    BusProber* prober_ = nullptr;
     bool wake_at_once_ = true; // as last told to the worker
 };
 

@@ -38,14 +38,8 @@ IoError MuxTracker::select(I2cDev& bus, uint16_t addr7, uint8_t channel) {
     const std::size_t target = mux_index(addr7);
     // Another mux with a channel enabled (or in an unknown state, e.g. left over from a
     // previous run) could put a same-address thruster on the bus next to ours.
-    for (std::size_t i = 0; i < known_.size(); ++i) {
-        if (i == target || !known_[i] || state_[i] == kDisabled)
-            continue;
-        const IoError e = write_control(bus, i, kMuxDisableAll);
-        if (e != IoError::None)
-            return e;
-        state_[i] = kDisabled;
-    }
+    if (const IoError e = disable_others(bus, target); e != IoError::None)
+        return e;
     if (state_[target] == static_cast<int8_t>(channel))
         return IoError::None;
     const IoError e = write_control(bus, target, mux_control_byte(channel));
@@ -53,6 +47,27 @@ IoError MuxTracker::select(I2cDev& bus, uint16_t addr7, uint8_t channel) {
         return e;
     state_[target] = static_cast<int8_t>(channel);
     return IoError::None;
+}
+
+IoError MuxTracker::disable_others(I2cDev& bus, std::size_t keep) {
+    for (std::size_t i = 0; i < known_.size(); ++i) {
+        if (i == keep || !known_[i] || state_[i] == kDisabled)
+            continue;
+        const IoError e = write_control(bus, i, kMuxDisableAll);
+        if (e != IoError::None)
+            return e;
+        state_[i] = kDisabled;
+    }
+    return IoError::None;
+}
+
+IoError MuxTracker::disable_all(I2cDev& bus) { return disable_others(bus, known_.size()); }
+
+std::optional<MuxRoute> MuxTracker::enabled() const {
+    for (std::size_t i = 0; i < known_.size(); ++i)
+        if (known_[i] && state_[i] >= 0)
+            return MuxRoute{static_cast<uint16_t>(kMuxAddrMin + i), static_cast<uint8_t>(state_[i])};
+    return std::nullopt;
 }
 
 void MuxTracker::invalidate() { state_.fill(kUnknown); }

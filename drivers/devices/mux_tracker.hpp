@@ -26,6 +26,10 @@ public:
     // write is its own I2C_RDWR. On failure the state of the mux that failed becomes unknown.
     // IoError::Other without bus traffic for an address outside 0x70..0x77 or channel > 3.
     IoError select(I2cDev& bus, uint16_t addr7, uint8_t channel);
+    // Every known mux with no channel enabled (a bus scan's look at the trunk alone).
+    IoError disable_all(I2cDev& bus);
+    // The one mux known to have a channel enabled, and that channel.
+    std::optional<MuxRoute> enabled() const;
     // Forget all state (after any bus error, recovery or reopen): the next select writes again.
     void invalidate();
     void invalidate(uint16_t addr7);
@@ -41,6 +45,8 @@ private:
     static constexpr int8_t kUnknown = -1;
     static constexpr int8_t kDisabled = -2;
     IoError write_control(I2cDev& bus, std::size_t index, uint8_t value);
+    // Disables every known mux but the one at index `keep` (none kept when out of range).
+    IoError disable_others(I2cDev& bus, std::size_t keep);
 
     std::array<bool, 8> known_{};
     std::array<int8_t, 8> state_{};  // channel 0..3, kUnknown or kDisabled

@@ -6,6 +6,7 @@
 #include "drivers/platform/sim/sim_device_io.hpp"
 #include "tests/integration/sim_fixture.hpp"
 #include "drivers/devices/thruster_driver.hpp"
+#include "drivers/devices/thruster_probe.hpp"
 
 #include "tests/catch.hpp"
 #include <memory>
@@ -210,6 +211,23 @@ TEST_CASE("same-address thrusters behind a PCA9544A get their channel selected f
     CHECK(log[1].addr == 0x29);
     CHECK(log[2].data == std::vector<uint8_t>{0x05});
     CHECK(log[4].data == std::vector<uint8_t>{0x04});
+}
+
+TEST_CASE("a bus scan's probe: the trunk alone with every channel off, then each channel") {
+    SimFixture probe;
+    SimFixture f({"--config", probe.write_file("vehicle.toml", two_muxed(0x70, 0, 0x71, 1))});
+    Bench b(f, {muxed(0x70, 0), muxed(0x71, 1)});
+    REQUIRE(b.thrusters[1]->send_order(0) == IoError::None); // 0x71 on channel 1
+    CHECK(b.mux.enabled()->addr7 == 0x71);
+    ProbeAnswer a;
+    REQUIRE(b.mux.disable_all(*b.bus) == IoError::None);
+    CHECK_FALSE(b.mux.enabled());
+    CHECK(probe_thruster(*b.bus, 0x52, a) == IoError::Nack); // both behind a mux: nobody on the trunk
+    REQUIRE(b.mux.select(*b.bus, 0x70, 0) == IoError::None);
+    REQUIRE(probe_thruster(*b.bus, 0x52, a) == IoError::None);
+    CHECK(a.variant == Variant::SeaBotix);
+    CHECK(probe_thruster(*b.bus, 0x54, a) == IoError::Nack);
+    CHECK(b.mux.enabled()->channel == 0);
 }
 
 TEST_CASE("reversed thrusters get the opposite direction on the wire") {

@@ -166,10 +166,10 @@ if [ -n "${CARACARA_KERNEL_BUILD:-}" ]; then
   step "using caracarad and caracara-sim of $cov in the guest root $guest_root"
   find "$cov" -name '*.gcda' -delete
 else
-  step "building caracarad and caracara-sim with --coverage"
+  step "building caracarad, caracara-sim and caracaractl with --coverage"
   cov=$work/cov
   nice -n 10 cmake -S "$top" -B "$cov" -DCMAKE_BUILD_TYPE=Debug -DCARACARA_WERROR=ON -DCMAKE_CXX_FLAGS=--coverage >/dev/null
-  nice -n 10 cmake --build "$cov" -j2 --target caracarad caracara-sim >/dev/null
+  nice -n 10 cmake --build "$cov" -j2 --target caracarad caracara-sim caracaractl >/dev/null
   find "$cov" -name '*.gcda' -delete
 fi
 

@@ -444,6 +444,48 @@ def sc_i2ctransfer(rig):
     check(nack and nack[-1].result == "nack", "no NACK of 0x11 in the wire log")
 
 
+def sc_bus_scan(rig):
+    """caracaractl scan through the real i2c-dev: killed, every probe address on the trunk and on
+    each of the mux's four channels, each thruster found where the configuration puts it (6 and 7
+    behind their channels), the empty addresses NACKed by the kernel; refused while armed; i2c-tools
+    reads the same status reply at thruster 0's address."""
+    refused = rig.ctl("scan")
+    check(refused.returncode == 1 and "NotKilled" in refused.stderr, "scan while armed: %r" % refused.stderr)
+    rig.vcall("Kill")
+    rig.wait_state("killed", 20)
+    since = rig.wire_next()
+    p = rig.ctl("scan", timeout=300)
+    print(p.stdout)
+    check(p.returncode == 0, "caracaractl scan exited %d: %s%s" % (p.returncode, p.stdout, p.stderr))
+    check("the bus matches the configuration" in p.stdout, "no match in %r" % p.stdout)
+    for i in MUXED:
+        check("0x70/%d     0x%02x" % (MUXED[i], DEFAULT_MT[i]) in p.stdout, "thruster %d not on its channel" % i)
+    # From a little before the scan: the mux's channel as the scan found it (the routine orders
+    # to 6 and 7 switch it every cycle); the whole log is long by now, and slow to read under TCG.
+    entries = [e for e in rig.wire_log(max(1, since - 400))[1] if e.bus == "i2c"]
+    check(not [e for e in entries if e.index >= since and not e.read and e.addr != MUX and e.data[:1] != bytes([ZERO])],
+          "a non-zero order during the scan")
+    channels = set()
+    channel = None
+    for e in entries:
+        if e.addr == MUX and not e.read and e.data and e.result == "ack":
+            channel = e.data[-1] & 0x03 if e.data[-1] & 0x04 else -1
+        elif e.index >= since and e.read and e.addr == 0x54 >> 1 and channel is not None:
+            check(e.result == "nack", "the empty legacy address answered: %s" % (e,))
+            channels.add(channel)
+    check(channels == {-1, 0, 1, 2, 3}, "0x54 probed on %s, not the trunk and channels 0-3" % sorted(channels))
+    r = subprocess.run(["/usr/sbin/i2ctransfer", "-y", str(I2C_BUS), "r7@0x%02x" % (DEFAULT_MT[0] >> 1)],
+                       capture_output=True, text=True, timeout=30)
+    reply = [int(x, 16) for x in r.stdout.split()]
+    check(r.returncode == 0 and len(reply) == 7 and reply[0] == DEFAULT_MT[0] | 1
+          and sum(reply[:6]) & 0xFF == reply[6], "i2ctransfer status read: %r %r" % (r.stdout, r.stderr))
+    row = [line for line in p.stdout.splitlines() if line.startswith("trunk") and "0x%02x" % DEFAULT_MT[0] in line]
+    check(row and row[0].split()[2] == "seabotix" and int(row[0].split()[3]) == reply[1] >> 4,
+          "scan row %r vs the status byte 0x%02x" % (row, reply[1]))
+    rig.vcall("ClearKill")
+    rig.wait_state("ready", 20)
+
+
 def write_config(rig, **sections):
     """Replaces some sections of the daemon's configuration file (read at its next start)."""
     rig.extra_config = dict(rig.extra_config, **sections)
@@ -1036,6 +1078,7 @@ SCENARIOS = [
     ("set_motion_through_muxes", sc_set_motion),
     ("kill", sc_kill),
     ("kill_switch_edge", sc_kill_switch),
+    ("bus_scan_through_the_kernel", sc_bus_scan),
     ("nacking_and_corrupt_thruster", sc_thruster_faults),
     ("teensy_busy_and_turn", sc_teensy),
     ("bus_hang_recovered_with_rebind", sc_bus_hang),

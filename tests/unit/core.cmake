@@ -8,5 +8,7 @@ caracara_unit_test(test_config SOURCES unit/test_config.cpp LIBS caracara_core)
 target_compile_definitions(test_config PRIVATE
   CARACARA_EXAMPLE_CONFIG="${CMAKE_SOURCE_DIR}/daemon/caracarad.toml.example")
 caracara_unit_test(test_direction_judgement SOURCES unit/test_direction_judgement.cpp LIBS caracara_core)
+# The bus scan: what it probes, its verdicts, a probe reply told SeaBotix from legacy.
+caracara_unit_test(test_bus_scan_report SOURCES unit/test_bus_scan_report.cpp LIBS caracara_devices)
 # Every enum's names (core/enum_names.hpp), wherever the enum lives.
 caracara_unit_test(test_enum_names SOURCES unit/test_enum_names.cpp LIBS caracara_daemon caracara_simcore)

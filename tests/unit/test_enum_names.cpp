@@ -3,6 +3,7 @@
 // compiler (an enumerator prints by name in __PRETTY_FUNCTION__, any other value as a cast), so a
 // value added to an enum without a name in its table fails here.
 #include "core/budget.hpp"
+#include "core/bus_scan_report.hpp"
 #include "core/config.hpp"
 #include "core/dive_format.hpp"
 #include "core/failsafe.hpp"
@@ -85,6 +86,7 @@ TEST_CASE("the compiler tells an enumerator from another value") {
 TEST_CASE("every enum's values have one name each, and each name reads back") {
     check_names<BudgetError>("BudgetError");
     check_names<BudgetPolicy>("BudgetPolicy");
+    check_names<ScanVerdict>("ScanVerdict");
     check_names<dive::EventKind>("dive::EventKind");
     check_names<dive::ReadError>("dive::ReadError");
     check_names<FailsafeAction>("FailsafeAction");

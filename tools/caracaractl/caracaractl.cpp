@@ -12,6 +12,7 @@
 #include "tools/caracaractl/teensy_commands.hpp"
 #include "tools/caracaractl/thrust_commands.hpp"
 #include "tools/caracaractl/vehicle_commands.hpp"
+#include "tools/caracaractl/scan.hpp"
 #include "tools/client/client.hpp"
 #include "tools/client/ssh_target.hpp"
 
@@ -38,6 +39,8 @@ constexpr Command kCommands[] = {
     {"kill", "", "Zero every thruster at once and latch the kill", 0, cmd_kill},
     {"motor-test", "N --value V", "Run thruster N alone at V (bounded, armed only) until ^C or --for", 1,
      cmd_motor_test, nullptr, kOptHold | kOptValue},
+    {"scan", "", "Probe every thruster address on every mux channel (killed only); compare with the configuration", 0,
+     [](Client& c, const Args&, const Options&) { return scan_bus(c); }},
     {"detect-directions", "[--write FILE]",
      "Pulse each thruster, still and armed, and tell ok/reversed/inconclusive from the rotation", 0,
      cmd_detect_directions, nullptr, kOptWrite},
