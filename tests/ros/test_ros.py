@@ -9,6 +9,7 @@ from the simulator's wire log. Under CI (CI=true) a missing tool fails the test.
 """
 
 import contextlib
+import glob
 import hashlib
 import json
 import math
@@ -54,7 +55,8 @@ def build_peer(distro):
             missing(tool + " is needed (scripts/deps.sh: fastddsgen, libfastrtps-dev or libfastdds-dev, nodejs)")
     if not os.path.exists("/usr/include/fastdds/dds/domain/DomainParticipant.hpp"):
         missing("Fast DDS's headers are needed (scripts/deps.sh: libfastrtps-dev, Debian 13's libfastdds-dev)")
-    fastdds3 = os.path.exists("/usr/include/fastdds/config.hpp")
+    # Fast DDS 3's version header (Debian puts it under the multiarch include directory).
+    fastdds3 = bool(glob.glob("/usr/include/fastdds/config.hpp") + glob.glob("/usr/include/*/fastdds/config.hpp"))
     npm_ci(HERE)
     idl = subprocess.run(["node", "msg_to_idl.mjs", distro] + TYPES, cwd=HERE, check=True, capture_output=True,
                          text=True).stdout
