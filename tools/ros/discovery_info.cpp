@@ -3,7 +3,6 @@
 #include "tools/ros/dds_qos.hpp"
 #include "tools/ros/type_name.hpp"
 
-#include <algorithm>
 #include <cstring>
 #include <ros_msgs.h>
 #include <stdexcept>
