@@ -3,7 +3,8 @@
 // (msg_to_idl.mjs), never from the project's IDL. Modes (samples travel as hex CDR,
 // encapsulation header included, so the test encodes and decodes them with
 // @foxglove/rosmsg2-serialization):
-//   peer listen SECONDS TOPIC=TYPE...   one JSON line per sample {"topic","cdr","t_ns"}, per
+//   peer listen SECONDS TOPIC=TYPE...   SECONDS once every reader matched a writer (10 s at most
+//                                       for that); one JSON line per sample {"topic","cdr","t_ns"}, per
 //                                       discovered participant {"participant","guid","user_data"},
 //                                       writer {"writer","guid","type","reliable","transient_local","xcdr1"}
 //                                       and reader {"reader","guid"} (GUIDs as 32 hex digits)
@@ -21,6 +22,7 @@
 #include <ros_hPubSubTypes.h>
 #endif
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -265,6 +267,7 @@ int main(int argc, char** argv) {
         DomainParticipant* part = participant(&discovery);
         Subscriber* sub = part->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
         std::vector<std::unique_ptr<Printer>> printers;
+        std::vector<DataReader*> readers;
         for (int i = 3; i < argc; ++i) {
             const std::string a = argv[i];
             const auto eq = a.find('=');
@@ -287,8 +290,17 @@ int main(int argc, char** argv) {
             if (!latched)
                 rq.durability().kind = VOLATILE_DURABILITY_QOS;
             printers.push_back(std::make_unique<Printer>(a.substr(0, eq), type));
-            sub->create_datareader(topic, rq, printers.back().get());
+            readers.push_back(sub->create_datareader(topic, rq, printers.back().get()));
         }
+        // SECONDS from when every reader has matched a writer (at most 10 s for that): Fast DDS
+        // 3.1 and Cyclone take 1-2 s to find each other's endpoints, 2.9 and Cyclone less.
+        for (int i = 0; i < 400 && !std::all_of(readers.begin(), readers.end(), [](DataReader* r) {
+                            SubscriptionMatchedStatus m{};
+                            r->get_subscription_matched_status(m);
+                            return m.current_count > 0;
+                        });
+             ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(25));
         std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(std::atof(argv[2]) * 1000)));
         part->delete_contained_entities();
         DomainParticipantFactory::get_instance()->delete_participant(part);
@@ -322,6 +334,11 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "peer: no reader matched %s\n", argv[2]);
             return 1;
         }
+        // This writer matched the reader; the reader matches this writer only when this side's
+        // publication data reaches it, and a volatile reader skips what was written before. With
+        // Fast DDS 3.1 that came 1-2 s later to Cyclone (a kill written 1 s after the match was
+        // lost, 2 s after it was taken: e2e_ros in the Debian 13 root), with 2.9 at once.
+        std::this_thread::sleep_for(std::chrono::milliseconds(PEER_FASTDDS3 ? 3000 : 0));
         const int count = std::atoi(argv[5]);
         const auto period = std::chrono::microseconds(static_cast<int>(1e6 / std::atof(argv[6])));
         for (int i = 0; i < count; ++i) {
