@@ -5,14 +5,19 @@ set -euo pipefail
 # stress-ng: the loaded bench (bench/run.py phase loaded).
 # Catch2: "catch2" on Debian 12 (2.13); on Debian 13 "libcatch2-dev" (3.x; "catch2" is only a
 # transitional name there). libgpiod-dev is 1.6 on 12 and 2.2 on 13, the build takes either.
+# Fast DDS (the ros tests' peer): libfastrtps-dev 2.9 on Debian 12, libfastdds-dev 3.1 on 13.
 catch2=libcatch2-dev
-[ "$(. /etc/os-release && echo "${VERSION_CODENAME:-}")" = bookworm ] && catch2=catch2
+fastdds=libfastdds-dev
+if [ "$(. /etc/os-release && echo "${VERSION_CODENAME:-}")" = bookworm ]; then
+  catch2=catch2
+  fastdds=libfastrtps-dev
+fi
 pkgs=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev "$catch2" libtomlplusplus-dev
       dbus python3 python3-dbus python3-gi systemd debootstrap systemd-container valgrind stress-ng
       clang libclang-rt-dev python3-matplotlib python3-pil ccache libboost-dev nlohmann-json3-dev openssh-client)
 # caracara-ros (tools/ros): Cyclone DDS and its IDL compiler; its tests' second DDS vendor, Fast DDS
 # with fastddsgen (tests/ros), and iproute2 for the private network namespace.
-pkgs+=(cyclonedds-dev cyclonedds-tools libfastrtps-dev fastddsgen iproute2)
+pkgs+=(cyclonedds-dev cyclonedds-tools "$fastdds" fastddsgen iproute2)
 # Node.js and npm for the bridge's tests (tests/bridge: the Foxglove and MCAP reference
 # implementations): Debian's only when no node with npm is there, since Debian's npm conflicts
 # with other nodejs builds (NodeSource's bundles its own npm).

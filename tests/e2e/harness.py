@@ -48,13 +48,16 @@ def missing(what):
 
 
 def npm_ci(here):
-    """node_modules in `here` as its package-lock.json pins them (once per lock)."""
-    if not shutil.which("node") or not shutil.which("npm"):
-        missing("node and npm are needed (scripts/deps.sh)")
+    """node_modules in `here` as its package-lock.json pins them (once per lock). npm is needed only
+    to install them (the Debian 13 root has node and the packages the host installed)."""
+    if not shutil.which("node"):
+        missing("node is needed (scripts/deps.sh)")
     stamp = os.path.join(here, "node_modules", ".package-lock.json")
     lock = os.path.join(here, "package-lock.json")
     if os.path.exists(stamp) and os.path.getmtime(stamp) >= os.path.getmtime(lock):
         return
+    if not shutil.which("npm"):
+        missing("npm is needed to install %s's packages (scripts/deps.sh)" % here)
     subprocess.run(["npm", "ci", "--cache", NPM_CACHE, "--no-audit", "--no-fund", "--prefer-offline"], cwd=here,
                    check=True, stdout=subprocess.DEVNULL)
 

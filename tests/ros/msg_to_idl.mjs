@@ -1,11 +1,13 @@
 // The Fast DDS peer's types: the ROS 2 message definitions as published
 // (@foxglove/rosmsg-msgs-common, DISTRO's set) turned into DDS IDL the way rosidl maps them
-// (module pkg::msg::dds_, struct Type_, an empty message's one uint8), for fastddsgen.
-// Never from the project's own IDL. Usage: node msg_to_idl.mjs humble|jazzy TYPE... > ros.idl
+// (module pkg::msg::dds_, struct Type_, an empty message's one uint8), for fastddsgen, with
+// rmw_dds_common's graph messages (rmw_dds_common.mjs). Never from the project's own IDL.
+// Usage: node msg_to_idl.mjs humble|jazzy TYPE... > ros.idl
 import msgs from "@foxglove/rosmsg-msgs-common";
+import { withRmwDdsCommon } from "./rmw_dds_common.mjs";
 
 const [distro, ...roots] = process.argv.slice(2);
-const defs = msgs["ros2" + distro];
+const defs = withRmwDdsCommon(distro, msgs["ros2" + distro]);
 const prim = { bool: "boolean", byte: "octet", char: "uint8", int8: "int8", uint8: "uint8", int16: "int16",
   uint16: "uint16", int32: "int32", uint32: "uint32", int64: "int64", uint64: "uint64", float32: "float",
   float64: "double", string: "string" };

@@ -9,6 +9,7 @@ from the simulator's wire log. Under CI (CI=true) a missing tool fails the test.
 """
 
 import contextlib
+import glob
 import hashlib
 import json
 import math
@@ -35,28 +36,33 @@ from test_failsafes import kill_edges, orders  # noqa: E402
 # Every type caracara-ros speaks, with the topic it is on.
 TYPES = ["sensor_msgs/Imu", "sensor_msgs/JointState", "sensor_msgs/Range", "diagnostic_msgs/DiagnosticArray",
          "std_msgs/Bool", "std_msgs/String", "std_msgs/Empty", "std_msgs/Float64MultiArray", "geometry_msgs/Wrench",
-         "tf2_msgs/TFMessage"]
+         "tf2_msgs/TFMessage", "rmw_dds_common/ParticipantEntitiesInfo"]
 PUBLISHED = {"rt/caracara/imu": "sensor_msgs/Imu", "rt/caracara/joint_states": "sensor_msgs/JointState",
              "rt/caracara/thrusters/ordered": "sensor_msgs/JointState", "rt/caracara/range/0": "sensor_msgs/Range",
              "rt/diagnostics": "diagnostic_msgs/DiagnosticArray", "rt/caracara/killed": "std_msgs/Bool",
              "rt/caracara/state": "std_msgs/String", "rt/caracara/kill_source": "std_msgs/String",
              "rt/tf": "tf2_msgs/TFMessage"}
+DISCOVERY_INFO = {"ros_discovery_info": "rmw_dds_common/ParticipantEntitiesInfo"}
+GID_BYTES = {"humble": 24, "jazzy": 16}  # rmw_dds_common's Gid: char[24] in Humble, char[16] since Iron
 MOTOR_MAX = 8850
 
 
 def build_peer(distro):
-    """The Fast DDS peer for one distro's definitions, built once per source (in the build tree)."""
-    for tool in ("fastddsgen", "g++"):
+    """The Fast DDS peer for one distro's definitions, built once per source (in the build tree).
+    Fast DDS 2.9 and fastddsgen 2 on Debian 12, Fast DDS 3.1 and fastddsgen 4 on Debian 13."""
+    for tool in ("fastddsgen", "g++", "node"):
         if not shutil.which(tool):
-            missing(tool + " is needed (scripts/deps.sh: fastddsgen, libfastrtps-dev)")
+            missing(tool + " is needed (scripts/deps.sh: fastddsgen, libfastrtps-dev or libfastdds-dev, nodejs)")
     if not os.path.exists("/usr/include/fastdds/dds/domain/DomainParticipant.hpp"):
-        missing("libfastrtps-dev is needed (scripts/deps.sh)")
+        missing("Fast DDS's headers are needed (scripts/deps.sh: libfastrtps-dev, Debian 13's libfastdds-dev)")
+    # Fast DDS 3's version header (Debian puts it under the multiarch include directory).
+    fastdds3 = bool(glob.glob("/usr/include/fastdds/config.hpp") + glob.glob("/usr/include/*/fastdds/config.hpp"))
     npm_ci(HERE)
     idl = subprocess.run(["node", "msg_to_idl.mjs", distro] + TYPES, cwd=HERE, check=True, capture_output=True,
                          text=True).stdout
     with open(os.path.join(HERE, "peer.cpp")) as f:
         src = f.read()
-    key = hashlib.sha256((idl + src).encode()).hexdigest()[:16]
+    key = hashlib.sha256((idl + src + str(fastdds3)).encode()).hexdigest()[:16]
     out = os.path.join(BUILD_DIR, "tests", "ros", "peer-%s-%s" % (distro, key))
     exe = os.path.join(out, "peer")
     if os.path.exists(exe):
@@ -64,11 +70,12 @@ def build_peer(distro):
     os.makedirs(out, exist_ok=True)
     with open(os.path.join(out, "ros_h.idl"), "w") as f:
         f.write(idl)
-    subprocess.run(["fastddsgen", "-replace", "-d", out, os.path.join(out, "ros_h.idl")], check=True,
-                   stdout=subprocess.DEVNULL)
-    subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, os.path.join(HERE, "peer.cpp"),
-                    os.path.join(out, "ros_h.cxx"), os.path.join(out, "ros_hPubSubTypes.cxx"),
-                    "-lfastrtps", "-lfastcdr", "-o", exe + ".tmp"], check=True)
+    # fastddsgen 4 would add XTypes type objects: the peer matches by type name, as ROS 2 does.
+    subprocess.run(["fastddsgen", "-replace"] + (["-no-typeobjectsupport"] if fastdds3 else []) +
+                   ["-d", out, os.path.join(out, "ros_h.idl")], check=True, stdout=subprocess.DEVNULL)
+    generated = sorted(os.path.join(out, n) for n in os.listdir(out) if n.endswith(".cxx"))
+    subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, os.path.join(HERE, "peer.cpp")] + generated +
+                   ["-lfastdds" if fastdds3 else "-lfastrtps", "-lfastcdr", "-o", exe + ".tmp"], check=True)
     os.rename(exe + ".tmp", exe)
     return exe
 
@@ -109,8 +116,9 @@ def network_is_private():
     subprocess.run(["ip", "route", "replace", "224.0.0.0/4", "dev", "lo"], check=True)
 
 
-def fixed_sample(type_):
+def fixed_sample(type_, distro="humble"):
     """A fixed sample of each type, every field set to something other than its default."""
+    gid = {"data": list(range(1, GID_BYTES[distro] + 1))}
     h = {"stamp": {"sec": 1700000000, "nanosec": 123456789}, "frame_id": "base_link"}
     q = {"x": 0.1, "y": -0.2, "z": 0.3, "w": 0.9}
     v = {"x": 1.5, "y": -2.5, "z": 3.25}
@@ -134,6 +142,9 @@ def fixed_sample(type_):
         "geometry_msgs/Wrench": {"force": v, "torque": {"x": -0.25, "y": 0.5, "z": -0.75}},
         "tf2_msgs/TFMessage": {"transforms": [{"header": h, "child_frame_id": "base_link",
                                                "transform": {"translation": v, "rotation": q}}]},
+        "rmw_dds_common/ParticipantEntitiesInfo": {"gid": gid, "node_entities_info_seq": [
+            {"node_namespace": "/caracara", "node_name": "caracara_ros", "reader_gid_seq": [gid],
+             "writer_gid_seq": [gid, gid]}]},
     }[type_]
 
 
@@ -175,7 +186,8 @@ class RosTestCase(VehicleTestCase):
 
     def listen(self, seconds, topics=PUBLISHED, during=None):
         """The peer's view for `seconds`: (samples by topic, decoded, with time), participants,
-        writers. `during` is called every 20 ms while the peer listens."""
+        writers by topic, and every writer and reader discovered (a list). `during` is called every
+        20 ms while the peer listens."""
         args = ["%s=%s" % (t, ty) for t, ty in topics.items()]
         # Into files, not pipes: nothing reads a pipe while `during` runs, and a full one would
         # stop the peer.
@@ -189,7 +201,7 @@ class RosTestCase(VehicleTestCase):
             err_f.seek(0)
             out, err = out_f.read(), err_f.read()
         self.assertEqual(p.returncode, 0, err)
-        samples, participants, writers = {}, [], {}
+        samples, participants, writers, endpoints = {}, [], {}, []
         for line in out.splitlines():
             o = json.loads(line)
             if "topic" in o:
@@ -199,7 +211,45 @@ class RosTestCase(VehicleTestCase):
                 participants.append(o)
             elif "writer" in o:
                 writers[o["writer"]] = o
-        return samples, participants, writers
+                endpoints.append(o)
+            elif "reader" in o:
+                endpoints.append(o)
+        return samples, participants, writers, endpoints
+
+    def check_discovery_info(self, reader_topics):
+        """ros_discovery_info as ROS 2's graph cache reads it: the participant's gid is the GUID the
+        peer discovered (zeros after it to the distro's Gid size), one node caracara_ros in the
+        namespace, and its writer and reader gids exactly the GUIDs of the writers and readers the
+        peer discovered on that participant (the discovery info's own writer is not the node's)."""
+        samples, participants, writers, endpoints = self.listen(3, {**PUBLISHED, **DISCOVERY_INFO})
+        # By GUID: a participant found again (after a lease lapse under load) is the same one.
+        ros = {p["guid"] for p in participants if p["user_data"] == "enclave=/;"}
+        self.assertEqual(len(ros), 1, participants)
+        guid = ros.pop()
+        prefix = guid[:24]
+        self.assertIn("ros_discovery_info", samples, "no ros_discovery_info received")
+        w = writers["ros_discovery_info"]
+        self.assertEqual(w["type"], "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_")
+        self.assertTrue(w["reliable"] and w["transient_local"] and w["xcdr1"], w)
+        info = samples["ros_discovery_info"][-1][1]
+        pad = "00" * (GID_BYTES[self.DISTRO] - 16)
+        gid_hex = lambda g: bytes(g["data"]).hex()  # noqa: E731
+        self.assertEqual(gid_hex(info["gid"]), guid + pad)
+        self.assertEqual(len(info["node_entities_info_seq"]), 1)
+        node = info["node_entities_info_seq"][0]
+        self.assertEqual((node["node_namespace"], node["node_name"]), ("/caracara", "caracara_ros"))
+        listed_writers = [gid_hex(g) for g in node["writer_gid_seq"]]
+        listed_readers = [gid_hex(g) for g in node["reader_gid_seq"]]
+        for g in listed_writers + listed_readers:
+            self.assertTrue(g.endswith(pad), g)
+        ours = {o["guid"]: o for o in endpoints if o["guid"].startswith(prefix)}.values()
+        seen_writers = [o["guid"] for o in ours if o.get("writer", "ros_discovery_info") != "ros_discovery_info"]
+        seen_readers = [o for o in ours if "reader" in o]
+        self.assertEqual(sorted(g[:32] for g in listed_writers), sorted(seen_writers))
+        self.assertEqual(sorted(g[:32] for g in listed_readers), sorted(o["guid"] for o in seen_readers))
+        self.assertEqual(sorted(o["reader"] for o in seen_readers), sorted(reader_topics))
+        # Every published topic's writer is among them.
+        self.assertLessEqual(set(PUBLISHED), {o["writer"] for o in ours if "writer" in o})
 
     def publish(self, topic, type_, msg, count=1, hz=20.0):
         hex_ = self.codec.encode(type_, msg, self.DISTRO)
@@ -233,7 +283,7 @@ class BytesTest(unittest.TestCase):
             try:
                 for t in TYPES:
                     with self.subTest(distro=distro, type=t):
-                        ref = codec.encode(t, fixed_sample(t), distro)
+                        ref = codec.encode(t, fixed_sample(t, distro), distro)
                         fast = subprocess.run([peer, "roundtrip", t, ref], capture_output=True, text=True, check=True)
                         self.assertEqual(fast.stdout.strip(), ref)
                         self.assertTrue(ref.startswith("0001"), "CDR little-endian (XCDR1) encapsulation")
@@ -303,7 +353,7 @@ class PublishedTest(RosTestCase):
     """Every topic's type name, QoS and values as the Fast DDS peer receives them, against the simulator."""
 
     def test_discovery_data(self):
-        _, participants, writers = self.listen(3)
+        _, participants, writers, _ = self.listen(3)
         self.assertTrue(any(p["user_data"] == "enclave=/;" for p in participants), participants)
         for topic, type_ in PUBLISHED.items():
             with self.subTest(topic=topic):
@@ -315,6 +365,10 @@ class PublishedTest(RosTestCase):
                 self.assertTrue(w["xcdr1"])
                 self.assertEqual(w["transient_local"], topic.split("/")[-1] in ("killed", "state", "kill_source"))
 
+    def test_discovery_info_lists_the_node(self):
+        """`ros2 node list` / `ros2 node info` see caracara_ros with its topics (Humble's 24-byte gid)."""
+        self.check_discovery_info(["rt/caracara/kill"])
+
     def test_values_against_the_simulator(self):
         rig = self.rig
         rig.reset()
@@ -324,7 +378,7 @@ class PublishedTest(RosTestCase):
         # The simulator's attitude through the window (the body turns under this thrust), to
         # compare each Imu sample with the simulator's attitude at its stamp.
         attitude = []
-        samples, _, _ = self.listen(3, during=lambda: attitude.append(
+        samples, _, _, _ = self.listen(3, during=lambda: attitude.append(
             (time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")])))
         for topic in PUBLISHED:
             self.assertIn(topic, samples, "nothing received on " + topic)
@@ -377,7 +431,7 @@ class PublishedTest(RosTestCase):
         rig.wait_state("killed")
         self.assertEqual(rig.vget("KillSource"), "dbus")
         poll(lambda: kill_edges(rig.wire_log(since)[1]), 5, message="no kill output edge")
-        samples, _, _ = self.listen(1.5, {"rt/caracara/killed": "std_msgs/Bool", "rt/caracara/kill_source": "std_msgs/String"})
+        samples, _, _, _ = self.listen(1.5, {"rt/caracara/killed": "std_msgs/Bool", "rt/caracara/kill_source": "std_msgs/String"})
         self.assertIs(samples["rt/caracara/killed"][-1][1]["data"], True)
         self.assertEqual(samples["rt/caracara/kill_source"][-1][1]["data"], "dbus")
 
@@ -403,11 +457,15 @@ class JazzyRangeTest(RosTestCase):
     DISTRO = "jazzy"
 
     def test_range_in_jazzy_layout(self):
-        samples, _, writers = self.listen(2, {"rt/caracara/range/0": "sensor_msgs/Range"})
+        samples, _, writers, _ = self.listen(2, {"rt/caracara/range/0": "sensor_msgs/Range"})
         self.assertEqual(writers["rt/caracara/range/0"]["type"], "sensor_msgs::msg::dds_::Range_")
         r = samples["rt/caracara/range/0"][-1][1]
         self.assertEqual(r["variance"], 0.0)
         self.assertAlmostEqual(r["range"], int(self.rig.sim_teensy("Distances")[0]) / 1000, delta=0.002)
+
+    def test_discovery_info_with_jazzy_gids(self):
+        """Jazzy's 16-byte Gid, read by the peer built from Jazzy's rmw_dds_common."""
+        self.check_discovery_info(["rt/caracara/kill"])
 
 
 class CommandsTest(RosTestCase):
@@ -415,6 +473,9 @@ class CommandsTest(RosTestCase):
 
     def setUp(self):
         self.rig.rearm()
+
+    def test_discovery_info_lists_the_command_readers(self):
+        self.check_discovery_info(["rt/caracara/kill", "rt/caracara/cmd_wrench", "rt/caracara/cmd_thrust"])
 
     def test_wrench_axes_as_the_mixing_says(self):
         rig = self.rig

@@ -36,10 +36,13 @@ arch=$(dpkg --print-architecture)
 cache_dir=${CARACARA_SYSTEST_CACHE:-/var/cache/caracara-systest}
 build_timeout_s=${CARACARA_DEBIAN13_BUILD_TIMEOUT:-1500}
 # Build and test dependencies (scripts/deps.sh's, by their Debian 13 names), scripts/package.sh's
-# tools, and what the kernel test's guest runs in this root: insmod, i2c-tools.
+# tools, and what the kernel test's guest runs in this root: insmod, i2c-tools. The ros tests'
+# (tests/ros): Debian 13's Fast DDS 3.1 and fastddsgen 4 for the peer, node for the reference
+# codec (its npm packages are installed from the host, below), iproute2 for the namespace.
 packages=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev libcatch2-dev
           libtomlplusplus-dev libboost-dev nlohmann-json3-dev dbus python3 python3-dbus python3-gi python3-matplotlib
-          systemd dpkg-dev debhelper lintian kmod i2c-tools openssh-client ccache cyclonedds-dev cyclonedds-tools)
+          systemd dpkg-dev debhelper lintian kmod i2c-tools openssh-client ccache cyclonedds-dev cyclonedds-tools
+          libfastdds-dev fastddsgen nodejs iproute2)
 # Bump when the way the cached root is made changes.
 recipe=3
 
@@ -162,12 +165,13 @@ echo "== $PRETTY_NAME, $(g++ --version | head -n 1), cmake $(cmake --version | s
 echo "== build (scripts/build.sh, CARACARA_WERROR=ON)"
 "$SRC/scripts/build.sh" "$BUILD" -DCARACARA_WERROR=ON
 grep -E '^(GPIODCXX_VERSION|Catch2_DIR|TOMLPP_VERSION|SYSTEMD_VERSION)' "$BUILD/CMakeCache.txt" | sed 's/^/   /'
-# Nor bridge: its npm packages come from the registry; the host's suites run it.
-echo "== ctest (all but the tests labelled system, kernel, bridge or ros)"
+# Nor bridge: its npm packages come from the registry; the host's suites run it. The ros tests
+# run: their npm packages were installed into the source from the host (below).
+echo "== ctest (all but the tests labelled system, kernel or bridge)"
 # Direction detection twice, not five times in a row: the statistics are the host's normal
 # build's; here the other toolchain (tests/e2e/test_direction_detection.py).
 export CARACARA_DETECTION_RUNS=2
-CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel|bridge|ros'
+CLICOLOR=0 ctest --test-dir "$BUILD" --output-on-failure -j2 --timeout 600 -LE 'system|kernel|bridge'
 echo "== Debian packages (scripts/package.sh, nocheck: the suite just ran)"
 DEB_BUILD_OPTIONS=nocheck "$SRC/scripts/package.sh" native "$DEBS"
 SCRIPT
@@ -175,6 +179,15 @@ chmod 0755 "$root/usr/local/bin/caracara-build-and-test"
 
 debs=$build-debs
 mkdir -p "$debs"
+# The ros tests' npm packages (tests/ros/package-lock.json): the root has no network and sees the
+# source read-only, so they are installed here, as the host's own e2e_ros does (tests/e2e/harness.py
+# npm_ci); the root's node runs them (plain JavaScript).
+ros_npm=$src/tests/ros
+if [ ! "$ros_npm/node_modules/.package-lock.json" -nt "$ros_npm/package-lock.json" ]; then
+  command -v npm >/dev/null || die "npm is needed for the ros tests' packages (scripts/deps.sh)"
+  (cd "$ros_npm" && npm ci --cache /var/cache/caracara-npm --no-audit --no-fund --prefer-offline >/dev/null) ||
+    die "npm ci in $ros_npm failed"
+fi
 # The root's own ccache (GCC 14, not the host's compiler), kept between runs: CI builds mostly
 # the same sources each time, from a clone at a new path (scripts/ccache.sh sets the base dir).
 ccache_dir=$cache_dir/ccache-$suite-$arch

@@ -8,31 +8,6 @@ namespace {
 
 std::string error(const char* what, dds_return_t r) { return std::string(what) + ": " + dds_strretcode(r); }
 
-dds_qos_t* qos_for(Profile p) {
-    dds_qos_t* q = dds_create_qos();
-    switch (p) {
-    case Profile::Default:
-        dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-        dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
-        dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 10);
-        break;
-    case Profile::Latched:
-        dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-        dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
-        dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
-        break;
-    case Profile::SensorReader:
-        dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
-        dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
-        dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 5);
-        break;
-    }
-    // XCDR1, as rmw_cyclonedds_cpp and rmw_fastrtps_cpp speak (XCDR2 is not what ROS 2 uses).
-    const dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};
-    dds_qset_data_representation(q, 1, xcdr1);
-    return q;
-}
-
 } // namespace
 
 DdsParticipant::DdsParticipant(const RosConfig& c) {
@@ -52,6 +27,14 @@ DdsParticipant::DdsParticipant(const RosConfig& c) {
     dds_delete_qos(q);
     if (participant_ < 0)
         throw std::runtime_error(error("DDS participant", participant_));
+    try {
+        discovery_info_ = std::make_unique<DiscoveryInfo>(participant_, c);
+    } catch (...) {
+        dds_delete(participant_);
+        if (domain_ > 0)
+            dds_delete(domain_);
+        throw;
+    }
 }
 
 DdsParticipant::~DdsParticipant() {
@@ -74,6 +57,7 @@ dds_entity_t DdsParticipant::writer(const dds_topic_descriptor_t* desc, const st
     dds_delete_qos(q);
     if (w < 0)
         throw std::runtime_error(error(("DDS writer on " + ros_name).c_str(), w));
+    discovery_info_->add_writer(w);
     return w;
 }
 
@@ -84,6 +68,7 @@ dds_entity_t DdsParticipant::reader(const dds_topic_descriptor_t* desc, const st
     dds_delete_qos(q);
     if (r < 0)
         throw std::runtime_error(error(("DDS reader on " + ros_name).c_str(), r));
+    discovery_info_->add_reader(r);
     return r;
 }
 

@@ -1,21 +1,18 @@
 // caracara-ros's one DDS participant (Cyclone DDS) as a ROS 2 node's participant looks: on
 // ROS_DOMAIN_ID's domain, "enclave=/;" in its USER_DATA (rmw_cyclonedds registers only such
-// participants), every writer and reader XCDR1 on "rt/<topic>" with ROS 2's QoS profiles.
+// participants), every writer and reader XCDR1 on "rt/<topic>" with ROS 2's QoS profiles, each
+// listed in its ros_discovery_info as the node caracara_ros's (`ros2 node list`).
 #pragma once
 
+#include "tools/ros/dds_qos.hpp"
+#include "tools/ros/discovery_info.hpp"
 #include "tools/ros/ros_config.hpp"
 
 #include <dds/dds.h>
+#include <memory>
 #include <string>
 
 namespace caracara::ros {
-
-// The QoS profiles of rmw_qos_profile_t that the topics use.
-enum class Profile {
-    Default,        // reliable, volatile, keep-last 10 (rmw_qos_profile_default)
-    Latched,        // reliable, transient-local, keep-last 1 (a late subscriber gets the state)
-    SensorReader,   // best-effort, keep-last 5: matches reliable and best-effort writers alike
-};
 
 class DdsParticipant {
 public:
@@ -36,6 +33,7 @@ private:
 
     dds_entity_t domain_ = 0;
     dds_entity_t participant_ = 0;
+    std::unique_ptr<DiscoveryInfo> discovery_info_; // lists every reader and writer made here
 };
 
 } // namespace caracara::ros

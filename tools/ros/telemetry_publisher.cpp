@@ -2,6 +2,7 @@
 
 #include "drivers/protocol/seabotix.hpp"
 #include "tools/ros/ros_conventions.hpp"
+#include "tools/ros/type_name.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -47,14 +48,6 @@ double actual_fraction(const Props& p) {
     return m ? motor_fraction(*m) : 0.0;
 }
 
-// Jazzy's Range under the ROS type name (its IDL module is "jazzy" only so that both layouts
-// compile into one program); no XTypes type information, as for a type without one.
-dds_topic_descriptor_t jazzy_range_descriptor() {
-    const dds_topic_descriptor_t& d = jazzy_sensor_msgs_msg_dds__Range__desc;
-    return {d.m_size, d.m_align, d.m_flagset & ~DDS_TOPIC_XTYPES_METADATA, d.m_nkeys, "sensor_msgs::msg::dds_::Range_",
-            d.m_keys, d.m_nops, d.m_ops, d.m_meta, {nullptr, 0}, {nullptr, 0}, d.restrict_data_representation};
-}
-
 } // namespace
 
 TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config)
@@ -62,7 +55,7 @@ TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, con
       mirror_([this](const std::string& path, const std::string&, const Props& changes,
                      const Props&) { changed(path, changes); },
               [this] { reload(); }),
-      jazzy_range_(jazzy_range_descriptor()) {
+      jazzy_range_(under_type_name(jazzy_sensor_msgs_msg_dds__Range__desc, "sensor_msgs::msg::dds_::Range_")) {
     const auto topic = [&](const char* name) { return ros_topic(config_, name); };
     imu_ = dds_.writer(&sensor_msgs_msg_dds__Imu__desc, topic("imu"), Profile::Default);
     tf_ = dds_.writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Default);
