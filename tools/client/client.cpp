@@ -134,7 +134,7 @@ Props to_props(const Value& dict) {
     return props;
 }
 
-const Value& property(const Props& props, const std::string& name) {
+const Value& property(const Props& props, const char* name) {
     static const Value none;
     const auto it = props.find(name);
     return it == props.end() ? none : it->second;

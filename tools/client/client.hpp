@@ -71,7 +71,9 @@ Value read_value(sd_bus_message* m);
 // Turns a decoded a{sv} into a map.
 Props to_props(const Value& dict);
 // The property `name` of `props`, a None value when there is none.
-const Value& property(const Props& props, const std::string& name);
+// A `const char*` name, not a std::string: GCC 14 takes a temporary string argument for one the
+// returned reference may point into (-Wdangling-reference).
+const Value& property(const Props& props, const char* name);
 
 class Client {
 public:
