@@ -240,15 +240,16 @@ if [ "$kernel_rc" = skipped ] && [ "${CARACARA_DEBIAN13_KERNEL:-1}" != 0 ]; then
   say "kernel test with the Debian 13 build (tests/kernel/run.sh, guest root: the Debian 13 root)"
   t3=$(date +%s)
   kernel_rc=0
-  # caracarad and caracara-sim with --coverage by the root's GCC 14 (kept with the kernel work
-  # directory, so a rerun rebuilds only what changed).
+  # caracarad, caracara-sim and caracaractl (the bus scan scenario runs it in the guest) with
+  # --coverage by the root's GCC 14 (kept with the kernel work directory, so a rerun rebuilds
+  # only what changed).
   kcov=$kwork/cov
   mkdir -p "$kcov"
   timeout --kill-after=20 "$build_timeout_s" \
     systemd-nspawn --quiet --keep-unit --register=no --directory="$root" --private-network \
       --bind-ro="$src" --bind="$kwork" --bind="$ccache_dir:/var/cache/ccache" --setenv=HOME=/root \
       sh -c ". '$src/scripts/ccache.sh' '$src' && cmake -S '$src' -B '$kcov' -DCMAKE_BUILD_TYPE=Debug -DCARACARA_WERROR=ON -DCMAKE_CXX_FLAGS=--coverage >/dev/null &&
-             cmake --build '$kcov' -j2 --target caracarad caracara-sim >/dev/null" >"$work/kcov.log" 2>&1 || kernel_rc=$?
+             cmake --build '$kcov' -j2 --target caracarad caracara-sim caracaractl >/dev/null" >"$work/kcov.log" 2>&1 || kernel_rc=$?
   if [ "$kernel_rc" -ne 0 ]; then
     tail -n 40 "$work/kcov.log"
     say "FAIL: the coverage build for the kernel test failed in the Debian 13 root"
