@@ -9,7 +9,7 @@ import shutil
 import time
 import unittest
 
-from harness import (SANITIZED, Rig, command, poll)
+from harness import (EMULATOR, SANITIZED, Rig, command, poll)
 
 # /proc/<pid>/task/<tid>/stat fields after the command (field 2): rt_priority is field 40 and
 # policy field 41 (proc(5)).
@@ -128,7 +128,12 @@ class RealtimeTest(unittest.TestCase):
         elif may_lock_memory():
             self.assertGreater(status_kib(pid, "VmLck"), 1024, "memory not locked")
             self.assertIn("realtime: memory locked", rig.log())
-            self.check_cold_libraries_unlocked(rig, pid)
+            if EMULATOR:
+                # qemu-user maps the arm64 daemon's code as data it translates (no r-xp mapping
+                # of libc to look at): which libraries are locked is judged on the native builds.
+                print("the cold libraries: not judged under %s" % " ".join(EMULATOR))
+            else:
+                self.check_cold_libraries_unlocked(rig, pid)
         else:
             self.assertEqual(status_kib(pid, "VmLck"), 0, "memory locked past RLIMIT_MEMLOCK")
             self.assertIn("realtime: memory not locked: RLIMIT_MEMLOCK", rig.log(),
