@@ -1,11 +1,11 @@
 #include "daemon/commissioning/preflight_checks.hpp"
 
+#include "drivers/platform/dive_files.hpp"
 #include "drivers/protocol/seabotix.hpp"
 
 #include <cstdarg>
 #include <cstdio>
 #include <ctime>
-#include <filesystem>
 #include <sys/statvfs.h>
 #include <sys/timex.h>
 #include <unistd.h>
@@ -48,13 +48,12 @@ std::string utc(time_t t) {
     return buf;
 }
 
-// Bytes in the recorder directory's files: the dives the writer rotates out to stay in its bound.
+// Bytes in the recorder directory's dives: what the writer counts against its bound
+// (DiveWriter::do_open) and rotates out to stay in it.
 uint64_t recorded_bytes(const std::string& dir) {
-    std::error_code ec;
     uint64_t total = 0;
-    for (const auto& e : std::filesystem::directory_iterator(dir, ec))
-        if (e.is_regular_file(ec))
-            total += e.file_size(ec);
+    for (const DiveFile& f : list_dive_files(dir))
+        total += f.size;
     return total;
 }
 
