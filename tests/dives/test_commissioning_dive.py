@@ -17,7 +17,6 @@ pulsed, in the dive and on the wire: the eight the wire log saw.
 
 import csv
 import os
-import subprocess
 import sys
 import time
 import unittest
