@@ -251,7 +251,10 @@ class RosTestCase(VehicleTestCase):
         # Every published topic's writer is among them.
         self.assertLessEqual(set(PUBLISHED), {o["writer"] for o in ours if "writer" in o})
 
-    def publish(self, topic, type_, msg, count=1, hz=20.0):
+    def publish(self, topic, type_, msg, count=3, hz=2.0):
+        """Sends `msg` `count` times: a volatile reader that matches this writer late skips what
+        was written before it did (Fast DDS 3.1 to Cyclone: once in CI, 3 s after the writer's
+        own match was not enough), so one sample alone may be lost in discovery."""
         hex_ = self.codec.encode(type_, msg, self.DISTRO)
         r = subprocess.run([self.peer, "publish", topic, type_, hex_, str(count), str(hz)], capture_output=True,
                            text=True, timeout=60)
