@@ -421,8 +421,10 @@ class PublishedTest(RosTestCase):
         for n in ["caracara: thruster_%d" % i for i in range(MOTORS)] + ["caracara: i2c bus", "caracara: teensy",
                                                                          "caracara: failsafes", "caracara: vehicle"]:
             self.assertIn(n, names)
-        # Rates follow the daemon's announcements: joint_states comes many times a second.
-        self.assertGreater(len(samples["rt/caracara/joint_states"]), 10)
+        # Rates follow the daemon's announcements: joint_states comes with the thrusters' telemetry
+        # (at most 5 Hz, one message a batch, and only when a reading changed: 10 in the 3 s on a
+        # loaded CI machine), not only with changes of state.
+        self.assertGreaterEqual(len(samples["rt/caracara/joint_states"]), 5)
 
     def test_kill_topic_with_commands_off(self):
         """Kill is always taken; the kill output's edge is on the wire."""
