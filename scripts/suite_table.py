@@ -42,16 +42,20 @@ RECORD = os.path.join(TOP, "bench", "suite-results.json")
 README = os.path.join(TOP, "README.md")
 
 # The bridge's and the cockpit's end-to-end tests (CTest e2e_bridge, e2e_cockpit, label bridge)
-# run in the normal build only; where a run leaves them out, why (the script that does it says
-# the same where it does it). Shown unless that run's tests include them after all.
+# run in the normal build only, caracara-ros's (e2e_ros, label ros) in every build but arm64;
+# where a run leaves them out, why (the script that does it says the same where it does it).
+# Shown unless that run's tests include them after all.
 LEFT_OUT = {
-    "arm64": "scripts/cross_test.sh runs ctest -LE bridge: under qemu-user their timing-bound "
+    "arm64": "scripts/cross_test.sh runs ctest -LE 'bridge|ros': under qemu-user their timing-bound "
              "steps time out; the arm64 bridge's protocol, MCAP and file serving run in test_foxglove",
+    "ros arm64": "scripts/cross_test.sh runs ctest -LE 'bridge|ros': e2e_ros holds caracara-ros to the "
+                 "250 ms client-loss bound through a Fast DDS peer on the host, not under qemu-user; "
+                 "the arm64 caracara-ros is built",
     "Debian 13": "tests/system/debian13.sh runs ctest -LE 'system|kernel|bridge' in the Debian 13 root: "
                  "their npm packages come from the registry, which the root has no network for; "
                  "the Debian 12 run's suites run them",
 }
-BRIDGE_TESTS = {"bridge": "e2e_bridge", "cockpit": "e2e_cockpit"}
+BRIDGE_TESTS = {"bridge": "e2e_bridge", "cockpit": "e2e_cockpit", "ros": "e2e_ros"}
 
 
 class Suite:
@@ -182,7 +186,8 @@ def table(results):
               Suite("cockpit Debian 13", "normal", left_out=LEFT_OUT["Debian 13"]),
               Suite("ASan+UBSan", "sanitize"), Suite("arm64", "cross"),
               Suite("bridge arm64", "cross", left_out=LEFT_OUT["arm64"]),
-              Suite("cockpit arm64", "cross", left_out=LEFT_OUT["arm64"]), Suite("fuzz", "fuzz")]
+              Suite("cockpit arm64", "cross", left_out=LEFT_OUT["arm64"]),
+              Suite("ros arm64", "cross", left_out=LEFT_OUT["ros arm64"]), Suite("fuzz", "fuzz")]
     by = {s.name: s for s in suites}
 
     def add(suite, t, counts_from=None):
@@ -253,7 +258,7 @@ def table(results):
     for step, sname in (("sanitize", "ASan+UBSan"), ("cross", "arm64"), ("fuzz", "fuzz")):
         for t in read_junit(os.path.join(results, step + ".xml")):
             if step == "cross" and t[0] in BRIDGE_TESTS.values():
-                add(by["bridge arm64" if t[0] == "e2e_bridge" else "cockpit arm64"], t)
+                add(by[next(k for k, v in BRIDGE_TESTS.items() if v == t[0]) + " arm64"], t)
             else:
                 add(by[sname], t)
         sel, rc, _ = steps.get(step, (False, 0, 0))
