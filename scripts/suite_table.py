@@ -318,14 +318,17 @@ def print_table(rows, steps, failed, ci):
         print("suites: every selected suite ran and held")
 
 
-def record(rows, steps, failed):
+def record(rows, steps, failed, record_path):
     """The run as a record: what README's CI table is written from (--readme)."""
     commit = git("rev-parse", "HEAD")
     return {
         "written_by": "scripts/suite_table.py --record (scripts/test.sh)",
         "finished": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%MZ"),
         "commit": commit,
-        "tree_clean": git("status", "--porcelain", "--untracked-files=no") == "" if commit else None,
+        # The record file itself is left out: it is the one file this run rewrites.
+        "tree_clean": all(line.split(maxsplit=1)[-1] == os.path.relpath(record_path, TOP)
+                          for line in git("status", "--porcelain", "--untracked-files=no").splitlines())
+        if commit else None,
         "ci": CI,
         "machine": "%s, %d CPUs" % (os.uname().machine, os.cpu_count() or 0),
         "steps": {n: {"selected": v[0], "exit": v[1], "seconds": v[2]} for n, v in steps.items()},
@@ -405,8 +408,11 @@ def main():
     rows, steps, failed = table(args.results)
     print_table(rows, steps, failed, CI)
     if args.record:
+        # Read the tree before the file is opened: opening truncates it (it used to make every
+        # record say "with uncommitted changes").
+        rec = record(rows, steps, failed, os.path.abspath(args.record))
         with open(args.record, "w") as f:
-            json.dump(record(rows, steps, failed), f, indent=1)
+            json.dump(rec, f, indent=1)
             f.write("\n")
     return 1 if failed else 0
 
