@@ -87,12 +87,16 @@ class Vehicle:
         self.vehicle.ClearKill()
 
     def orientation(self):
-        """(yaw, pitch, roll) in radians; yaw is clockwise from above."""
+        """(heading, pitch, roll) in radians, as the Teensy reports them (docs/frames.md): heading
+        clockwise from above, pitch + nose up, roll + right side down."""
         o = self.teensy.Get(TEENSY_IFACE, "Orientation", dbus_interface=PROPS)
         return float(o[0]), float(o[1]), float(o[2])
 
-    def motion(self, x=0.0, y=0.0, z=0.0, yaw=0.0, pitch=0.0, roll=0.0):
-        self.vehicle.SetMotion(float(x), float(y), float(z), float(yaw), float(pitch), float(roll))
+    def motion(self, forward=0.0, turn_right=0.0):
+        """SetMotion takes the packet seed's axes (docs/frames.md): x + towards port, y + forward,
+        z + deeper, yaw + clockwise seen from above, pitch + nose up, roll + right side down. This
+        mission only drives forward and turns right (clockwise); each -1..1, 0 stops."""
+        self.vehicle.SetMotion(0.0, float(forward), 0.0, float(turn_right), 0.0, 0.0)
 
     def kill(self):
         self.vehicle.Kill()
@@ -116,8 +120,9 @@ class Mission:
         now = time.monotonic()
         if force or now - self.last_print >= 0.5:
             self.last_print = now
-            yaw, pitch, roll = self.v.orientation()
-            self.log("%-14s yaw %7.1f deg  pitch %5.1f deg  roll %5.1f deg" % (what, deg(yaw), deg(pitch), deg(roll)))
+            heading, pitch, roll = self.v.orientation()
+            self.log("%-14s heading %7.1f deg  nose up %5.1f deg  roll right %5.1f deg" %
+                     (what, deg(heading), deg(pitch), deg(roll)))
 
     def wait_ready(self):
         deadline = time.monotonic() + self.args.ready_timeout
@@ -150,7 +155,7 @@ class Mission:
         what = "leg %d forward" % leg
         end = time.monotonic() + self.args.leg_seconds
         while time.monotonic() < end:
-            self.v.motion(y=self.args.speed)
+            self.v.motion(forward=self.args.speed)
             self.report(what)
             time.sleep(self.period)
         self.check_state()
@@ -179,7 +184,7 @@ class Mission:
             else:
                 settled = 0
             demand = max(-self.args.yaw_demand, min(self.args.yaw_demand, 1.5 * err - 0.6 * rate))
-            self.v.motion(yaw=demand)
+            self.v.motion(turn_right=demand)
             self.report(what)
             if now > deadline:
                 raise MissionError("%s did not reach %.1f deg within %g s (at %.1f deg)" %

@@ -4,6 +4,7 @@
 #include "sim/inspect_reply.hpp"
 #include "sim/sim_vehicle.hpp"
 
+#include <cmath>
 #include <string>
 #include <tuple>
 
@@ -77,6 +78,23 @@ int m_commands(sd_bus_message* m, void* userdata, sd_bus_error*) {
                                       static_cast<uint64_t>(teensy(userdata).frames().commands_executed(cmd)));
 }
 
+// Place(x, y, depth, yaw, pitch, roll): the vehicle put somewhere, at rest (sim/vehicle_body.hpp's
+// world and angles), so that a test can start a motion below the surface or turned.
+int m_place(sd_bus_message* m, void* userdata, sd_bus_error* err) {
+    double x = 0, y = 0, depth = 0, yaw = 0, pitch = 0, roll = 0;
+    if (int r = sd_bus_message_read(m, "dddddd", &x, &y, &depth, &yaw, &pitch, &roll); r < 0)
+        return r;
+    for (double v : {x, y, depth, yaw, pitch, roll})
+        if (!std::isfinite(v))
+            return sd_bus_error_setf(err, kInspectInvalid, "a place must be finite numbers");
+    if (depth < 0)
+        return sd_bus_error_setf(err, kInspectInvalid, "depth must be 0 or more (the surface is 0), got %g", depth);
+    VehicleBody& body = static_cast<SimVehicle*>(userdata)->body();
+    body.set_position({x, y, depth});
+    body.set_attitude({yaw, pitch, roll});
+    return sd_bus_reply_method_return(m, "");
+}
+
 // GetFrameLog() -> a(tttysayay): seq, start_ns, end_ns, command, outcome, mosi, miso.
 int m_frame_log(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return reply_with(m, [&](sd_bus_message* reply) {
@@ -129,6 +147,8 @@ constexpr dbus::Member kMembers[] = {
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("CommandCount", SD_BUS_ARGS("y", command), SD_BUS_RESULT("t", received, "t", executed),
                                    m_commands, kUnpriv)),
+    member(SD_BUS_METHOD_WITH_ARGS("Place", SD_BUS_ARGS("d", x, "d", y, "d", depth, "d", yaw, "d", pitch, "d", roll),
+                                   SD_BUS_NO_RESULT, m_place, kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("GetFrameLog", SD_BUS_NO_ARGS, SD_BUS_RESULT("a(tttysayay)", frames), m_frame_log, kUnpriv)),
 };
 constexpr auto kVtable = dbus::vtable(kMembers);

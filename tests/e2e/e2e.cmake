@@ -9,7 +9,7 @@ foreach(name properties announcements thrusters bus_recovery budget motion packe
              introspection caracaractl mission faults gpio_lines dive_crash failsafes
              packet_kill fault_reports wheels bus_lost vanished_lines adapter_limits start_killed
              command_timeout_timer thrust_profiles zero_thrusters_step realtime teensy_silence motor_test
-             preflight bus_scan)
+             preflight bus_scan frames)
   caracara_python_test(e2e_${name} test_${name} ${CARACARA_E2E_DIR})
 endforeach()
 # Direction detection, one CTest test per vehicle (test class), so the three rigs run side by

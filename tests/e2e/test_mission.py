@@ -58,7 +58,7 @@ class MissionTest(unittest.TestCase):
         # It moved, and it printed its orientation as it went.
         pos = rig.sim_teensy("Position")
         self.assertGreater(abs(pos[0] - pos0[0]) + abs(pos[1] - pos0[1]), 0.0)
-        self.assertGreaterEqual(sum(1 for line in out.splitlines() if "yaw" in line), 8)
+        self.assertGreaterEqual(sum(1 for line in out.splitlines() if "heading" in line), 8)
         self.assertIn("mission complete", out)
         # Killed at the end, every thruster at zero.
         self.assertEqual(rig.state(), "killed")

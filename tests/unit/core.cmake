@@ -1,5 +1,7 @@
 # core/: one test program per piece of pure logic.
 caracara_unit_test(test_mixing SOURCES unit/test_mixing.cpp LIBS caracara_core)
+# core/frames: every edge's axes against the seed's axis table, orientations in ENU and NED.
+caracara_unit_test(test_frames SOURCES unit/test_frames.cpp LIBS caracara_core)
 caracara_unit_test(test_budget SOURCES unit/test_budget.cpp LIBS caracara_core)
 caracara_unit_test(test_packet SOURCES unit/test_packet.cpp LIBS caracara_core)
 caracara_unit_test(test_safety SOURCES unit/test_safety.cpp LIBS caracara_core)

@@ -7,6 +7,7 @@
 #include "core/config.hpp"
 #include "core/dive_format.hpp"
 #include "core/failsafe.hpp"
+#include "core/frames.hpp"
 #include "core/mixing.hpp"
 #include "core/packet.hpp"
 #include "core/preflight_row.hpp"
@@ -92,6 +93,8 @@ TEST_CASE("every enum's values have one name each, and each name reads back") {
     check_names<FailsafeAction>("FailsafeAction");
     check_names<FailsafeCondition>("FailsafeCondition");
     check_names<MixError>("MixError");
+    check_names<frames::PilotAxis>("frames::PilotAxis");
+    check_names<frames::WorldFrame>("frames::WorldFrame");
     check_names<PacketError>("PacketError");
     check_names<PreflightItem>("PreflightItem");
     check_names<SafetyState>("SafetyState");

@@ -32,8 +32,9 @@ constexpr Command kCommands[] = {
     {"monitor", "[--all]", "Print property changes, timestamped, until ^C", 0, cmd_monitor, nullptr, kOptAll},
     {"thrust", "V0 V1 V2 V3 V4 V5 V6 V7", "Hold the eight motor values (-8850..8850) until ^C", 8, cmd_thrust,
      nullptr, kOptHold},
-    {"motion", "X Y Z YAW PITCH ROLL", "Hold a 6-axis motion demand (each -1..1) until ^C", 6, cmd_motion, nullptr,
-     kOptHold},
+    {"motion", "WORD=VALUE...", "Hold a motion in a pilot's words (forward=, starboard=, up=, turn-right=, nose-up=,\n"
+     "                                   roll-right=; each -1..1, negative the opposite) until ^C", kWordArgs, cmd_motion,
+     nullptr, kOptHold},
     {"packet", "W0 ... W12", "Hold a 13-word Caracara packet (motors, kill, power-off, RGB)", 13, cmd_packet,
      nullptr, kOptHold},
     {"kill", "", "Zero every thruster at once and latch the kill", 0, cmd_kill},
@@ -234,9 +235,12 @@ int main(int argc, char** argv) {
         }
         if (options.hold.once && options.for_given)
             usage_error("--for and --once exclude each other");
-        if (args.size() != command->nargs)
-            usage_error(strf("%s takes %zu argument%s, got %zu", command->name, command->nargs,
-                             command->nargs == 1 ? "" : "s", args.size()));
+        if (command->nargs == kWordArgs ? args.empty() || args.size() > 6 : args.size() != command->nargs)
+            usage_error(command->nargs == kWordArgs
+                            ? strf("%s takes 1 to 6 WORD=VALUE arguments (%s), got %zu", command->name, kMotionWords,
+                                   args.size())
+                            : strf("%s takes %zu argument%s, got %zu", command->name, command->nargs,
+                                   command->nargs == 1 ? "" : "s", args.size()));
         Client client(choice);
         return command->run(client, args, options);
     } catch (const Failure& f) {

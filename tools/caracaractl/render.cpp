@@ -150,11 +150,11 @@ void print_thrusters(std::ostream& out, const std::vector<const Props*>& list) {
 void print_teensy(std::ostream& out, const Props& t) {
     const Value& o = prop(t, "Orientation");
     if (o.items.size() == 3) {
-        const char* names[] = {"yaw", "pitch", "roll"};
-        std::string text;
-        for (size_t i = 0; i < 3; ++i)
-            text += strf("%s%s %.1f\u00b0 (%.3f rad)", i ? ", " : "", names[i], o.items[i].number() * kDegPerRad,
-                         o.items[i].number());
+        // The Teensy's angles in a pilot's words (docs/frames.md): each signed, with what + means.
+        const double d[3] = {o.items[0].number() * kDegPerRad, o.items[1].number() * kDegPerRad,
+                             o.items[2].number() * kDegPerRad};
+        const std::string text = strf("heading %.1f\u00b0 (clockwise), pitch %+.1f\u00b0 (nose up), roll %+.1f\u00b0 "
+                                      "(right side down)", d[0], d[1], d[2]);
         key_line(out, "Orientation", text);
     }
     key_line(out, "Distances", join(prop(t, "Distances"), ", ", [](const Value& d) { return render(d) + " mm"; }));

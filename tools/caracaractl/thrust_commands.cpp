@@ -2,6 +2,12 @@
 
 #include "tools/caracaractl/render.hpp"
 
+#include "core/frames.hpp"
+
+#include <algorithm>
+#include <optional>
+#include <set>
+
 namespace caracara::ctl {
 
 namespace {
@@ -17,12 +23,31 @@ int cmd_thrust(Client& c, const Args& a, const Options& o) {
 }
 
 int cmd_motion(Client& c, const Args& a, const Options& o) {
-    const char* names[] = {"X", "Y", "Z", "YAW", "PITCH", "ROLL"};
-    double v[6];
-    for (size_t i = 0; i < 6; ++i)
-        v[i] = parse_double(a[i], names[i]);
+    // A pilot's words (docs/frames.md), converted to the D-Bus contract's axes in core/frames and
+    // nowhere else: WORD=VALUE, each word at most once, a word left out is 0.
+    frames::PilotMotion m;
+    std::set<frames::PilotAxis> given;
+    for (const std::string& arg : a) {
+        const size_t eq = arg.find('=');
+        std::string word = arg.substr(0, eq == std::string::npos ? 0 : eq);
+        std::replace(word.begin(), word.end(), '-', '_');
+        const std::optional<frames::PilotAxis> axis = parse_name<frames::PilotAxis>(word);
+        if (!axis)
+            usage_error("motion takes WORD=VALUE (" + std::string(kMotionWords) + "), each -1..1, negative for the "
+                        "opposite motion; not '" + arg + "' (docs/frames.md)");
+        if (!given.insert(*axis).second)
+            usage_error("motion: '" + arg.substr(0, eq) + "' given twice");
+        frames::pilot_axis(m, *axis) = parse_double(arg.substr(eq + 1), arg.substr(0, eq));
+    }
+    const AxisDemand v = frames::from_pilot(m);
+    std::string shown;
+    for (const auto& n : EnumNames<frames::PilotAxis>::table)
+        if (given.contains(n.value))
+            shown += strf("%s%s=%g", shown.empty() ? "" : " ", n.name.data(), frames::pilot_axis(m, n.value));
     return hold_command(c, "SetMotion", append_args("dddddd", v[0], v[1], v[2], v[3], v[4], v[5]),
-                        strf("SetMotion(%g, %g, %g, %g, %g, %g)", v[0], v[1], v[2], v[3], v[4], v[5]), o.hold);
+                        strf("SetMotion(%g, %g, %g, %g, %g, %g), the seed's axes, from %s", v[0], v[1], v[2], v[3],
+                             v[4], v[5], shown.c_str()),
+                        o.hold);
 }
 
 int cmd_packet(Client& c, const Args& a, const Options& o) {
