@@ -64,7 +64,7 @@ for _ in $(seq 100); do
   sleep 0.1
 done
 echo; echo "== forward at 60% while yawing at 40% for 3 seconds"
-ctl motion 0 0.6 0 0.4 0 0 --for 3 &
+ctl motion forward=0.6 turn-right=0.4 --for 3 &
 hold=$!
 sleep 2
 sim_speeds

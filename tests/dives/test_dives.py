@@ -178,7 +178,7 @@ class DiveRecorderTest(unittest.TestCase):
         os.makedirs(cls.out)
         cls.rig.arm()
         hold = subprocess.Popen(command("caracaractl") + ["--bus-address", cls.rig.address, "motion",
-                                                          "0", "0.6", "0", "0.4", "0", "0", "--for", "2"],
+                                                          "forward=0.6", "turn-right=0.4", "--for", "2"],
                                 stdout=subprocess.DEVNULL)
         hold.wait(30)
         cls.rig.vcall("Kill")

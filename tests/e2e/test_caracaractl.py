@@ -170,7 +170,7 @@ class CaracaractlTest(VehicleTestCase):
 
     def test_motion(self):
         motors = SEED_AXIS_MOTORS["x"]
-        proc = self.hold("motion", 0.2, 0, 0, 0, 0, 0, "--for", 20)
+        proc = self.hold("motion", "starboard=-0.2", "--for", 20)  # towards port: the seed's x
         try:
             value = round(0.2 * harness.MOTOR_MAX)
             self.rig.wait_sim_speeds([speed_byte(motors[i] * value) if i in motors else ZERO for i in range(MOTORS)])
@@ -185,7 +185,8 @@ class CaracaractlTest(VehicleTestCase):
     def test_usage_errors(self):
         before = self.rig.sim_snapshot()
         for args in [("frob",), ("thrust", 1, 2, 3), ("thrust", 0, 0, 0, 0, 0, 0, 0, "x"),
-                     ("leds", 256, 0, 0), ("leds", 1, 2), ("motion", 0, 0, 0, 0, 0), ("--no-such-option", "status"),
+                     ("leds", 256, 0, 0), ("leds", 1, 2), ("motion", 0, 0, 0, 0, 0), ("motion", "forward=0.1", "forward=0.2"), ("motion", "left=0.1"), ("motion",),
+                     ("motion", "up=fast"), ("--no-such-option", "status"),
                      ("kill", "now"), ("thrust", 0, 0, 0, 0, 0, 0, 0, 0, "--for", "soon")]:
             with self.subTest(args=args):
                 r = self.ctl(*args)

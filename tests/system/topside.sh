@@ -91,7 +91,7 @@ check "caracaractl -H visitor@vehicle status exits 0 and shows the vehicle ready
   bash -c '[ "$1" = 0 ] && grep -q "State: ready" <<<"$2"' _ "$rc" "$status"
 
 # --- refusals: the bus policy (4), SSH (4), an unreachable vehicle (3) -------------------------------
-rc=0; out=$(caracaractl -H visitor@vehicle motion 0 0.5 0 0 0 0 --once 2>&1) || rc=$?
+rc=0; out=$(caracaractl -H visitor@vehicle motion forward=0.5 --once 2>&1) || rc=$?
 info "visitor motion: exit $rc: $out"
 check "caracaractl -H visitor@vehicle motion: exit 4 (the bus policy refuses a user outside caracara)" [ "$rc" = 4 ]
 rc=0; out=$(caracaractl -H visitor@vehicle kill 2>&1) || rc=$?
@@ -111,9 +111,9 @@ check "caracaractl -H skipper@10.231.9.9 (no route): exit 3" [ "$rc" = 3 ]
 # --- motion in hold mode, as a member of the caracara group -----------------------------------------
 # Y 0.5 drives motors 0, 2, 4, 6 at 4425: SPEED 0x80 + round(4425 * 102 / 8850) = 179.
 idx=$(wire_next)
-caracaractl -H skipper@vehicle motion 0 0.5 0 0 0 0 --for 60 >"$TOP/hold.log" 2>&1 &
+caracaractl -H skipper@vehicle motion forward=0.5 --for 60 >"$TOP/hold.log" 2>&1 &
 ctl_pid=$!
-check "caracaractl -H skipper@vehicle motion 0 0.5 0 0 0 0 (held): four thrusters at SPEED 179 on the wire" \
+check "caracaractl -H skipper@vehicle motion forward=0.5 (held): four thrusters at SPEED 179 on the wire" \
   wait_until 10 latest_at "$idx" 179 4
 controller=$(prop $V $VP $V Controller)
 creds=$(rd call org.freedesktop.DBus /org/freedesktop/DBus org.freedesktop.DBus GetConnectionCredentials s "$controller" 2>&1)
