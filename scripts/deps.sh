@@ -14,7 +14,9 @@ if [ "$(. /etc/os-release && echo "${VERSION_CODENAME:-}")" = bookworm ]; then
 fi
 pkgs=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev "$catch2" libtomlplusplus-dev
       dbus python3 python3-dbus python3-gi systemd debootstrap systemd-container valgrind stress-ng
-      clang libclang-rt-dev python3-matplotlib python3-pil ccache libboost-dev nlohmann-json3-dev openssh-client)
+      clang libclang-rt-dev python3-matplotlib python3-pil ccache libboost-dev nlohmann-json3-dev openssh-client
+      udev)
+# udev: the kernel test applies the shipped udev rules with systemd-udevd (devices_for_the_daemon_alone).
 # caracara-ros (tools/ros): Cyclone DDS and its IDL compiler; its tests' second DDS vendor, Fast DDS
 # with fastddsgen (tests/ros), and iproute2 for the private network namespace.
 pkgs+=(cyclonedds-dev cyclonedds-tools "$fastdds" fastddsgen iproute2)

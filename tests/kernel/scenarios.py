@@ -71,6 +71,8 @@ class KernelRig(Rig):
         kw.setdefault("extra_config", {"gpio": GPIO, "recovery": RECOVERY,
                                        "i2c": {"device": I2C_DEV, "timeout_ms": 100, "retries": 1}})
         kw.setdefault("extra_toml", THRUSTERS)
+        # devices_for_the_daemon_alone runs the daemon and a pilot as users of their own.
+        kw.setdefault("bus_policy_extra", '<allow user="*"/>')
         super().__init__(**kw)
 
     def start(self, daemon=True):
@@ -1045,6 +1047,118 @@ def sc_bus_clear_faults(rig):
         check(rig.state() == "ready", "round %d: state %s (%s)" % (round_, rig.state(), rig.vget("KillSource")))
 
 
+# --- who may open the devices (issue 46): the installed sysusers.d and udev rules, for real --------
+
+def device_nodes():
+    """Every node and sysfs file the daemon drives: the I2C, SPI and GPIO nodes and the adapter
+    driver's bind files."""
+    nodes = sorted(os.path.join("/dev", n) for n in os.listdir("/dev")
+                   if re.fullmatch(r"i2c-\d+|spidev\d+\.\d+|gpiochip\d+", n))
+    return nodes + [DRIVER + "/bind", DRIVER + "/unbind"]
+
+
+def as_user(user, argv, **kw):
+    """argv run as `user` with that user's groups (setpriv --init-groups), as a login would."""
+    return subprocess.run(["setpriv", "--reuid=" + user, "--regid=" + user, "--init-groups"] + argv,
+                          capture_output=True, text=True, timeout=60, **kw)
+
+
+def users_from_sysusers():
+    """systemd-sysusers with the shipped systemd/caracara.sysusers (and a pilot in caracara) on a
+    copy of /etc's user files, put over the read-only ones: the users and groups a package makes."""
+    root = "/run/sysroot"
+    os.makedirs(root + "/etc", exist_ok=True)
+    for f in ("passwd", "group", "shadow", "gshadow"):
+        subprocess.run(["cp", "-p", "/etc/" + f, root + "/etc/" + f], check=True)
+    with open(root + "/pilot.conf", "w") as f:
+        f.write('u pilot - "A pilot" - -\nm pilot caracara\n')
+    subprocess.run(["systemd-sysusers", "--root=" + root, os.path.join(harness.SOURCE_DIR, "systemd", "caracara.sysusers"),
+                    root + "/pilot.conf"], check=True, capture_output=True)
+    for f in ("passwd", "group", "shadow", "gshadow"):
+        subprocess.run(["mount", "--bind", root + "/etc/" + f, "/etc/" + f], check=True)
+
+
+def nodes_from_udev():
+    """systemd-udevd with the shipped systemd/60-caracara.rules (and its driver line for the test
+    adapter's driver, as the file tells an integrator to add), every node and driver replayed."""
+    os.makedirs("/run/udev/rules.d", exist_ok=True)
+    with open(os.path.join(harness.SOURCE_DIR, "systemd", "60-caracara.rules")) as f:
+        rules = f.read()
+    driver_line = next(line for line in rules.splitlines() if 'KERNEL=="i2c-bcm2835"' in line)
+    with open("/run/udev/rules.d/60-caracara.rules", "w") as f:
+        f.write(rules + "\n" + driver_line.replace("i2c-bcm2835", DRIVER_ID) + "\n")
+    udevd = subprocess.Popen(["/lib/systemd/systemd-udevd"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    subprocess.run(["udevadm", "trigger", "--action=add", "--subsystem-match=i2c-dev", "--subsystem-match=spidev",
+                    "--subsystem-match=gpio"], check=True)
+    subprocess.run(["udevadm", "trigger", "--action=add", "--subsystem-match=drivers", "--sysname-match=" + DRIVER_ID],
+                   check=True)
+    subprocess.run(["udevadm", "settle", "--timeout=30"], check=True)
+    return udevd
+
+
+def sc_device_access(rig):
+    """Only the daemon's user opens the devices: the shipped sysusers and udev rules give every I2C, SPI and GPIO node and the adapter driver's bind files to caracara-io; a pilot (in caracara) is refused open() on each, while caracarad, run as caracara, drives all eight thrusters through them and rebinds the driver."""
+    users_from_sysusers()
+    udevd = nodes_from_udev()
+    try:
+        import grp
+        io_gid = grp.getgrnam("caracara-io").gr_gid
+        check(grp.getgrnam("caracara-io").gr_mem == ["caracara"], "caracara-io members %s" % grp.getgrnam("caracara-io").gr_mem)
+        check("pilot" in grp.getgrnam("caracara").gr_mem, "the pilot is not in caracara")
+        nodes = device_nodes()
+        check(len(nodes) >= 5, "nodes %s" % nodes)
+        for n in nodes:
+            st = os.stat(n)
+            check(st.st_gid == io_gid and st.st_mode & 0o007 == 0, "%s: group %d mode %o" % (n, st.st_gid, st.st_mode))
+        # A pilot's shell: open() refused on every one (EACCES), before any driver sees it.
+        probe = ("import os,sys\nfor n in sys.argv[1:]:\n"
+                 "    try:\n        os.close(os.open(n, os.O_WRONLY if n.endswith('bind') else os.O_RDWR)); print(n, 'opened')\n"
+                 "    except OSError as e:\n        print(n, e.errno)\n")
+        r = as_user("pilot", ["/usr/bin/python3", "-c", probe] + nodes)
+        got = dict(line.rsplit(" ", 1) for line in r.stdout.split("\n") if line)
+        check(got == {n: str(errno.EACCES) for n in nodes}, "the pilot's open(): %s %s" % (got, r.stderr))
+        # The daemon's user: caracarad drives them (the dives' and the rig's files readable to it).
+        rig.thrust([0] * MOTORS)
+        rig.stop_daemon()
+        for d in (rig.dir, rig.dives_dir):
+            os.chmod(d, 0o755)
+        os.chown(rig.dives_dir, pwd_uid("caracara"), io_gid)
+        rig.daemon_exit = None
+        rig._spawn("caracarad", ["setpriv", "--reuid=caracara", "--regid=caracara", "--init-groups", binary("caracarad"),
+                                 "--bus-address", rig.address, "--config", rig.config_path])
+        poll(lambda: rig.conn.name_has_owner(VEHICLE) or rig._died("caracarad"), rig.START_TIMEOUT,
+             message="caracarad (as caracara) did not take its name")
+        rig._check_alive("caracarad")
+        rig.arm(60)
+        values = [1100, -1100, 1100, -1100, 1100, -1100, 1100, -1100]
+        rig.thrust(values)
+        rig.wait_sim_speeds([speed_byte(v) for v in values], 20)
+        unb0, bind0 = int(rig.sim_get("Unbinds")), int(rig.sim_get("Binds"))
+        rec0 = int(rig.bus("Recoveries"))
+        rig.sim_call("HangBus", dbus.UInt32(5), signature="u")
+        poll(lambda: int(rig.bus("Recoveries")) > rec0, 30, message="no recovery as caracara")
+        check(int(rig.sim_get("Unbinds")) == unb0 + 1 and int(rig.sim_get("Binds")) == bind0 + 1,
+              "as caracara, driver unbinds/binds %s/%s" % (rig.sim_get("Unbinds"), rig.sim_get("Binds")))
+        poll(lambda: rig.bus("State") == "ok", 15)
+        rig.wait_orders_refreshed()
+        check(rig.sim_speeds() == [speed_byte(v) for v in values], "orders not resumed after the rebind")
+        rig.vcall("Kill")
+        rig.wait_sim_zero()
+    finally:
+        udevd.terminate()
+        udevd.wait(10)
+        # The next scenarios' daemon runs as root again, as every other scenario's.
+        if not rig._died("caracarad"):
+            rig.stop_daemon()
+        rig.start_daemon()
+
+
+def pwd_uid(user):
+    import pwd
+    return pwd.getpwnam(user).pw_uid
+
+
+
 def diagnose(rig):
     """Where caracarad and caracara-sim are stuck, as the kernel sees them."""
     for name in ("caracarad", "caracara-sim"):
@@ -1097,6 +1211,7 @@ SCENARIOS = [
     ("kill_switch_read_fails", sc_kill_switch_read_fails),
     ("kill_switch_event_overflow", sc_kill_switch_event_overflow),
     ("gpio_chip_gone_while_held", sc_gpio_chip_gone),
+    ("devices_for_the_daemon_alone", sc_device_access),
     # Restarted by the loop below (it died).
     ("fatal_signal_kill_output_first", sc_fatal_signal),
     ("sigterm", sc_sigterm),

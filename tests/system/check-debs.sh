@@ -55,9 +55,8 @@ debs_install() {
   check "no file of the packages under /usr/local" bash -c '! grep -q "^/usr/local" /root/debs-files.txt'
   check "no conffile and no $CONF: the daemon runs on its built-in defaults" \
     bash -c '[ ! -e "$1" ] && [ -z "$(dpkg-query -W -f="\${Conffiles}" caracarad caracara-sim)" ]' _ "$CONF"
-  check "the postinst created the caracara user and group, and caracara-bridge in the group" \
-    bash -c 'getent passwd caracara >/dev/null && getent group caracara >/dev/null &&
-             id -nG caracara-bridge | grep -qw caracara'
+  check "the postinst created the caracara user and group, caracara-bridge and caracara-ros in the group, and caracara-io with only caracara in it" \
+    users_and_groups
   check "the postinst enabled and started caracarad.service and caracara-sim.service" \
     bash -c 'systemctl is-enabled -q caracarad caracara-sim && systemctl is-active -q caracarad caracara-sim'
   check "caracara-sim's drop-in puts caracarad in sim mode" \

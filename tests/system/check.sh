@@ -28,6 +28,25 @@ speed_is() { [ "$(speed "$1")" = "$2" ]; }
 active() { [ "$(systemctl is-active "$1")" = active ]; }
 # as USER COMMAND...
 as() { local u=$1; shift; runuser -u "$u" -- "$@"; }
+# The users and groups of systemd/caracara.sysusers (issue 46): the pilots' group caracara with
+# the two clients in it; the devices' group caracara-io with the daemon's user alone.
+users_and_groups() {
+  getent passwd caracara >/dev/null && getent group caracara >/dev/null &&
+    id -nG caracara-bridge | grep -qw caracara && id -nG caracara-ros | grep -qw caracara &&
+    [ "$(getent group caracara-io | cut -d: -f4)" = caracara ] &&
+    ! id -nG caracara-bridge | grep -qw caracara-io && ! id -nG caracara-ros | grep -qw caracara-io
+}
+# in_groups PID GROUP...: the process runs with each GROUP among its groups (/proc, the kernel's
+# own list: what an open() of a device node is judged against).
+in_groups() {
+  local pid=$1 g gid groups
+  shift
+  groups=" $(sed -n 's/^Groups:[[:space:]]*//p' "/proc/$pid/status") $(awk '/^Gid:/ { print $2 }' "/proc/$pid/status") "
+  for g in "$@"; do
+    gid=$(getent group "$g" | cut -d: -f3)
+    [ -n "$gid" ] && [[ $groups == *" $gid "* ]] || return 1
+  done
+}
 # denied USER ARGS...: `busctl call ARGS` as USER is refused by the bus policy.
 denied() {
   local u=$1 err
@@ -168,9 +187,8 @@ if [ -d "$DEBS" ]; then
   conf_file=
 else
   systemd-sysusers
-  check "systemd-sysusers creates the caracara user and group, and caracara-bridge in the group" \
-    bash -c 'getent passwd caracara >/dev/null && getent group caracara >/dev/null &&
-             id -nG caracara-bridge | grep -qw caracara'
+  check "systemd-sysusers creates the caracara user and group, caracara-bridge and caracara-ros in the group, and caracara-io with only caracara in it" \
+    users_and_groups
   systemctl daemon-reload
   check "dbus reloads its configuration with the caracara policies" systemctl reload dbus
   dropin=/usr/share/caracara/caracarad-sim.conf
@@ -482,6 +500,41 @@ check "pilot: the installed cockpit (/usr/share/caracara/cockpit) is served on t
 check "pilot: the bridge lists the recorded dives (/var/log/caracara, read only)" \
   as pilot perl -e "$HTTP_GET" /dives/ "["
 
+# --- 7c. caracara-ros: its own user in the pilots' group, the daemon's name denied (issue 46) ------------
+if [ -d "$DEBS" ]; then
+  rc=0
+  (cd "$DEBS" && apt_get install ./caracara-ros_*.deb) || rc=$?
+  check "apt-get install ./caracara-ros_*.deb (exit $rc)" [ "$rc" = 0 ]
+else
+  [ -f /etc/caracara/ros.toml ] || install -D -m 0644 /usr/share/caracara/ros.toml.example /etc/caracara/ros.toml
+fi
+check "systemctl start caracara-ros (Type=notify: returns once its participant exists)" timeout 60 systemctl start caracara-ros
+ros_user() { [ "$(ps -o user:32=,group:32= -p "$(unit caracara-ros MainPID)" | awk '{print $1, $2}')" = "caracara-ros caracara" ]; }
+check "caracara-ros runs as caracara-ros, group caracara" ros_user
+check "caracara-ros may not own org.caracara.Vehicle1 (the bus policy)" \
+  denied caracara-ros org.freedesktop.DBus /org/freedesktop/DBus org.freedesktop.DBus RequestName su $V 4
+# The devices' group: the daemon's process has it (the unit's SupplementaryGroups=, under
+# PrivateUsers=), the two network-facing clients do not.
+check "caracarad runs with the devices' group caracara-io" in_groups "$(unit caracarad MainPID)" caracara caracara-io
+check "caracara-bridge and caracara-ros run without caracara-io" \
+  bash -c '! grep -qw "$(getent group caracara-io | cut -d: -f3)" <(sed -n "s/^Groups://p" /proc/$1/status /proc/$2/status)' _ \
+  "$(unit caracara-bridge MainPID)" "$(unit caracara-ros MainPID)"
+# Held to the bridge's bound (EXPOSURE_MAX); the network DDS needs (PrivateNetwork=no, AF_INET,
+# an allow list of private ranges) is 0.9 of it, which the bridge, on a Unix socket, does not pay.
+sec=$(systemd-analyze security --no-pager caracara-ros.service 2>&1)
+echo "$sec" | grep -E '^✗' | sed "s/^/  caracara-ros: /"
+ros_exposure=$(echo "$sec" | sed -n 's/.*Overall exposure level for .*: \([0-9.]*\) .*/\1/p')
+echo "EXPOSURE: caracara-ros.service ${ros_exposure:-?}"
+check "systemd-analyze security caracara-ros.service: exposure ${ros_exposure:-?} <= $EXPOSURE_MAX (the bridge's bound)" \
+  awk -v x="${ros_exposure:-99}" -v max="$EXPOSURE_MAX" 'BEGIN { exit !(x <= max) }'
+systemctl stop caracara-ros
+if [ -d "$DEBS" ]; then
+  rc=0
+  (cd / && apt_get purge caracara-ros) || rc=$?
+  check "apt-get purge caracara-ros (exit $rc): its unit gone, caracarad still running" \
+    bash -c '[ "$1" = 0 ] && [ "$(systemctl show -p LoadState --value caracara-ros)" = not-found ] && systemctl is-active -q caracarad' _ "$rc"
+fi
+
 # --- 7b. the topside: caracaractl -H, busctl -H and a python3-dbus script over SSH (check-topside.sh)
 . "$(dirname "$0")/check-topside.sh"
 topside_checks
@@ -578,6 +631,7 @@ check "and is ready once armed" arm
 # --- 12. exposure -----------------------------------------------------------------------------------------
 # The bound issue 11 set for the units (systemd-analyze security: 0.0 safest .. 10.0):
 # EXPOSURE_MAX from tests/bounds.json (bounds.sh).
+# (caracara-ros's: 7c, while its package is installed.)
 for u in caracarad caracara-sim caracara-bridge; do
   sec=$(systemd-analyze security --no-pager "$u.service" 2>&1)
   echo "$sec" | grep -E '^✗' | sed "s/^/  $u: /"

@@ -38,11 +38,12 @@ build_timeout_s=${CARACARA_DEBIAN13_BUILD_TIMEOUT:-1500}
 # Build and test dependencies (scripts/deps.sh's, by their Debian 13 names), scripts/package.sh's
 # tools, and what the kernel test's guest runs in this root: insmod, i2c-tools. The ros tests'
 # (tests/ros): Debian 13's Fast DDS 3.1 and fastddsgen 4 for the peer, node for the reference
-# codec (its npm packages are installed from the host, below), iproute2 for the namespace.
+# codec (its npm packages are installed from the host, below), iproute2 for the namespace; udev
+# for the kernel test's devices_for_the_daemon_alone (the shipped rules applied by systemd-udevd).
 packages=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev libcatch2-dev
           libtomlplusplus-dev libboost-dev nlohmann-json3-dev dbus python3 python3-dbus python3-gi python3-matplotlib
           systemd dpkg-dev debhelper lintian kmod i2c-tools openssh-client ccache cyclonedds-dev cyclonedds-tools
-          libfastdds-dev fastddsgen nodejs iproute2)
+          libfastdds-dev fastddsgen nodejs iproute2 udev)
 # Bump when the way the cached root is made changes.
 recipe=3
 

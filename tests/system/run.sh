@@ -50,8 +50,8 @@ timeout_s=${CARACARA_SYSTEST_TIMEOUT:-420}
 # What the container needs besides debootstrap's minbase: an init, the system bus, and the
 # shared libraries of caracarad, caracara-sim and caracaractl (their names differ by release).
 case $suite in
-  bookworm) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod2 libtomlplusplus3 openssh-server) ;;
-  trixie) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod3 libtomlplusplus3t64 openssh-server) ;;
+  bookworm) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod2 libtomlplusplus3 openssh-server libddsc0debian) ;;
+  trixie) packages=(systemd systemd-sysv dbus libsystemd0 libgpiod3 libtomlplusplus3t64 openssh-server libddsc0t64) ;;
   *) echo "system-test: CARACARA_SYSTEST_SUITE must be bookworm or trixie, not '$suite'" >&2; exit 2 ;;
 esac
 # Bump when the way the cached root is made changes.
@@ -77,11 +77,14 @@ cannot_run() {
 # MemoryMax), real-time scheduling (+2: the loop's policy, its memory locked) and the zeroing
 # step judged on this step's own zero orders and journal lines (+4: the three BOUND: lines of
 # check.sh asserted against tests/bounds.json, the step's zeros before the next daemon's start
-# and its report after a cursor, in place of zeros that a restart also sends). The install
-# count is the debs count less check-debs.sh's 34 plus check.sh's two installation checks, as it
-# was counted by hand; CI runs --debs.
-checks_planned_debs=184
-checks_planned_install=152
+# and its report after a cursor, in place of zeros that a restart also sends), caracara-ros's
+# own user (+8 with --debs, +6 with a build tree: its package installed and purged, its start,
+# its user in the group, the name it may not own, the devices' group on the daemon and not on
+# the clients, its exposure). The install count is the debs count less check-debs.sh's 34 plus
+# check.sh's two installation checks, less 7c's two package checks, as it was counted by hand;
+# CI runs --debs.
+checks_planned_debs=192
+checks_planned_install=158
 
 if [ "$(id -u)" -ne 0 ]; then
   cannot_run "needs root (debootstrap, systemd-nspawn)"
@@ -209,6 +212,10 @@ if [ -n "$debs" ]; then
     dpkg-deb -b "$work/next-$p" "$root/systest-debs-next/" >/dev/null
     rm -rf "$work/next-$p"
   done
+  # caracara-ros: installed, checked and purged on its own (check.sh 7c), before the upgrade.
+  f=$(find "$debs" -maxdepth 1 -name "caracara-ros_*_$arch.deb" | sort -V | tail -n 1)
+  [ -n "$f" ] || die "no caracara-ros_*_$arch.deb in $debs (scripts/package.sh $arch $debs)"
+  install -D -m 0644 "$f" "$root/systest-debs/$(basename "$f")"
   install -D -m 0755 "$here/check-debs.sh" "$root/usr/local/libexec/caracara-systest/check-debs.sh"
 else
   say "installing $build into the root (cmake --install --prefix /usr)"
