@@ -114,10 +114,11 @@ def bench_latency(peer, codec, n):
         rig.arm()
         start_ros(rig, True)
         values = (0.3, 0.5)
-        # The bytes each value gives on the thruster that moves most (the daemon's mixing).
+        # The bytes each value gives on the thruster that moves most (the daemon's mixing), for
+        # forward: SetMotion's y in the seed's axes, a Wrench's force.x in REP 103's (docs/frames.md).
         expected = []
         for v in values:
-            rig.motion(x=v)
+            rig.motion(y=v)
             expected.append(poll(lambda: rig.sim_speeds() if rig.sim_speeds() != [ZERO] * MOTORS else None, 10))
         thruster = max(range(MOTORS), key=lambda i: abs(expected[0][i] - ZERO))
         assert expected[0][thruster] != expected[1][thruster]
@@ -129,7 +130,7 @@ def bench_latency(peer, codec, n):
         sends = []
         for k in range(n):
             t = time.monotonic_ns()
-            rig.motion(x=values[k % 2])
+            rig.motion(y=values[k % 2])
             sends.append((t, k))
             time.sleep(0.05)
         dbus_ms = latencies(rig, sends, expected, thruster, since)

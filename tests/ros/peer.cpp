@@ -8,8 +8,10 @@
 //                                       discovered participant {"participant","guid","user_data"},
 //                                       writer {"writer","guid","type","reliable","transient_local","xcdr1"}
 //                                       and reader {"reader","guid"} (GUIDs as 32 hex digits)
-//   peer publish TOPIC TYPE HEX[,HEX...] COUNT HZ [hold]   publishes once matched, the samples in
-//                                       turn, one JSON line each {"sent","t_ns"}; hold: then sleeps
+//   peer publish TOPIC TYPE HEX[,HEX...] COUNT HZ [hold|stdin]   publishes once matched, the samples in
+//                                       turn, one JSON line each {"sent","t_ns"}; hold: then sleeps;
+//                                       stdin: then goes on at HZ with the last sample, each hex line
+//                                       read from stdin the sample from then on, until stdin closes
 //   peer roundtrip TYPE HEX             Fast CDR's bytes for the sample the hex decodes to
 // t_ns is CLOCK_MONOTONIC, the clock of the simulator's wire log.
 // TYPE is "pkg/Name"; TOPIC the DDS topic ("rt/caracara/imu"). Participant lease 100 ms, so a
@@ -35,6 +37,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <functional>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -350,6 +353,43 @@ int main(int argc, char** argv) {
         if (argc > 7 && std::string(argv[7]) == "hold")
             for (;;)
                 std::this_thread::sleep_for(std::chrono::seconds(1));
+        if (argc > 7 && std::string(argv[7]) == "stdin") {
+            // A pilot's stack: the same writer keeps sending, and what it sends changes (a zero
+            // Wrench ends a motion) without a new writer to match.
+            std::mutex m;
+            std::string next;
+            bool closed = false;
+            std::thread in([&] {
+                for (std::string line; std::getline(std::cin, line);) {
+                    std::lock_guard l(m);
+                    next = line;
+                }
+                std::lock_guard l(m);
+                closed = true;
+            });
+            void* current = samples.back();
+            for (int i = count;; ++i) {
+                {
+                    std::lock_guard l(m);
+                    if (closed)
+                        break;
+                    if (!next.empty()) {
+                        SerializedPayload_t p = unhex(next);
+                        next.clear();
+                        samples.push_back(current = type.create_data());
+                        if (!deserialize(type, p, current)) {
+                            std::fprintf(stderr, "peer: a stdin line is no %s\n", argv[3]);
+                            std::exit(1);
+                        }
+                    }
+                }
+                w->write(current);
+                std::printf("{\"sent\":%d,\"t_ns\":%lld}\n", i, static_cast<long long>(now_ns()));
+                std::fflush(stdout);
+                std::this_thread::sleep_for(period);
+            }
+            in.join();
+        }
         std::this_thread::sleep_for(std::chrono::milliseconds(300)); // reliable: let the last sample out
         part->delete_contained_entities();
         DomainParticipantFactory::get_instance()->delete_participant(part);

@@ -1,5 +1,6 @@
 #include "tools/foxglove/dive_ros_mcap.hpp"
 
+#include "core/frames.hpp"
 #include "core/safety.hpp"
 #include "tools/foxglove/cdr_writer.hpp"
 #include "tools/foxglove/channels.hpp"
@@ -83,7 +84,7 @@ private:
 };
 
 void joint_state(CdrWriter& m, uint64_t ns, const std::vector<double>& velocity, const std::vector<double>& effort) {
-    m.header(ns, "base_link");
+    m.header(ns, ros::kDefaultBaseFrame);
     m.u32(ros::kThrusterJoints);
     for (unsigned i = 0; i < ros::kThrusterJoints; ++i)
         m.string(ros::thruster_joint_name(i));
@@ -168,9 +169,11 @@ std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d) {
     for (const dive::Sample& s : d.samples) {
         events_until(s.t_100us);
         const uint64_t ns = at(s.t_100us);
-        const ros::Quaternion q = ros::quaternion_from_ypr(s.orientation[0], s.orientation[1], s.orientation[2]);
+        // REP 103 / 145 as caracara-ros's defaults: base_link (FLU) in odom (ENU).
+        const frames::Quaternion q =
+            frames::orientation({s.orientation[0], s.orientation[1], s.orientation[2]}, frames::WorldFrame::EnuFlu);
         CdrWriter imu;
-        imu.header(ns, "base_link");
+        imu.header(ns, ros::kDefaultBaseFrame);
         for (const double v : {q.x, q.y, q.z, q.w})
             imu.f64(v);
         // REP 145, as caracara-ros: orientation covariance unknown (zeros); no angular velocity
@@ -192,8 +195,8 @@ std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d) {
         bag.put(kImu, ns, imu);
         CdrWriter tf;
         tf.u32(1);
-        tf.header(ns, "odom");
-        tf.string("base_link");
+        tf.header(ns, ros::kDefaultWorldFrame);
+        tf.string(ros::kDefaultBaseFrame);
         for (const double v : {0.0, 0.0, 0.0, q.x, q.y, q.z, q.w})
             tf.f64(v);
         bag.put(kTf, ns, tf);

@@ -1,5 +1,6 @@
 #include "tools/ros/command_subscriber.hpp"
 
+#include "core/frames.hpp"
 #include "core/motor.hpp"
 
 #include <cmath>
@@ -28,6 +29,23 @@ void take_each(dds_entity_t reader, Use use) {
         if (n > 0)
             dds_return_loan(reader, samples, n);
     }
+}
+
+// A refused Wrench is named in SetMotion's (the seed's) axes: the log says which Wrench field
+// each is, read off core/frames' conversion ("x = force.y, ..., roll = torque.x").
+std::string wrench_axes_note() {
+    static const char* const kFields[] = {"force.x", "force.y", "force.z", "torque.x", "torque.y", "torque.z"};
+    std::string note = "cmd_wrench in SetMotion's axes:";
+    for (std::size_t axis = 0; axis < caracara::kAxisCount; ++axis)
+        for (std::size_t k = 0; k < 6; ++k) {
+            frames::BodyMotion unit;
+            frames::Vec3& v = k < 3 ? unit.linear : unit.angular;
+            (k % 3 == 0 ? v.x : k % 3 == 1 ? v.y : v.z) = 1;
+            if (const double sign = frames::from_flu(unit)[axis]; sign != 0)
+                note += std::string(axis == 0 ? " " : ", ") + std::string(caracara::axis_name(axis)) + " = " +
+                        (sign < 0 ? "-" : "") + kFields[k];
+        }
+    return note;
 }
 
 std::string writer_name(dds_instance_handle_t h) {
@@ -110,7 +128,8 @@ Pilot* CommandSubscriber::pilot(dds_instance_handle_t writer) {
     auto& p = pilots_[writer];
     if (!p) {
         try {
-            p = std::make_unique<Pilot>(event_, config_.bus, writer_name(writer));
+            static const std::string kWrenchNote = wrench_axes_note();
+            p = std::make_unique<Pilot>(event_, config_.bus, writer_name(writer), kWrenchNote);
             std::fprintf(stderr, "caracara-ros: writer %s commands as a pilot\n", writer_name(writer).c_str());
         } catch (const std::exception& e) {
             std::fprintf(stderr, "caracara-ros: writer %s: %s\n", writer_name(writer).c_str(), e.what());
@@ -123,10 +142,12 @@ Pilot* CommandSubscriber::pilot(dds_instance_handle_t writer) {
 
 void CommandSubscriber::take_wrenches() {
     take_each<geometry_msgs_msg_dds__Wrench_>(wrench_reader_, [&](const auto& w, dds_instance_handle_t writer) {
-        // force x, y, z -> surge, sway, heave; torque z, y, x -> yaw, pitch, roll (SetMotion's
-        // order). Range and NaN are the daemon's to refuse, by name.
+        // REP 103: the Wrench is in the body's FLU frame (force along, torque about x forward,
+        // y left, z up), each -1..1 of the axis's full demand; core/frames turns it into the
+        // seed's axes SetMotion takes. Range and NaN are the daemon's to refuse, by name.
+        const frames::BodyMotion flu{{w.force.x, w.force.y, w.force.z}, {w.torque.x, w.torque.y, w.torque.z}};
         if (Pilot* p = pilot(writer))
-            p->set_motion({w.force.x, w.force.y, w.force.z, w.torque.z, w.torque.y, w.torque.x});
+            p->set_motion(frames::from_flu(flu));
     });
 }
 

@@ -1,5 +1,5 @@
 // The command topics: kill (std_msgs/Empty, always taken), and when the config turns commands
-// on, cmd_wrench (geometry_msgs/Wrench -> SetMotion) and cmd_thrust (std_msgs/Float64MultiArray,
+// on, cmd_wrench (geometry_msgs/Wrench in REP 103's body FLU frame -> SetMotion) and cmd_thrust (std_msgs/Float64MultiArray,
 // 8 values -1..1 -> SetThrust). Each remote writer of a motion topic is a Pilot with its own D-Bus
 // connection; a writer that goes away (unmatched: it left, its lease expired) has its
 // connection closed, which the daemon takes as a client that left. Cyclone's listener threads

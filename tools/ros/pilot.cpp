@@ -10,7 +10,8 @@ namespace caracara::ros {
 
 namespace names = caracara::dbus;
 
-Pilot::Pilot(sd_event* event, const caracara::dbus::BusChoice& bus, std::string writer) : writer_(std::move(writer)) {
+Pilot::Pilot(sd_event* event, const caracara::dbus::BusChoice& bus, std::string writer, std::string motion_note)
+    : writer_(std::move(writer)), motion_writer_(motion_note.empty() ? writer_ : writer_ + " (" + motion_note + ")") {
     if (const int r = caracara::dbus::open_bus(bus, "caracara-ros-pilot", bus_); r < 0)
         throw std::runtime_error(std::string("cannot connect to the bus: ") + std::strerror(-r));
     if (const int r = sd_bus_attach_event(bus_.get(), event, SD_EVENT_PRIORITY_NORMAL); r < 0)
@@ -30,11 +31,11 @@ int Pilot::on_reply(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return 0;
 }
 
-void Pilot::send(caracara::dbus::MessagePtr call, const char* what) {
+void Pilot::send(caracara::dbus::MessagePtr call, const char* what, const std::string& writer) {
     int r = sd_bus_message_set_auto_start(call.get(), 0);
     sd_bus_slot* slot = nullptr;
     if (r >= 0)
-        r = sd_bus_call_async(bus_.get(), &slot, call.get(), on_reply, const_cast<char*>(writer_.c_str()), 0);
+        r = sd_bus_call_async(bus_.get(), &slot, call.get(), on_reply, const_cast<char*>(writer.c_str()), 0);
     if (r < 0) {
         std::fprintf(stderr, "caracara-ros: %s from writer %s not sent: %s\n", what, writer_.c_str(), std::strerror(-r));
         return;
@@ -52,7 +53,7 @@ void Pilot::set_motion(const std::array<double, 6>& a) {
     if (r >= 0)
         r = sd_bus_message_append(call.get(), "dddddd", a[0], a[1], a[2], a[3], a[4], a[5]);
     if (r >= 0)
-        send(std::move(call), "SetMotion");
+        send(std::move(call), "SetMotion", motion_writer_);
 }
 
 void Pilot::set_thrust(const std::vector<int32_t>& v) {
@@ -63,7 +64,7 @@ void Pilot::set_thrust(const std::vector<int32_t>& v) {
     if (r >= 0)
         r = sd_bus_message_append_array(call.get(), 'i', v.data(), v.size() * sizeof(int32_t));
     if (r >= 0)
-        send(std::move(call), "SetThrust");
+        send(std::move(call), "SetThrust", writer_);
 }
 
 } // namespace caracara::ros

@@ -16,7 +16,8 @@ namespace caracara::ros {
 class Pilot {
 public:
     // Connects at once and attaches to `event`; throws std::runtime_error when it cannot.
-    Pilot(sd_event* event, const caracara::dbus::BusChoice& bus, std::string writer);
+    // `motion_note` goes with a refused SetMotion in the log (what its axes are in the command's terms).
+    Pilot(sd_event* event, const caracara::dbus::BusChoice& bus, std::string writer, std::string motion_note = "");
     ~Pilot();
     Pilot(const Pilot&) = delete;
     Pilot& operator=(const Pilot&) = delete;
@@ -26,9 +27,9 @@ public:
 
 private:
     static int on_reply(sd_bus_message* m, void* userdata, sd_bus_error* error);
-    void send(caracara::dbus::MessagePtr call, const char* what);
+    void send(caracara::dbus::MessagePtr call, const char* what, const std::string& writer);
 
-    std::string writer_;
+    std::string writer_, motion_writer_;
     caracara::dbus::BusPtr bus_;
 };
 

@@ -4,6 +4,22 @@
 
 namespace caracara::ros {
 
+namespace {
+
+// A boolean key: true or false, anything else refused by name (a string "false" is not false).
+std::string read_bool(const std::string& path, const toml::node_view<toml::node>& ros, const char* key, bool& out) {
+    const toml::node* n = ros[key].node();
+    if (!n)
+        return "";
+    if (const auto v = n->value_exact<bool>()) {
+        out = *v;
+        return "";
+    }
+    return path + ": ros." + key + " must be true or false";
+}
+
+} // namespace
+
 std::string load_config(const std::string& path, RosConfig& c) {
     toml::table t;
     try {
@@ -17,7 +33,8 @@ std::string load_config(const std::string& path, RosConfig& c) {
     const auto ros = t["ros"];
     for (const auto& [key, _] : ros.as_table() ? *ros.as_table() : toml::table{}) {
         static const char* const known[] = {"namespace", "domain_id", "range_layout", "commands", "world_frame",
-                                            "base_frame", "range_min_m", "range_max_m", "range_fov_rad"};
+                                            "base_frame", "frame_convention", "publish_odom_tf", "range_min_m",
+                                            "range_max_m", "range_fov_rad"};
         bool ok = false;
         for (const char* k : known)
             ok = ok || key.str() == k;
@@ -42,12 +59,21 @@ std::string load_config(const std::string& path, RosConfig& c) {
         else
             return path + ": ros.range_layout must be \"humble\" or \"jazzy\" (\"" + *v + "\")";
     }
-    if (auto v = ros["commands"].value<bool>())
-        c.commands = *v;
+    if (std::string e = read_bool(path, ros, "commands", c.commands); !e.empty())
+        return e;
     if (auto v = ros["world_frame"].value<std::string>())
         c.world_frame = *v;
     if (auto v = ros["base_frame"].value<std::string>())
         c.base_frame = *v;
+    if (const toml::node* n = ros["frame_convention"].node()) {
+        const auto v = n->value_exact<std::string>();
+        const auto f = v ? parse_name<frames::WorldFrame>(*v) : std::nullopt;
+        if (!f)
+            return path + ": ros.frame_convention must be \"enu\" or \"ned\"" + (v ? " (\"" + *v + "\")" : "");
+        c.frame_convention = *f;
+    }
+    if (std::string e = read_bool(path, ros, "publish_odom_tf", c.publish_odom_tf); !e.empty())
+        return e;
     if (auto v = ros["range_min_m"].value<double>())
         c.range_min_m = static_cast<float>(*v);
     if (auto v = ros["range_max_m"].value<double>())

@@ -1,9 +1,11 @@
 // caracara-ros's settings: the ROS namespace and domain, the Range layout (Humble or Jazzy),
-// whether commands are taken, the frames, and the network DDS may use. Read from a TOML file
+// whether commands are taken, the frames and their convention, and the network DDS may use. Read from a TOML file
 // (/etc/caracara/ros.toml; docs/ros2.md lists every key) and the command line.
 #pragma once
 
+#include "core/frames.hpp"
 #include "drivers/sdbus/sdbus.hpp"
+#include "tools/ros/ros_conventions.hpp"
 
 #include <cstdint>
 #include <string>
@@ -19,8 +21,14 @@ struct RosConfig {
     bool commands = false;            // Wrench and per-thruster commands; kill is always taken
     // The one network interface DDS uses: loopback until the config names the tether ("" = Cyclone picks).
     std::string interface = "lo";
-    std::string world_frame = "odom";
-    std::string base_frame = "base_link";
+    std::string world_frame = kDefaultWorldFrame;
+    std::string base_frame = kDefaultBaseFrame;
+    // The Imu's and /tf's orientation: REP 103 / 145 (base_link FLU in odom ENU), or NED / FRD
+    // under the frame names with _ned / _frd (ros_conventions.hpp).
+    frames::WorldFrame frame_convention = frames::WorldFrame::EnuFlu;
+    // Off for a vehicle whose localization publishes odom -> base_link: two publishers of one
+    // transform make tf2 jump between them.
+    bool publish_odom_tf = true;
     float range_min_m = 0.0f, range_max_m = 65.535f, range_fov_rad = 0.0f;
     caracara::dbus::BusChoice bus;
 };

@@ -1,11 +1,12 @@
 // How caracara-ros turns the vehicle's values into ROS messages, shared by the live topics
 // (tools/ros/telemetry_publisher.cpp) and a recorded dive's export for rosbag2
-// (tools/foxglove/dive_ros_mcap.cpp), so both say the same. Pure; no DDS.
+// (tools/foxglove/dive_ros_mcap.cpp), so both say the same. Pure; no DDS. The orientation's
+// conversion is core/frames.hpp's, not here.
 #pragma once
 
+#include "core/frames.hpp"
 #include "core/motor.hpp"
 
-#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -13,17 +14,17 @@ namespace caracara::ros {
 
 inline constexpr unsigned kThrusterJoints = 8;
 
-struct Quaternion {
-    double x, y, z, w;
-};
+// The frame names of the defaults (REP 105): the world frame and the vehicle's body.
+inline const std::string kDefaultWorldFrame = "odom";
+inline const std::string kDefaultBaseFrame = "base_link";
 
-// The Teensy's yaw, pitch, roll (Z, Y, X Euler angles in radians) as a quaternion.
-inline Quaternion quaternion_from_ypr(double yaw, double pitch, double roll) {
-    const double cy = std::cos(yaw / 2), sy = std::sin(yaw / 2);
-    const double cp = std::cos(pitch / 2), sp = std::sin(pitch / 2);
-    const double cr = std::cos(roll / 2), sr = std::sin(roll / 2);
-    return {sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy,
-            cr * cp * cy + sr * sp * sy};
+// A frame's name in a convention (core/frames.hpp): NED / FRD frames carry _ned / _frd, as MAVROS
+// names them, so a tool never takes them for REP 103's ENU / FLU ones.
+inline std::string world_frame_id(const std::string& world, frames::WorldFrame f) {
+    return f == frames::WorldFrame::NedFrd ? world + "_ned" : world;
+}
+inline std::string body_frame_id(const std::string& base, frames::WorldFrame f) {
+    return f == frames::WorldFrame::NedFrd ? base + "_frd" : base;
 }
 
 // A motor value as a fraction of full thrust (-1..1): JointState velocities, cmd_thrust's values.

@@ -1,5 +1,6 @@
 #include "tools/ros/telemetry_publisher.hpp"
 
+#include "core/frames.hpp"
 #include "drivers/protocol/seabotix.hpp"
 #include "tools/ros/ros_conventions.hpp"
 #include "tools/ros/type_name.hpp"
@@ -52,13 +53,16 @@ double actual_fraction(const Props& p) {
 
 TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config)
     : event_(event), dds_(dds), config_(config),
+      world_frame_(world_frame_id(config.world_frame, config.frame_convention)),
+      body_frame_(body_frame_id(config.base_frame, config.frame_convention)),
       mirror_([this](const std::string& path, const std::string&, const Props& changes,
                      const Props&) { changed(path, changes); },
               [this] { reload(); }),
       jazzy_range_(under_type_name(jazzy_sensor_msgs_msg_dds__Range__desc, "sensor_msgs::msg::dds_::Range_")) {
     const auto topic = [&](const char* name) { return ros_topic(config_, name); };
     imu_ = dds_.writer(&sensor_msgs_msg_dds__Imu__desc, topic("imu"), Profile::Default);
-    tf_ = dds_.writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Default);
+    if (config_.publish_odom_tf) // else no writer at all: ros2 topic info /tf names only the localization's
+        tf_ = dds_.writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Default);
     joints_ = dds_.writer(&sensor_msgs_msg_dds__JointState__desc, topic("joint_states"), Profile::Default);
     ordered_ = dds_.writer(&sensor_msgs_msg_dds__JointState__desc, topic("thrusters/ordered"), Profile::Default);
     diagnostics_ = dds_.writer(&diagnostic_msgs_msg_dds__DiagnosticArray__desc, "/diagnostics", Profile::Default);
@@ -205,19 +209,23 @@ void TelemetryPublisher::write_imu_and_tf() {
     const Value& o = get(props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Orientation");
     if (o.items.size() != 3)
         return;
-    const Quaternion r = quaternion_from_ypr(o.items[0].number(), o.items[1].number(), o.items[2].number());
+    // REP 145: the orientation of the body frame in the world frame, in the config's convention.
+    const frames::Quaternion r = frames::orientation({o.items[0].number(), o.items[1].number(), o.items[2].number()},
+                                                     config_.frame_convention);
     const geometry_msgs_msg_dds__Quaternion_ q{r.x, r.y, r.z, r.w};
     sensor_msgs_msg_dds__Imu_ imu{};
-    imu.header = header(config_.base_frame);
+    imu.header = header(body_frame_);
     imu.orientation = q;
     // REP 145: the orientation's covariance is unknown (all zeros); the Teensy gives no angular
     // velocity or linear acceleration, marked by -1 in the first element of their covariances.
     imu.angular_velocity_covariance[0] = -1;
     imu.linear_acceleration_covariance[0] = -1;
     dds_write(imu_, &imu);
+    if (!config_.publish_odom_tf)
+        return;
     geometry_msgs_msg_dds__TransformStamped_ t{};
-    t.header = header(config_.world_frame);
-    t.child_frame_id = c_str(config_.base_frame);
+    t.header = header(world_frame_);
+    t.child_frame_id = c_str(body_frame_);
     t.transform.rotation = q;
     tf2_msgs_msg_dds__TFMessage_ tf{};
     tf.transforms = {1, 1, &t, false};

@@ -3,7 +3,8 @@
 // topics it touches once per batch of signals, so the rates are the daemon's announcement
 // rates; nothing is polled. The topics (docs/ros2.md): imu, joint_states, thrusters/ordered,
 // range/N, /diagnostics (at most 1 Hz, at once when a level changes), killed, state and
-// kill_source (transient-local), /tf.
+// kill_source (transient-local), /tf (unless the config leaves odom -> base_link to the
+// vehicle's localization).
 #pragma once
 
 #include "tools/client/client.hpp"
@@ -50,6 +51,8 @@ private:
     sd_event* event_;
     DdsParticipant& dds_;
     const RosConfig& config_;
+    // The Imu's and /tf's frame names in the config's convention (headers point into them).
+    const std::string world_frame_, body_frame_;
     std::unique_ptr<client::Client> client_;
     caracara::SourcePtr flush_, retry_, diagnostics_timer_;
     client::ObjectMirror mirror_;
@@ -59,7 +62,7 @@ private:
     std::string last_state_, last_source_;
     bool state_written_ = false;
 
-    dds_entity_t imu_, tf_, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
+    dds_entity_t imu_, tf_ = 0, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
     std::vector<dds_entity_t> ranges_;
     dds_topic_descriptor_t jazzy_range_;
 };
