@@ -32,7 +32,7 @@ import harness  # noqa: E402
 from harness import missing, npm_ci  # noqa: E402
 from full_dive_dir import fill  # noqa: E402
 from harness import BUILD_DIR, Rig, angle_diff, poll  # noqa: E402
-from vehicle_motion import START_HEADING_RAD, judge  # noqa: E402
+from vehicle_motion import START_HEADING_RAD, describe, judge  # noqa: E402
 from ssh_bridge import free_port, port_listens, private_sshd  # noqa: E402
 
 # [failsafe.pilot-lost] persistence_ms of the rig: a closed tab, the last pilot, kills this long
@@ -491,7 +491,7 @@ class BridgeTest(BridgeRig, unittest.TestCase):
                         def hold(seconds):
                             answer.update(pilot.hold(seconds=seconds, topic="/command/motion",
                                                      message={part: {axis: demand}}))
-                        judge(self, self.rig, motion, hold, what)
+                        m = judge(self, self.rig, motion, hold, what)
                         # /tf's last rotation (the Teensy's angles come at the daemon's telemetry
                         # rate) against the simulated heading now: ENU yaw = pi/2 - heading.
                         heading, pitch, roll = (float(v) for v in self.rig.sim_teensy("Orientation"))
@@ -507,8 +507,8 @@ class BridgeTest(BridgeRig, unittest.TestCase):
                                                                                             sim_angle))
                         off = angle_diff(enu_yaw, math.pi / 2 - heading)
                         turned = angle_diff(enu_yaw, math.pi / 2 - START_HEADING_RAD)
-                        print("# %s: /tf yaw turned %+.3f rad from the start, %+.3f rad off the simulator's"
-                              % (what, turned, off), file=sys.stderr)
+                        print("# %s: %s; /tf's yaw turned %+.3f rad from the start, %+.3f rad off the "
+                              "simulator's" % (what, describe(m), turned, off), file=sys.stderr)
                         self.assertLessEqual(abs(off), TF_YAW_TOLERANCE_RAD, "%s: /tf's yaw %.3f, the simulated "
                                              "heading %.3f" % (what, enu_yaw, heading))
                         if (part, axis) == ("angular", "z"):

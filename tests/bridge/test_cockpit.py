@@ -10,10 +10,11 @@ on a rig of their own whose thrusters are all mounted as configured.
 import os
 import shutil
 import subprocess
+import sys
 import unittest
 
 from test_bridge import BUILD_DIR, HERE, BridgeRig, HeldPilot, missing, npm_ci
-from vehicle_motion import judge
+from vehicle_motion import describe, judge
 
 CHROMIUM = "/usr/bin/chromium"
 
@@ -88,7 +89,8 @@ class CockpitSticksTest(BridgeRig, unittest.TestCase):
 
                     def hold(seconds):
                         answer.update(pilot.hold(seconds=seconds, **inputs))
-                    judge(self, self.rig, motion, hold, "the cockpit's %s" % name)
+                    m = judge(self, self.rig, motion, hold, "the cockpit's %s" % name)
+                    print("# %s: %s; %d commands" % (name, describe(m), answer["sent"]), file=sys.stderr)
                     self.assertGreater(answer["sent"], 10, "%s: the page's commands while held" % name)
 
     def test_z_bridge_stops_cleanly(self):
