@@ -18,7 +18,7 @@
 //            bridge at CARACARA_TCP_URL, tests/bridge/listing_load.mjs)
 import { spawn } from "node:child_process";
 import { createInterface } from "node:readline";
-import { BUS, DEFAULT_MT, MOTOR_MAX, X_AXIS, connect, poll, sleep, speedByte, wireLog, wireNext } from "../tests/bridge/lib.mjs";
+import { BUS, DEFAULT_MT, MOTOR_MAX, X_AXIS, Y_AXIS, connect, poll, sleep, speedByte, wireLog, wireNext } from "../tests/bridge/lib.mjs";
 import { closesDuringListing, killsDuringListing, stats } from "../tests/bridge/listing_load.mjs";
 
 const url = process.env.CARACARA_WS_URL;
@@ -78,7 +78,7 @@ async function motion() {
     let t0;
     if (i % 2 === 0) {
       t0 = process.hrtime.bigint();
-      c.publish(pub, { x: value });
+      c.publish(pub, { linear: { y: value } }); // left, REP 103: the seed's x
     } else {
       py.stdin.write(`${value}\n`);
       t0 = BigInt((await lines.next()).value);
@@ -116,7 +116,7 @@ async function orderAfter(since, speed, t0) {
 }
 
 async function cockpit() {
-  const { armPad, launch, openCockpit, surge } = await import("../tests/bridge/chromium.mjs");
+  const { armPad, forwardDemand, launch, openCockpit } = await import("../tests/bridge/chromium.mjs");
   const chromium = await launch();
   try {
     const { page } = await openCockpit(chromium.browser, process.env.CARACARA_HTTP_URL);
@@ -139,14 +139,14 @@ async function cockpit() {
       if (i % 2 === 0) {
         // Stick and deadman at once; the page's next tick samples and sends; then released (zero).
         const stick = [-0.6, 0.6, -0.7, 0.7][(i / 2) % 4];
-        const speed = speedByte(X_AXIS[2] * Math.round(surge(stick) * MOTOR_MAX));
+        const speed = speedByte(Y_AXIS[2] * Math.round(forwardDemand(stick) * MOTOR_MAX)); // forward: the seed's y
         const before = await page.evaluate(() => window.cockpit.lastChange?.at ?? -1);
         await page.evaluate((s) => { window.__pad.axes[1] = s; window.__pad.buttons[4] = { pressed: true, touched: true, value: 1 }; }, stick);
         const at = await poll(() => page.evaluate((b) => (window.cockpit.lastChange?.at > b ? window.cockpit.lastChange.at : null), before), 2000, "the sample");
         const t0 = BigInt(Math.round(at * 1e6)) + best.offset;
         viaPad.push(Number((await orderAfter(since, speed, t0)) - t0) / 1000);
         await page.evaluate(() => { window.__pad.buttons[4] = { pressed: false, touched: false, value: 0 }; });
-        await poll(() => page.evaluate(() => window.cockpit.lastSent.motion.x === 0), 2000, "the release");
+        await poll(() => page.evaluate(() => window.cockpit.lastSent.motion.forward === 0), 2000, "the release");
       } else {
         const value = [0.2, -0.2, 0.3, -0.3][((i - 1) / 2) % 4];
         py.stdin.write(`${value}\n`);

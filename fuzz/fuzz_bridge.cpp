@@ -41,7 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
             if (c.kind == CommandKind::Thrust)
                 FUZZ_CHECK(c.args.size() == 1 && std::get<std::vector<int32_t>>(c.args[0]).size() == 8,
                            "thrust without its 8 values");
-            if (c.kind == CommandKind::Motion) {
+            if (c.kind == CommandKind::Motion || c.kind == CommandKind::Drive) {
                 FUZZ_CHECK(c.args.size() == 6, "motion with %zu axes", c.args.size());
                 for (const auto& a : c.args)
                     FUZZ_CHECK(std::isfinite(std::get<double>(a)), "a motion axis that is not finite");

@@ -304,13 +304,16 @@ def bridge_seeds():
                 '{"id":2,"topic":"/command/thrust","encoding":"json","schemaName":"t"},'
                 '{"id":3,"topic":"/command/leds","encoding":"json","schemaName":"l"},'
                 '{"id":4,"topic":"/command/profile","encoding":"json","schemaName":"p"},'
-                '{"id":5,"topic":"/command/kill","encoding":"json","schemaName":"k"}]}')
+                '{"id":5,"topic":"/command/kill","encoding":"json","schemaName":"k"},'
+                '{"id":6,"topic":"/command/drive","encoding":"json","schemaName":"d"}]}')
     write("bridge", "subscribe-all", frame('{"op":"subscribe","subscriptions":[' +
                                            ",".join('{"id":%d,"channelId":%d}' % (i, i) for i in range(1, 15)) + "]}"))
-    write("bridge", "commands", adv + message(1, '{"x":0.5,"yaw":-0.25}') + message(2, '{"values":[1,2,3,4,5,6,7,8]}') +
-          message(3, '{"red":1,"green":2,"blue":3}') + message(4, '{"name":"water"}') + message(5, "{}"))
+    write("bridge", "commands", adv + message(1, '{"linear":{"x":0.5,"y":0,"z":0},"angular":{"x":0,"y":0,"z":-0.25}}') +
+          message(2, '{"values":[1,2,3,4,5,6,7,8]}') + message(3, '{"red":1,"green":2,"blue":3}') +
+          message(4, '{"name":"water"}') + message(5, "{}") + message(6, '{"forward":0.5,"turn_right":-0.25}'))
     write("bridge", "bad", frame("not json") + frame('{"op":"nope"}') + frame(b"\x09\x00", True) +
-          message(9, "{}") + adv + message(2, '{"values":[1]}') + frame('{"op":"unsubscribe","subscriptionIds":[7]}'))
+          message(9, "{}") + adv + message(2, '{"values":[1]}') + message(1, '{"x":0.5}') +
+          message(6, '{"surge":1}') + frame('{"op":"unsubscribe","subscriptionIds":[7]}'))
 
 
 def main():

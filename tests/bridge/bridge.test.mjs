@@ -37,6 +37,7 @@ function keepPublishing(c, id, msg, everyMs = 100) {
   return () => clearInterval(timer);
 }
 
+// The SPEED bytes of the seed's x (port) demand v: a Twist's linear.y (left, REP 103) of v.
 const xMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in X_AXIS ? speedByte(X_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
 
 test("serverInfo, the subprotocol, and every channel advertised with a JSON Schema", async () => {
@@ -82,11 +83,11 @@ test("a thrust set over D-Bus shows on /vehicle/motors; thruster telemetry equal
   await poll(() => simSpeeds().every((s) => s === ZERO), 10000, "zero after the holder left");
 });
 
-test("a published motion reaches the wire as the mixing says; a closed client zeroes it within the client-loss bound, and the last pilot's kill follows after pilot-lost's persistence", async () => {
+test("a published Twist (linear.y, left: the seed's port) reaches the wire as the mixing says; a closed client zeroes it within the client-loss bound, and the last pilot's kill follows after pilot-lost's persistence", async () => {
   await rearm();
   const c = await client();
   const id = c.publisher("/command/motion");
-  const stop = keepPublishing(c, id, { x: 0.2 });
+  const stop = keepPublishing(c, id, { linear: { x: 0, y: 0.2, z: 0 }, angular: { x: 0, y: 0, z: 0 } });
   try {
     await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(0.2)), 10000, "the motion on the wire");
     const state = await c.waitFor("/vehicle/state", (s) => s.controller !== "");
@@ -128,7 +129,7 @@ test("kill from a client, a refused command as a status with the daemon's error 
   c.publish(kill, {});
   await c.waitFor("/vehicle/state", (s) => s.state === "killed" && s.kill_source === "dbus");
   await c.waitFor("/events", (l) => l.name === "kill" && l.level === 3);
-  c.publish(motion, { y: 0.1 });
+  c.publish(motion, { linear: { x: 0.1 } });
   const refused = await c.waitStatus((s) => s.level === 2 && s.message.includes(ERR + "Killed"));
   assert.match(refused.message, /\/command\/motion/);
   assert.equal(vget("State"), "killed");
@@ -153,15 +154,43 @@ test("kill from a client, a refused command as a status with the daemon's error 
   assert.deepEqual(wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] !== ZERO), []);
 });
 
+test("the seed's flat axes on /command/motion are refused by name, never read as a Twist; /command/drive takes a pilot's words", async () => {
+  await rearm();
+  const c = await client();
+  const since = wireNext();
+  const motion = c.publisher("/command/motion");
+  for (const old of [{ x: 0.5 }, { y: 0.5 }, { yaw: 0.5 }, { x: 0, y: 0.2, z: 0, yaw: 0, pitch: 0, roll: 0 }]) {
+    const n = c.statuses.length;
+    c.publish(motion, old);
+    const s = await poll(() => c.statuses.slice(n).find((m) => m.level === 2), 5000, `a refusal of ${JSON.stringify(old)}`);
+    assert.match(s.message, /^\/command\/motion: motion is a Twist in body FLU, .*the flat '(x|y|z|yaw|pitch|roll)' of the seed's axes is refused/);
+  }
+  const drive = c.publisher("/command/drive");
+  c.publish(drive, { surge: 0.5 });
+  await c.waitStatus((m) => m.level === 2 &&
+    m.message === "/command/drive: drive takes forward, starboard, up, turn_right, nose_up, roll_right, not 'surge'");
+  assert.deepEqual(wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] !== ZERO), [],
+                   "nothing moved");
+  // The words: starboard 0.2 is the seed's x of -0.2.
+  const stop = keepPublishing(c, drive, { starboard: 0.2 });
+  try {
+    await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(-0.2)), 10000, "the drive on the wire");
+  } finally {
+    stop();
+  }
+  c.publish(drive, {});
+  await poll(() => simSpeeds().every((v) => v === ZERO), 5000, "zero");
+});
+
 test("a second client keeps its own pilot rules; while it is connected, another leaving kills nothing", async () => {
   await rearm();
   const a = await client();
   const b = await client();
-  const stopA = keepPublishing(a, a.publisher("/command/motion"), { x: 0.2 });
+  const stopA = keepPublishing(a, a.publisher("/command/motion"), { linear: { y: 0.2 } });
   await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(0.2)), 10000, "A's motion");
   const controllerA = (await a.waitFor("/vehicle/state", (s) => s.controller !== "")).controller;
   stopA();
-  const stopB = keepPublishing(b, b.publisher("/command/motion"), { x: -0.2 });
+  const stopB = keepPublishing(b, b.publisher("/command/motion"), { linear: { y: -0.2 } });
   try {
     await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(-0.2)), 10000, "B's motion");
     const controllerB = (await b.waitFor("/vehicle/state", (s) => s.controller !== "" && s.controller !== controllerA)).controller;

@@ -39,9 +39,9 @@ export async function openCockpit(browser, url) {
   return { page, log };
 }
 
-// The default mapping's surge (docs/cockpit.md) for the left stick's y, computed on its own:
+// The default mapping's "forward" (docs/cockpit.md) for the left stick's y, computed on its own:
 // "-a1" through the dead zone 0.1 and the expo 0.3, times the gain 0.5.
-export function surge(stick) {
+export function forwardDemand(stick) {
   if (Math.abs(stick) <= 0.1) return 0;
   const t = (Math.abs(stick) - 0.1) / 0.9;
   return -Math.sign(stick) * (0.7 * t + 0.3 * t ** 3) * 0.5;

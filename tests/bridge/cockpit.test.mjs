@@ -7,9 +7,9 @@ import { bound } from "./bounds.mjs";
 import fs from "node:fs";
 import net from "node:net";
 import path from "node:path";
-import { armPad, launch, openCockpit, surge } from "./chromium.mjs";
+import { armPad, forwardDemand, launch, openCockpit } from "./chromium.mjs";
 import { execFileSync } from "node:child_process";
-import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, SURFACE_MS, VEHICLE, X_AXIS, ZERO, busctl, firstZeros, killEdges,
+import { BUILD, DEFAULT_MT, MOTORS, MOTOR_MAX, PILOT_LOST_MS, ROOT, SIM, SIM_ROOT, SURFACE_MS, VEHICLE, Y_AXIS, ZERO, busctl, firstZeros, killEdges,
   hold, poll, rearm, simSpeeds, simThruster, sleep, speedByte, vget, wireLog, wireNext } from "./lib.mjs";
 
 const HTTP = process.env.CARACARA_HTTP_URL;
@@ -135,7 +135,8 @@ test("the page shows the state and the values the simulator reports, loading not
   await page.close();
 });
 
-const xMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in X_AXIS ? speedByte(X_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
+// The SPEED bytes of a "forward" demand v: the seed's y axis, as the mixing has it.
+const forwardMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in Y_AXIS ? speedByte(Y_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
 const allZero = () => simSpeeds().every((s) => s === ZERO);
 // A page armed on purpose and driving forward (the stick at -0.6) on a freshly armed vehicle.
 async function drivingPage() {
@@ -143,11 +144,11 @@ async function drivingPage() {
   const { page } = await open();
   await armPad(page);
   await stick(page, -0.6);
-  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(forwardMotion(forwardDemand(-0.6))), 10000, "driving");
   return page;
 }
 
-test("a scripted gamepad drives motion to the wire as the mixing says only while the deadman is held", async () => {
+test("a scripted gamepad: the left stick forward reaches the wire as the seed's forward axis (the mixing's y), only while the deadman is held", async () => {
   await rearm();
   const { page } = await open();
   await setPad(page, () => { window.__pad.axes[1] = -0.6; });
@@ -156,8 +157,8 @@ test("a scripted gamepad drives motion to the wire as the mixing says only while
   assert.equal(await page.evaluate(() => window.cockpit.sent), 0, "no command without the deadman");
   await armPad(page);
   await stick(page, -0.6);
-  const expected = xMotion(surge(-0.6));
-  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "the gamepad's surge on the wire");
+  const expected = forwardMotion(forwardDemand(-0.6));
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "the gamepad's forward on the wire");
   assert.equal(await text(page, "#deadman"), "HELD");
   await shot(page, "driving");
   // Held for a second: the page keeps sending (fixed rate), the wire keeps the motion.
@@ -195,7 +196,7 @@ test("a scripted gamepad drives motion to the wire as the mixing says only while
 test("the mapping and the gain (selector and d-pad) are editable and kept in the browser's storage", async () => {
   const { page } = await open();
   await page.click("details summary");
-  await page.$eval("#map-x", (e) => { e.value = "a1"; e.dispatchEvent(new Event("change")); });
+  await page.$eval("#map-forward", (e) => { e.value = "a1"; e.dispatchEvent(new Event("change")); });
   // The gamepad's d-pad up steps the gain on each press (not while held).
   await setPad(page, () => { window.__pad.buttons[12] = { pressed: true, touched: true, value: 1 }; });
   await page.waitForFunction(() => document.getElementById("gain").value === "0.75", { timeout: 2000 });
@@ -204,11 +205,84 @@ test("the mapping and the gain (selector and d-pad) are editable and kept in the
   await setPad(page, () => { window.__pad.buttons[12] = { pressed: false, touched: false, value: 0 }; });
   await page.select("#gain", "0.25");
   await page.reload({ waitUntil: "load" });
-  assert.equal(await page.$eval("#map-x", (e) => e.value), "a1");
+  assert.equal(await page.$eval("#map-forward", (e) => e.value), "a1");
   assert.equal(await page.$eval("#gain", (e) => e.value), "0.25");
-  await page.$eval("#map-x", (e) => { e.value = "q9"; e.dispatchEvent(new Event("change")); });
+  await page.$eval("#map-forward", (e) => { e.value = "q9"; e.dispatchEvent(new Event("change")); });
   assert.match(await text(page, "#mapping-error"), /not a mapping/);
   await page.evaluate(() => localStorage.clear());
+  await page.close();
+});
+
+test("a mapping saved with the old axis names (x was port) is not taken: reset to the defaults, and the page says so", async () => {
+  const { page } = await open();
+  // The defaults before issue 43, as a browser kept them.
+  const old = { x: "-a1", y: "a0", z: "b6-b7", yaw: "a2", pitch: "-a3", roll: "b15-b14", deadman: 4, gain_up: 12,
+    gain_down: 13, kill: 1, clear_kill: 9, deadzone: 0.1, expo: 0.3, gain: 0.5 };
+  assert.equal(await page.$eval("#mapping-notice", (e) => e.hidden), true, "no notice with nothing saved");
+  await page.evaluate((m) => localStorage.setItem("caracara.cockpit.mapping", JSON.stringify(m)), old);
+  await page.reload({ waitUntil: "load" });
+  await page.waitForFunction(() => document.getElementById("link").dataset.lost === "false", { timeout: 15000 });
+  assert.equal(await page.$eval("#mapping-notice", (e) => e.hidden), false);
+  await onScreen(page, "#mapping-notice");
+  assert.match(await text(page, "#mapping-notice"), /named the old axes \(x, y, z, yaw, pitch, roll\).*reset to the defaults/);
+  assert.match(await text(page, "#events"), /reset to the defaults/);
+  assert.equal(await page.$eval("#map-forward", (e) => e.value), "-a1");
+  assert.equal(await page.$eval("label[for=map-forward]", (e) => e.textContent), "forward");
+  const stored = await page.evaluate(() => JSON.parse(localStorage.getItem("caracara.cockpit.mapping")));
+  assert.ok(!("x" in stored) && stored.forward === "-a1", `stored: ${JSON.stringify(stored)}`);
+  await shotView(page, "mapping-reset");
+  // Said once: the defaults are what is stored now.
+  await page.reload({ waitUntil: "load" });
+  assert.equal(await page.$eval("#mapping-notice", (e) => e.hidden), true);
+  await page.evaluate(() => localStorage.clear());
+  await page.close();
+});
+
+test("the attitude instrument reads as an aircraft's: nose up puts the horizon below the centre, roll right raises its right end, a clockwise turn moves the heading scale left", async () => {
+  const { page } = await open();
+  // Drawn on a canvas of its own (the live one follows /teensy); the colour at a point: "water" (above) or "ground".
+  const at = (yaw, pitch, roll, points) => page.evaluate(async (yaw, pitch, roll, points) => {
+    const { drawAttitude } = await import("./attitude.js");
+    const c = document.createElement("canvas");
+    c.width = 260; c.height = 300;
+    drawAttitude(c, yaw, pitch, roll);
+    const ctx = c.getContext("2d");
+    return points.map(([x, y]) => {
+      const [r, , b] = ctx.getImageData(x, y, 1, 1).data;
+      return b > r ? "water" : r > b ? "ground" : "other";
+    });
+  }, yaw, pitch, roll, points);
+  const rad = Math.PI / 180;
+  // The instrument's centre is (130, 120), its radius 116 px for 45 degrees of pitch; the vehicle's
+  // symbol is the yellow line at y 120 and the chevron below the centre, the points below keep off it.
+  assert.deepEqual(await at(0, 0, 0, [[130, 110], [130, 140]]), ["water", "ground"]);
+  assert.deepEqual(await at(0, 10 * rad, 0, [[100, 138]]), ["water"], "nose up: the horizon below the centre");
+  assert.deepEqual(await at(0, -10 * rad, 0, [[100, 102]]), ["ground"], "nose down: the horizon above the centre");
+  // Roll right 20 degrees: the horizon's right end up (right of the centre, a little above it: ground),
+  // its left end down (left of the centre, a little below it: water).
+  assert.deepEqual(await at(0, 0, 20 * rad, [[190, 108], [70, 132]]), ["ground", "water"], "roll right");
+  assert.deepEqual(await at(0, 0, -20 * rad, [[190, 132], [70, 108]]), ["water", "ground"], "roll left");
+  // Heading: the scale (240 px for 180 degrees, its top at y 246) has the north tick, 12 px long, under
+  // the pointer at heading 0; after a clockwise turn of 20 degrees it is 27 px left of the pointer.
+  const tickNear = (yaw, x) => page.evaluate(async (yaw, x) => {
+    const { drawAttitude } = await import("./attitude.js");
+    const c = document.createElement("canvas");
+    c.width = 260; c.height = 300;
+    drawAttitude(c, yaw, 0, 0);
+    const row = c.getContext("2d").getImageData(x - 3, 246 + 9, 7, 1).data;
+    let most = 0;
+    for (let i = 0; i < row.length; i += 4) most = Math.max(most, Math.min(row[i], row[i + 1], row[i + 2]));
+    return most;
+  }, yaw, x);
+  const left = Math.round(130 - 20 * 240 / 180);
+  assert.ok(await tickNear(20 * rad, left) > 120, "after a clockwise turn the north tick is left of the pointer");
+  assert.ok(await tickNear(-20 * rad, left) < 60, "not after a counter-clockwise one");
+  assert.ok(await tickNear(-20 * rad, 260 - left) > 120, "after a counter-clockwise one it is right of the pointer");
+  // The heading in figures as a compass reads it: 0 to 360, clockwise.
+  assert.deepEqual(await page.evaluate(async () => {
+    const { headingDegrees } = await import("./attitude.js");
+    return [-0.2, 0, 1].map(headingDegrees);
+  }), ["348.5", "0.0", "57.3"]);
   await page.close();
 });
 
@@ -220,7 +294,7 @@ test("closing the page while driving zeroes the thrusters within the client-loss
   const since = wireNext();
   const closedAt = process.hrtime.bigint(); // CLOCK_MONOTONIC, as the wire log's times
   await page.close();
-  const driven = new Set(Object.keys(X_AXIS).map((i) => DEFAULT_MT[i] >> 1));
+  const driven = new Set(Object.keys(Y_AXIS).map((i) => DEFAULT_MT[i] >> 1));
   const zeroTimes = await poll(() => {
     const first = new Map();
     for (const e of wireLog(since))
@@ -281,7 +355,7 @@ test("the kill button and the Space (while driving) and Escape keys each kill; c
   // Space while driving, with a form control focused: killed, zero, and the page stops sending.
   await armPad(page);
   await stick(page, -0.6);
-  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(surge(-0.6))), 10000, "driving");
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(forwardMotion(forwardDemand(-0.6))), 10000, "driving");
   await page.focus("#gain");
   await killedBy(page, () => page.keyboard.press("Space"));
   assert.ok(allZero());
@@ -337,7 +411,7 @@ test("after a kill and Clear kill, or a reconnect, with the deadman and the stic
   assert.match(await text(page, "#arm"), /press the deadman|release the deadman/, "a loaded page says how to arm");
   await armPad(page);
   await stick(page, -0.6);
-  const expected = xMotion(surge(-0.6));
+  const expected = forwardMotion(forwardDemand(-0.6));
   await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving");
   await killedBy(page, () => page.click("#kill"));
   const since = wireNext();

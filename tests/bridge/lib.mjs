@@ -21,8 +21,9 @@ export const ROOT = "/org/caracara/Vehicle1";
 export const SIM = "org.caracara.Simulator1";
 export const SIM_ROOT = "/org/caracara/Simulator1";
 export const ERR = "org.caracara.Vehicle1.Error.";
-// The packet seed's x axis (motor: sign), as tests/e2e/harness.py has it.
+// The packet seed's x (port) and y (forward) axes (motor: sign), as tests/e2e/harness.py has them.
 export const X_AXIS = { 2: +1, 6: +1, 0: -1, 4: -1 };
+export const Y_AXIS = { 0: +1, 2: +1, 4: +1, 6: +1 };
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 

@@ -100,9 +100,9 @@ export async function closesDuringListing(url, listUrl, samples) {
       await rearm();
       const c = await connect(url);
       const motion = c.publisher("/command/motion");
-      const timer = setInterval(() => { if (!c.closed) c.publish(motion, { x: 0.2 }); }, 50);
+      const timer = setInterval(() => { if (!c.closed) c.publish(motion, { linear: { y: 0.2 } }); }, 50);
       try {
-        c.publish(motion, { x: 0.2 });
+        c.publish(motion, { linear: { y: 0.2 } });
         await poll(() => simSpeeds()[2] !== ZERO, 10000, "the motion on the wire");
         await poll(() => lister.busy, 10000, "a listing in progress");
         await sleep(Math.random() * 20);

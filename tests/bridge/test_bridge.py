@@ -2,14 +2,18 @@
 bridge on a Unix socket, a private sshd and a real `ssh -L PORT:SOCKET` forward, then the
 reference client's tests (bridge.test.mjs, node --test) through it; the socket's group rule;
 a recorded dive exported to MCAP and read back by the reference reader (mcap_check.mjs); the
-token on TCP; and the bridge's bounds (issue 35): a Kill and a close while another client lists
+token on TCP; /command/motion's Twist judged by where the simulated vehicle went
+(tests/e2e/vehicle_motion.py, issue 43) and a clockwise turn read back from /tf; and the bridge's bounds (issue 35): a Kill and a close while another client lists
 a full dive directory, floods from a client that does not read (bounds.test.mjs, on a second
 bridge on TCP), and stalled tokenless connections beside the pilots.
 
 The npm packages are pinned in package-lock.json and installed with `npm ci`, cached under
 /var/cache/caracara-npm. Under CI (CI=true) a missing node, npm or sshd fails the test.
 """
+import json
+import math
 import os
+import select
 import shutil
 import socket
 import subprocess
@@ -27,7 +31,8 @@ import bounds  # noqa: E402
 import harness  # noqa: E402
 from harness import missing, npm_ci  # noqa: E402
 from full_dive_dir import fill  # noqa: E402
-from harness import BUILD_DIR, Rig, poll  # noqa: E402
+from harness import BUILD_DIR, Rig, angle_diff, poll  # noqa: E402
+from vehicle_motion import START_HEADING_RAD, describe, judge  # noqa: E402
 from ssh_bridge import free_port, port_listens, private_sshd  # noqa: E402
 
 # [failsafe.pilot-lost] persistence_ms of the rig: a closed tab, the last pilot, kills this long
@@ -35,6 +40,10 @@ from ssh_bridge import free_port, port_listens, private_sshd  # noqa: E402
 PILOT_LOST_MS = 1000
 # [failsafe.surface] duration_ms of the rig: the ascent the cockpit's banner shows.
 SURFACE_MS = 3000
+# /tf's angles against the simulated attitude read just after it: the attitude comes at the daemon's
+# telemetry rate, and a turn of 0.5 demand runs at about 0.5 rad/s (tests/bounds.json
+# MOTION_ROTATION_MIN_RAD's note).
+TF_YAW_TOLERANCE_RAD = 0.15
 
 
 class Sshd:
@@ -78,6 +87,63 @@ def connect_as(path, *setpriv):
     r = subprocess.run(["setpriv", *setpriv, "/usr/bin/python3", "-c", code, path], capture_output=True, text=True,
                        timeout=30)
     return r.stdout.strip() or r.stderr.strip()
+
+
+class HeldPilot:
+    """tests/bridge/hold_motion.mjs (the cockpit in chromium, or the Foxglove reference client):
+    hold(seconds=S, ...) commands a motion for S seconds, then stops it, and returns its answer."""
+
+    def __init__(self, rig, mode, **env):
+        self.mode = mode
+        self.log_path = os.path.join(rig.dir, "hold_motion-%s.log" % mode)
+        self.log = open(self.log_path, "w")
+        self.proc = subprocess.Popen(["node", "hold_motion.mjs", mode], cwd=HERE, stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=self.log, text=True,
+                                     env={**os.environ, "CARACARA_BUILD_DIR": BUILD_DIR,
+                                          "CARACARA_BUS_ADDRESS": rig.address, **env})
+        if self.answer(60) != "ready":
+            raise AssertionError("hold_motion.mjs %s did not start" % mode)
+
+    def answer(self, timeout=30):
+        ready, _, _ = select.select([self.proc.stdout], [], [], timeout)
+        line = self.proc.stdout.readline() if ready else ""
+        if not line:
+            self.log.flush()
+            with open(self.log_path, errors="replace") as f:
+                raise AssertionError("hold_motion.mjs %s gave no answer: %s" % (self.mode, f.read()[-3000:]))
+        return json.loads(line)
+
+    def hold(self, **request):
+        try:
+            self.proc.stdin.write(json.dumps(request) + "\n")
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            self.answer(0)  # says why it ended
+        return self.answer(request.get("seconds", 0) + 30)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        try:
+            self.proc.stdin.close()
+        except BrokenPipeError:
+            pass  # it ended already: its log says why
+        try:
+            code = self.proc.wait(60)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            code = self.proc.wait()
+        self.proc.stdout.close()
+        self.log.close()
+        if exc[0] is None and code != 0:
+            with open(self.log_path, errors="replace") as f:
+                raise AssertionError("hold_motion.mjs %s exited %d: %s" % (self.mode, code, f.read()[-3000:]))
+
+
+def quaternion_yaw(q):
+    """The yaw about the world's z of a body-to-world rotation (foxglove.FrameTransform's)."""
+    return math.atan2(2 * (q["w"] * q["z"] + q["x"] * q["y"]), 1 - 2 * (q["y"] ** 2 + q["z"] ** 2))
 
 
 class BridgeRig:
@@ -158,6 +224,13 @@ class BridgeRig:
         self.bridge.terminate()
         self.assertEqual(self.bridge.wait(20), 0, "caracara-bridge: " + self.bridge_output())
         self.assertFalse(os.path.exists(self.socket))
+
+    def rearm(self):
+        """Ready again, whatever an earlier test left (killed, or a restarted daemon)."""
+        if self.rig.state() != "killed":
+            self.rig.vcall("Kill")
+        self.rig.vcall("ClearKill")
+        self.rig.wait_state("ready")
 
     def node(self, script, **env):
         r = subprocess.run(["node", "--test", "--test-reporter=spec", script], cwd=HERE, capture_output=True, text=True,
@@ -400,6 +473,48 @@ class BridgeTest(BridgeRig, unittest.TestCase):
         _, line = pilot()
         self.assertIn("101", line)
         self.assertIsNone(p.poll())
+
+    def test_8_a_twist_on_command_motion_moves_the_vehicle_in_body_flu(self):
+        # REP 103 body FLU (x forward, y left, z up, right-handed rotations), each way; the
+        # simulated vehicle is the referee. A clockwise turn reads on /tf as the ENU yaw decreasing.
+        twist = [("linear", "x", "forward", "backward"), ("linear", "y", "port", "starboard"),
+                 ("linear", "z", "up", "deeper"), ("angular", "z", "counter-clockwise", "clockwise"),
+                 ("angular", "y", "nose down", "nose up"), ("angular", "x", "roll right", "roll left")]
+        self.rearm()
+        with HeldPilot(self.rig, "foxglove", CARACARA_WS_URL="ws://127.0.0.1:%d" % self.port) as pilot:
+            for part, axis, plus, minus in twist:
+                for demand, motion in ((0.5, plus), (-0.5, minus)):
+                    what = "/command/motion %s.%s=%+.1f" % (part, axis, demand)
+                    with self.subTest(what):
+                        answer = {}
+
+                        def hold(seconds):
+                            answer.update(pilot.hold(seconds=seconds, topic="/command/motion",
+                                                     message={part: {axis: demand}}))
+                        m = judge(self, self.rig, motion, hold, what)
+                        # /tf's last rotation (the Teensy's angles come at the daemon's telemetry
+                        # rate) against the simulated heading now: ENU yaw = pi/2 - heading.
+                        heading, pitch, roll = (float(v) for v in self.rig.sim_teensy("Orientation"))
+                        q = answer["tf"][1]
+                        enu_yaw = quaternion_yaw(q)
+                        # The body's forward (x) and left (y) axes in the world: their heights are
+                        # the sines of nose up and of roll right (right side down raises the left).
+                        nose_up = math.asin(max(-1, min(1, 2 * (q["x"] * q["z"] - q["w"] * q["y"]))))
+                        roll_right = math.asin(max(-1, min(1, 2 * (q["y"] * q["z"] + q["w"] * q["x"]))))
+                        for name, tf_angle, sim_angle in (("nose up", nose_up, pitch), ("roll right", roll_right, roll)):
+                            self.assertLessEqual(abs(tf_angle - sim_angle), TF_YAW_TOLERANCE_RAD,
+                                                 "%s: /tf's %s %.3f, the simulator's %.3f" % (what, name, tf_angle,
+                                                                                            sim_angle))
+                        off = angle_diff(enu_yaw, math.pi / 2 - heading)
+                        turned = angle_diff(enu_yaw, math.pi / 2 - START_HEADING_RAD)
+                        print("# %s: %s; /tf's yaw turned %+.3f rad from the start, %+.3f rad off the "
+                              "simulator's" % (what, describe(m), turned, off), file=sys.stderr)
+                        self.assertLessEqual(abs(off), TF_YAW_TOLERANCE_RAD, "%s: /tf's yaw %.3f, the simulated "
+                                             "heading %.3f" % (what, enu_yaw, heading))
+                        if (part, axis) == ("angular", "z"):
+                            # Counter-clockwise is ENU's positive yaw: the sign of the demand.
+                            self.assertGreaterEqual(turned * math.copysign(1, demand), bounds.MOTION_ROTATION_MIN_RAD,
+                                                    "%s: /tf's yaw turned %+.3f rad" % (what, turned))
 
     def test_9_bridge_stops_cleanly(self):
         self.check_bridge_stops_cleanly()

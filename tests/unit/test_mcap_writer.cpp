@@ -4,13 +4,16 @@
 // says. The reference reader (@mcap/core) judges real exports in e2e_bridge. Also the channel
 // catalogue shared with the bridge: every message's JSON has exactly its schema's fields.
 #include "core/crc32.hpp"
+#include "core/frames.hpp"
 #include "tests/catch.hpp"
 #include "tools/bridge/client_protocol.hpp"
+#include "tools/bridge/command.hpp"
 #include "core/safety_state.hpp"
 #include "tools/foxglove/channels.hpp"
 #include "tools/foxglove/dive_mcap.hpp"
 #include "tools/foxglove/mcap_writer.hpp"
 
+#include <array>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -260,12 +263,76 @@ TEST_CASE("a dive exported to MCAP: motor tests and a detection run on /events",
     }
 }
 
-TEST_CASE("the attitude quaternion: identity at rest, yaw clockwise from above is a turn about -z", "[foxglove]") {
-    const auto rest = nlohmann::json::parse(fg::attitude_json(0, 0, 0, 0))["rotation"];
-    CHECK(rest["w"].get<double>() == Approx(1.0));
-    const auto yaw = nlohmann::json::parse(fg::attitude_json(0, 3.14159265358979 / 2, 0, 0))["rotation"];
-    CHECK(yaw["z"].get<double>() == Approx(-0.70710678).margin(1e-6));
-    CHECK(yaw["w"].get<double>() == Approx(0.70710678).margin(1e-6));
+namespace {
+// A body-frame vector turned into the world by a /tf rotation.
+std::array<double, 3> rotate(const nlohmann::json& q, std::array<double, 3> v) {
+    const double x = q["x"], y = q["y"], z = q["z"], w = q["w"];
+    // v + 2w (u x v) + 2 u x (u x v), u the quaternion's vector part
+    const std::array<double, 3> t{2 * (y * v[2] - z * v[1]), 2 * (z * v[0] - x * v[2]), 2 * (x * v[1] - y * v[0])};
+    return {v[0] + w * t[0] + (y * t[2] - z * t[1]), v[1] + w * t[1] + (z * t[0] - x * t[2]),
+            v[2] + w * t[2] + (x * t[1] - y * t[0])};
+}
+nlohmann::json tf_rotation(double yaw, double pitch, double roll) {
+    return nlohmann::json::parse(fg::attitude_json(0, yaw, pitch, roll))["rotation"];
+}
+} // namespace
+
+TEST_CASE("/tf: the FLU body in the ENU world (core/frames), heading 0 facing north, a clockwise turn decreasing yaw", "[foxglove]") {
+    const auto rest = rotate(tf_rotation(0, 0, 0), {1, 0, 0}); // forward points north: +y
+    CHECK(rest[0] == Approx(0).margin(1e-9));
+    CHECK(rest[1] == Approx(1));
+    const auto east = rotate(tf_rotation(3.14159265358979 / 2, 0, 0), {1, 0, 0}); // heading 90 deg clockwise: east
+    CHECK(east[0] == Approx(1));
+    CHECK(east[1] == Approx(0).margin(1e-9));
+    const auto yaw = [](const nlohmann::json& q) {
+        return caracara::frames::yaw_of({q["x"], q["y"], q["z"], q["w"]});
+    };
+    CHECK(yaw(tf_rotation(0.3, 0, 0)) < yaw(tf_rotation(0, 0, 0)));
+    CHECK(rotate(tf_rotation(0, 0.2, 0), {1, 0, 0})[2] > 0.19); // nose up: forward points up
+    CHECK(rotate(tf_rotation(0, 0, 0.2), {0, 1, 0})[2] > 0.19); // roll right: the left side rises
+}
+
+TEST_CASE("/command/motion is a Twist in body FLU and /command/drive a pilot's words, both in the seed's axes for SetMotion", "[bridge]") {
+    using caracara::bridge::CommandKind;
+    using caracara::bridge::parse_command;
+    const auto args = [](CommandKind k, const char* json) {
+        const auto p = parse_command(k, json);
+        INFO(p.error);
+        REQUIRE(p.command);
+        std::vector<double> out;
+        for (const auto& a : p.command->args)
+            out.push_back(std::get<double>(a));
+        return out;
+    };
+    // SetMotion (x +port, y +forward, z +deeper, yaw +clockwise, pitch +nose up, roll +right side down).
+    CHECK(args(CommandKind::Motion, R"({"linear":{"x":0.5}})") == std::vector<double>{0, 0.5, 0, 0, 0, 0});
+    CHECK(args(CommandKind::Motion, R"({"linear":{"y":0.5}})") == std::vector<double>{0.5, 0, 0, 0, 0, 0});
+    CHECK(args(CommandKind::Motion, R"({"linear":{"z":0.5}})") == std::vector<double>{0, 0, -0.5, 0, 0, 0});
+    CHECK(args(CommandKind::Motion, R"({"angular":{"z":0.5}})") == std::vector<double>{0, 0, 0, -0.5, 0, 0});
+    CHECK(args(CommandKind::Motion, R"({"angular":{"y":0.5}})") == std::vector<double>{0, 0, 0, 0, -0.5, 0});
+    CHECK(args(CommandKind::Motion, R"({"angular":{"x":0.5}})") == std::vector<double>{0, 0, 0, 0, 0, 0.5});
+    CHECK(args(CommandKind::Motion, R"({"linear":{"x":0,"y":0,"z":0},"angular":{"x":0,"y":0,"z":0}})") ==
+          std::vector<double>(6, 0.0));
+    CHECK(args(CommandKind::Drive, R"({"forward":0.5})") == std::vector<double>{0, 0.5, 0, 0, 0, 0});
+    CHECK(args(CommandKind::Drive, R"({"starboard":0.5})") == std::vector<double>{-0.5, 0, 0, 0, 0, 0});
+    CHECK(args(CommandKind::Drive, R"({"up":0.5})") == std::vector<double>{0, 0, -0.5, 0, 0, 0});
+    CHECK(args(CommandKind::Drive, R"({"turn_right":0.5,"nose_up":0.25,"roll_right":-1})") ==
+          std::vector<double>{0, 0, 0, 0.5, 0.25, -1});
+    // The old flat fields are refused by name, never read as forward; anything else named.
+    for (const char* old : {R"({"x":0.5})", R"({"y":0.1})", R"({"yaw":-1})", R"({"linear":{"x":0.1},"roll":0})"}) {
+        const auto p = parse_command(CommandKind::Motion, old);
+        CHECK_FALSE(p.command);
+        CHECK(p.error.find("motion is a Twist in body FLU") != std::string::npos);
+        CHECK(p.error.find("of the seed's axes is refused") != std::string::npos);
+    }
+    CHECK(parse_command(CommandKind::Motion, R"({"linear":{"x":"fast"}})").error == "motion linear 'x' must be a number");
+    CHECK(parse_command(CommandKind::Motion, R"({"linear":[1,0,0]})").error.find("must be an object") != std::string::npos);
+    CHECK(parse_command(CommandKind::Motion, R"({"linear":{"w":1}})").error == "motion's 'linear' takes x, y, z, not 'w'");
+    CHECK(parse_command(CommandKind::Motion, R"({"twist":{}})").error == "motion takes \"linear\" and \"angular\", not 'twist'");
+    CHECK(parse_command(CommandKind::Drive, R"({"surge":1})").error ==
+          "drive takes forward, starboard, up, turn_right, nose_up, roll_right, not 'surge'");
+    CHECK(parse_command(CommandKind::Drive, R"({"forward":true})").error == "drive 'forward' must be a number");
+    CHECK(caracara::bridge::command_topic("/command/drive") == CommandKind::Drive);
 }
 
 TEST_CASE("the bridge's client protocol: commands only from advertised command topics, errors named", "[bridge]") {
@@ -280,15 +347,18 @@ TEST_CASE("the bridge's client protocol: commands only from advertised command t
         std::copy(body.begin(), body.end(), b.begin() + 5);
         return b;
     };
-    CHECK_FALSE(p.on_binary(binary(5, R"({"x":0.5})")).command); // not advertised
+    CHECK_FALSE(p.on_binary(binary(5, R"({"linear":{"x":0.5}})")).command); // not advertised
     CHECK(p.on_text(R"({"op":"advertise","channels":[{"id":5,"topic":"/command/motion","encoding":"json"}]})").replies.empty());
-    const auto o = p.on_binary(binary(5, R"({"x":0.5,"yaw":-1})"));
+    const auto o = p.on_binary(binary(5, R"({"linear":{"y":0.5},"angular":{"z":1}})"));
     REQUIRE(o.command);
     REQUIRE(o.command->args.size() == 6);
-    CHECK(std::get<double>(o.command->args[0]) == 0.5);
-    CHECK(std::get<double>(o.command->args[3]) == -1);
+    CHECK(std::get<double>(o.command->args[0]) == 0.5);  // left: the seed's +x (port)
+    CHECK(std::get<double>(o.command->args[3]) == -1);   // counter-clockwise: the seed's -yaw
     CHECK(std::get<double>(o.command->args[1]) == 0); // an axis left out
-    CHECK_FALSE(p.on_binary(binary(5, R"({"x":"fast"})")).command);
+    CHECK_FALSE(p.on_binary(binary(5, R"({"linear":{"x":"fast"}})")).command);
+    const auto old = p.on_binary(binary(5, R"({"x":0.5})"));
+    CHECK_FALSE(old.command);
+    CHECK(old.replies.at(0).find("/command/motion: motion is a Twist in body FLU") != std::string::npos);
     CHECK_FALSE(p.on_binary(binary(5, "{")).command);
     CHECK(p.on_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":1},{"id":1,"channelId":2}]})").replies.size() == 1);
     CHECK(p.subscribers(1) == std::vector<uint32_t>{1});

@@ -1,5 +1,8 @@
 #include "tools/bridge/command.hpp"
 
+#include "core/frames.hpp"
+
+#include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -9,7 +12,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr const char* kAxes[] = {"x", "y", "z", "yaw", "pitch", "roll"};
 constexpr std::size_t kMotors = 8;
 constexpr std::size_t kMaxProfileName = 256;
 
@@ -18,13 +20,80 @@ using Parse = std::string (*)(const json& j, std::vector<CommandArg>& args);
 
 std::string no_args(const json&, std::vector<CommandArg>&) { return ""; }
 
+// SetMotion's arguments, in the seed's axes (the D-Bus contract), from a demand core/frames made.
+void demand_args(const AxisDemand& d, std::vector<CommandArg>& args) {
+    for (const double v : d)
+        args.emplace_back(v);
+}
+
+// A finite JSON number; a component left out is 0.
+std::string component(const json& j, const std::string& key, double& out, const std::string& what) {
+    const auto it = j.find(key);
+    if (it == j.end())
+        return "";
+    if (!it->is_number() || !std::isfinite(it->get<double>()))
+        return what + " '" + key + "' must be a number";
+    out = it->get<double>();
+    return "";
+}
+
+// One of a Twist's vectors: {"x","y","z"}, nothing else.
+std::string twist_vector(const json& j, const char* name, frames::Vec3& v) {
+    const auto it = j.find(name);
+    if (it == j.end())
+        return "";
+    if (!it->is_object())
+        return std::string("motion's '") + name + "' must be an object {\"x\",\"y\",\"z\"}";
+    for (const auto& [key, _] : it->items())
+        if (key != "x" && key != "y" && key != "z")
+            return std::string("motion's '") + name + "' takes x, y, z, not '" + key + "'";
+    const std::string what = std::string("motion ") + name;
+    for (auto [key, out] : {std::pair{"x", &v.x}, std::pair{"y", &v.y}, std::pair{"z", &v.z}})
+        if (std::string why = component(*it, key, *out, what); !why.empty())
+            return why;
+    return "";
+}
+
+// The flat fields /command/motion took before issue 43, in the seed's axes (x was port): Foxglove's
+// users read x as forward, so they are refused by name, never taken as a Twist's.
+constexpr std::string_view kSeedFields[] = {"x", "y", "z", "yaw", "pitch", "roll"};
+
+// A geometry_msgs/Twist in REP 103 body FLU (what Foxglove's Teleop panel publishes), each
+// component -1..1 of full demand, converted by core/frames.
 std::string motion(const json& j, std::vector<CommandArg>& args) {
-    for (const char* axis : kAxes) {
-        const auto it = j.find(axis);
-        if (it != j.end() && !it->is_number())
-            return std::string("motion axis '") + axis + "' must be a number";
-        args.emplace_back(it == j.end() ? 0.0 : it->get<double>()); // an axis left out is 0
+    for (const auto& [key, _] : j.items()) {
+        for (const std::string_view old : kSeedFields)
+            if (key == old)
+                return "motion is a Twist in body FLU, {\"linear\":{\"x\":forward,\"y\":left,\"z\":up},"
+                       "\"angular\":{\"x\":roll right,\"y\":nose down,\"z\":turn left}}: the flat '" + key +
+                       "' of the seed's axes is refused (docs/foxglove.md)";
+        if (key != "linear" && key != "angular")
+            return "motion takes \"linear\" and \"angular\", not '" + key + "'";
     }
+    frames::BodyMotion m;
+    if (std::string why = twist_vector(j, "linear", m.linear); !why.empty())
+        return why;
+    if (std::string why = twist_vector(j, "angular", m.angular); !why.empty())
+        return why;
+    demand_args(frames::from_flu(m), args);
+    return "";
+}
+
+// The cockpit's motion in a pilot's words (EnumNames<frames::PilotAxis>), converted by core/frames.
+std::string drive(const json& j, std::vector<CommandArg>& args) {
+    frames::PilotMotion m;
+    for (const auto& [key, _] : j.items()) {
+        const auto axis = parse_name<frames::PilotAxis>(key);
+        if (!axis) {
+            std::string names;
+            for (const auto& n : EnumNames<frames::PilotAxis>::table)
+                names += (names.empty() ? "" : ", ") + std::string(n.name);
+            return "drive takes " + names + ", not '" + key + "'";
+        }
+        if (std::string why = component(j, key, frames::pilot_axis(m, *axis), "drive"); !why.empty())
+            return why;
+    }
+    demand_args(frames::from_pilot(m), args);
     return "";
 }
 
@@ -98,6 +167,7 @@ constexpr Row kCommands[] = {
     {{CommandKind::DetectDirections, "/command/detect_directions", "DetectDirections", CommandReply::Directions,
       kDetectTimeout},
      no_args},
+    {{CommandKind::Drive, "/command/drive", "SetMotion", CommandReply::None, milliseconds(0)}, drive},
 };
 
 const Row& row(CommandKind kind) { return kCommands[static_cast<std::size_t>(kind)]; }
@@ -130,7 +200,7 @@ static_assert([] {
     for (std::size_t i = 0; i < std::size(kCommands); ++i)
         if (static_cast<std::size_t>(kCommands[i].spec.kind) != i)
             return false;
-    return std::size(kCommands) == static_cast<std::size_t>(CommandKind::DetectDirections) + 1;
+    return std::size(kCommands) == static_cast<std::size_t>(CommandKind::Drive) + 1;
 }());
 
 } // namespace caracara::bridge

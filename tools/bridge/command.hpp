@@ -15,7 +15,9 @@
 
 namespace caracara::bridge {
 
-enum class CommandKind : uint8_t { Motion, Thrust, Kill, ClearKill, Leds, Profile, MotorTest, DetectDirections };
+// Motion: a Twist in REP 103 body FLU (Foxglove); Drive: a pilot's words (the cockpit). Both are
+// SetMotion, converted by core/frames (docs/frames.md).
+enum class CommandKind : uint8_t { Motion, Thrust, Kill, ClearKill, Leds, Profile, MotorTest, DetectDirections, Drive };
 
 // What a successful reply carries back to the client that sent the command.
 enum class CommandReply : uint8_t {

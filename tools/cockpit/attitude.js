@@ -1,5 +1,8 @@
-// The attitude instrument: an artificial horizon (roll turns it, pitch moves it) and a
-// heading scale (yaw), drawn on a canvas from the Teensy's angles in radians.
+// The attitude instrument, read as an aircraft's: an artificial horizon (nose up puts the horizon
+// below the centre; roll right, right side down, turns the horizon counter-clockwise on the
+// screen, its right end up) and a heading scale (a clockwise turn brings higher headings in from
+// the right), drawn on a canvas from the Teensy's angles in radians: heading clockwise from
+// above, pitch nose up, roll right side down (core/frames.hpp, docs/frames.md).
 const DEG = 180 / Math.PI;
 
 export function drawAttitude(canvas, yaw, pitch, roll) {
@@ -13,8 +16,8 @@ export function drawAttitude(canvas, yaw, pitch, roll) {
   ctx.arc(cx, cy, r, 0, 2 * Math.PI);
   ctx.clip();
   ctx.translate(cx, cy);
-  ctx.rotate(-roll);
-  const shift = pitch * DEG * pxPerDeg;
+  ctx.rotate(-roll); // the canvas's y is down: a negative angle turns counter-clockwise on screen
+  const shift = pitch * DEG * pxPerDeg; // nose up: the horizon drawn lower
   ctx.translate(0, shift);
   ctx.fillStyle = "#2d6fa8"; // water above
   ctx.fillRect(-2 * r, -4 * r, 4 * r, 4 * r);
@@ -88,3 +91,5 @@ export function drawAttitude(canvas, yaw, pitch, roll) {
 }
 
 export const degrees = (rad) => (Math.abs(rad * DEG) < 0.05 ? 0 : rad * DEG).toFixed(1);
+// A heading as a compass reads it: 0 up to 360, clockwise.
+export const headingDegrees = (rad) => (((Number(degrees(rad)) % 360) + 360) % 360).toFixed(1);

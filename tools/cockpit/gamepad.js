@@ -1,20 +1,24 @@
-// Gamepad piloting (docs/cockpit.md): the Gamepad API's standard mapping to the six motion
-// axes. Each axis is a sum of terms ("-a1", "b7-b6": aN a stick axis, bN a button's value),
+// Gamepad piloting (docs/cockpit.md): the Gamepad API's standard mapping to the six motions, named
+// in a pilot's words (core/frames.hpp's PilotAxis; the bridge's /command/drive converts them).
+// Each motion is a sum of terms ("-a1", "b6-b7": aN a stick axis, bN a button's value),
 // each stick term through a dead zone and an expo curve, then times the gain. Nothing moves
 // unless the deadman button is held. Kill on a button's press; Clear kill on another held for
 // CLEAR_HOLD_MS, never on a tap.
-export const AXES = ["x", "y", "z", "yaw", "pitch", "roll"];
+export const AXES = ["forward", "starboard", "up", "turn_right", "nose_up", "roll_right"];
+// The mapping's axes before issue 43, the seed's (x was port, +z deeper): a mapping saved with
+// them would drive the wrong way, so it is not taken, and the page says so.
+export const OLD_AXES = ["x", "y", "z", "yaw", "pitch", "roll"];
 export const GAINS = [0.25, 0.5, 0.75, 1.0];
 export const CLEAR_HOLD_MS = 2000;
-const KEY = "caracara.cockpit.mapping";
+export const KEY = "caracara.cockpit.mapping";
 
 export const DEFAULT_MAPPING = {
-  x: "-a1",      // left stick forward: surge
-  y: "a0",       // left stick right: sway
-  z: "b6-b7",    // left trigger up, right trigger down: heave
-  yaw: "a2",     // right stick right
-  pitch: "-a3",  // right stick forward: nose up
-  roll: "b15-b14", // d-pad right/left
+  forward: "-a1",          // left stick forward: forward (back: backward)
+  starboard: "a0",         // left stick right: starboard (left: port)
+  up: "b6-b7",             // left trigger: up; right trigger: down
+  turn_right: "a2",        // right stick right: turn right, clockwise from above
+  nose_up: "-a3",          // right stick forward: nose up (back: nose down)
+  roll_right: "b15-b14",   // d-pad right: roll right, right side down (left: roll left)
   deadman: 4,    // left bumper, held
   gain_up: 12,   // d-pad up: the next gain
   gain_down: 13, // d-pad down: the one before
@@ -53,13 +57,28 @@ export function validMapping(m) {
   return true;
 }
 
+// {mapping, notice}: the stored mapping, or the defaults; notice (null when none) says why a
+// stored one was not taken. One with the old axis names is reset to the defaults, stored, so the
+// notice is said once.
 export function loadMapping(storage = localStorage) {
+  let stored;
   try {
-    const m = { ...DEFAULT_MAPPING, ...JSON.parse(storage.getItem(KEY) ?? "{}") };
-    validMapping(m);
-    return m;
+    stored = JSON.parse(storage.getItem(KEY) ?? "{}");
   } catch {
-    return { ...DEFAULT_MAPPING };
+    return { mapping: { ...DEFAULT_MAPPING }, notice: "The saved gamepad mapping could not be read: the defaults are in use." };
+  }
+  if (stored && typeof stored === "object" && OLD_AXES.some((a) => a in stored)) {
+    storage.setItem(KEY, JSON.stringify(DEFAULT_MAPPING));
+    return { mapping: { ...DEFAULT_MAPPING }, notice: "The gamepad mapping saved in this browser named the old axes " +
+      "(x, y, z, yaw, pitch, roll), which drove the wrong way: it was reset to the defaults (left stick forward: " +
+      "forward, right: starboard, left trigger: up). Check the mapping before driving." };
+  }
+  try {
+    const m = { ...DEFAULT_MAPPING, ...stored };
+    validMapping(m);
+    return { mapping: m, notice: null };
+  } catch (err) {
+    return { mapping: { ...DEFAULT_MAPPING }, notice: `The saved gamepad mapping was refused (${err.message}): the defaults are in use.` };
   }
 }
 
@@ -82,7 +101,7 @@ export function shape(v, deadzone, expo) {
   return Math.sign(v) * ((1 - expo) * t + expo * t * t * t);
 }
 
-// A gamepad's state -> {held, centred, motion: {x..roll}}; motion is all zero unless the
+// A gamepad's state -> {held, centred, motion: {forward..roll_right}}; motion is all zero unless the
 // deadman is held; centred: every term of every axis inside the dead zone, deadman or not.
 export function sample(pad, mapping) {
   const button = (i) => pad.buttons[i]?.value ?? (pad.buttons[i]?.pressed ? 1 : 0);

@@ -1,8 +1,8 @@
 // The cockpit (docs/cockpit.md): one Foxglove WebSocket client of the bridge that serves this
 // page, showing the vehicle live, killing from anywhere on the page, and piloting with a gamepad.
 import { FoxgloveClient } from "./foxglove.js";
-import { AXES, CLEAR_HOLD_MS, GAINS, loadMapping, sample, saveMapping, stepGain, validMapping } from "./gamepad.js";
-import { degrees, drawAttitude } from "./attitude.js";
+import { AXES, CLEAR_HOLD_MS, GAINS, KEY, loadMapping, sample, saveMapping, stepGain, validMapping } from "./gamepad.js";
+import { degrees, drawAttitude, headingDegrees } from "./attitude.js";
 import { DiveList } from "./dives.js";
 import { Commissioning } from "./commissioning.js";
 import { banner, controllerWords, killSourceWords } from "./words.js";
@@ -63,7 +63,7 @@ function connect() {
 function bridgeStatus(level, text, id) {
   if (id && commissioning.answer(id, text)) return;
   commissioning.refused(text); // shown in its panel, and logged below
-  const refused = /^\/command\/(motion|thrust) refused: \S*?([A-Za-z]+)(?::|$)/.exec(text);
+  const refused = /^\/command\/(drive|motion|thrust) refused: \S*?([A-Za-z]+)(?::|$)/.exec(text);
   if (refused) {
     const first = cockpit.refusal === null;
     cockpit.refusal = refused[2];
@@ -215,7 +215,7 @@ function showTeensy(t) {
   cockpit.teensy = t;
   const { yaw, pitch, roll } = t.orientation;
   drawAttitude($("attitude"), yaw, pitch, roll);
-  $("yaw").textContent = degrees(yaw);
+  $("yaw").textContent = headingDegrees(yaw);
   $("pitch").textContent = degrees(pitch);
   $("roll").textContent = degrees(roll);
   $("teensy-online").textContent = t.online ? "online" : "OFFLINE";
@@ -285,7 +285,7 @@ $("confirm-clear").addEventListener("close", () => {
 });
 
 // --- gamepad -------------------------------------------------------------------------------------
-let mapping = loadMapping();
+let { mapping, notice: mappingNotice } = loadMapping();
 let driving = false;       // the deadman was held at the last sample
 let sendTimer = null;
 const gainButtons = new Set(); // gain buttons held at the last sample
@@ -301,9 +301,10 @@ function pad() {
   return pads.find((p) => p && p.connected !== false) ?? null;
 }
 
+// In a pilot's words: the bridge's /command/drive converts them (core/frames, docs/frames.md).
 function sendMotion(motion) {
   const at = performance.now();
-  if (!client?.publish("/command/motion", motion)) return;
+  if (!client?.publish("/command/drive", motion)) return;
   cockpit.sent++;
   // When the command changed (bench/bridge_bench.mjs times a sample to the wire from here).
   if (AXES.some((a) => motion[a] !== cockpit.lastSent?.motion[a])) cockpit.lastChange = { motion, at };
@@ -345,7 +346,7 @@ function tick() {
   for (const button of [mapping.gain_up, mapping.gain_down, mapping.kill, mapping.clear_kill])
     if (press(button)) gainButtons.add(button); else gainButtons.delete(button);
   const s = sample(p, mapping);
-  $("pad-motion").textContent = AXES.map((a) => `${a} ${s.motion[a].toFixed(2)}`).join(" · ");
+  $("pad-motion").textContent = AXES.map((a) => `${AXIS_WORDS[a]} ${s.motion[a].toFixed(2)}`).join(" · ");
   // Not ready (killed, arming, fault, surfacing, link lost): nothing to send, and arming again.
   const ready = fresh() && cockpit.state?.state === "ready" && !(cockpit.state.surfacing_ms >= 0);
   if (!ready) {
@@ -370,13 +371,23 @@ document.addEventListener("visibilitychange", () => {
 window.addEventListener("gamepaddisconnected", () => stopDriving());
 window.addEventListener("pagehide", () => { stopDriving(); commissioning.release(); client?.close(); });
 
+// The mapping's motions as the page labels them.
+const AXIS_WORDS = { forward: "forward", starboard: "starboard", up: "up", turn_right: "turn right", nose_up: "nose up",
+  roll_right: "roll right" };
+
+function showMappingNotice() {
+  $("mapping-notice").textContent = mappingNotice ?? "";
+  $("mapping-notice").hidden = !mappingNotice;
+  if (mappingNotice) $("mapping-details").open = true;
+}
+
 function mappingForm() {
   const form = $("mapping");
   form.innerHTML = "";
   const fields = [...AXES, "deadman", "gain_up", "gain_down", "kill", "clear_kill", "deadzone", "expo"];
   for (const k of fields) {
     const label = document.createElement("label");
-    label.textContent = k;
+    label.textContent = AXIS_WORDS[k] ?? k;
     label.htmlFor = `map-${k}`;
     const input = document.createElement("input");
     input.id = `map-${k}`;
@@ -397,7 +408,7 @@ function mappingForm() {
   const reset = document.createElement("button");
   reset.type = "button";
   reset.textContent = "defaults";
-  reset.addEventListener("click", () => { localStorage.removeItem("caracara.cockpit.mapping"); mapping = loadMapping(); mappingForm(); });
+  reset.addEventListener("click", () => { localStorage.removeItem(KEY); ({ mapping } = loadMapping()); mappingForm(); });
   form.append(reset);
   const gain = $("gain");
   gain.innerHTML = GAINS.map((g) => `<option value="${g}">${g * 100} %</option>`).join("");
@@ -407,6 +418,8 @@ $("gain").addEventListener("change", (e) => setGain(Number(e.target.value)));
 
 // --- start ---------------------------------------------------------------------------------------
 mappingForm();
+showMappingNotice();
+if (mappingNotice) logEvent(3, "cockpit", mappingNotice, Date.now());
 drawAttitude($("attitude"), 0, 0, 0);
 for (let i = 0; i < MOTORS; i++) thrusterRow(i);
 connect();

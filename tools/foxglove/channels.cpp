@@ -1,5 +1,6 @@
 #include "tools/foxglove/channels.hpp"
 
+#include "core/frames.hpp"
 #include "drivers/protocol/seabotix.hpp"
 
 #include <cmath>
@@ -228,21 +229,14 @@ std::string to_json(const LogEvent& m) {
 }
 
 std::string attitude_json(uint64_t time_ns, double yaw, double pitch, double roll) {
-    // The Teensy's angles (yaw +clockwise from above, pitch +nose up, roll +clockwise from
-    // behind) as rotations of a right-handed x-forward, y-left, z-up body: about z by -yaw,
-    // about y by -pitch, about x by +roll (applied z, then y, then x).
-    const double z = -finite(yaw) / 2, y = -finite(pitch) / 2, x = finite(roll) / 2;
-    const double cz = std::cos(z), sz = std::sin(z), cy = std::cos(y), sy = std::sin(y), cx = std::cos(x),
-                 sx = std::sin(x);
+    // REP 103 / 145, as caracara-ros: the FLU body in the ENU world, the heading reference north
+    // (+y); core/frames owns the conversion (docs/frames.md).
+    const frames::Quaternion q = frames::orientation({finite(yaw), finite(pitch), finite(roll)}, frames::WorldFrame::EnuFlu);
     return json{{"timestamp", time_json(time_ns)},
                 {"parent_frame_id", "world"},
                 {"child_frame_id", "caracara"},
                 {"translation", {{"x", 0.0}, {"y", 0.0}, {"z", 0.0}}},
-                {"rotation",
-                 {{"x", sx * cy * cz - cx * sy * sz},
-                  {"y", cx * sy * cz + sx * cy * sz},
-                  {"z", cx * cy * sz - sx * sy * cz},
-                  {"w", cx * cy * cz + sx * sy * sz}}}}
+                {"rotation", {{"x", q.x}, {"y", q.y}, {"z", q.z}, {"w", q.w}}}}
         .dump();
 }
 

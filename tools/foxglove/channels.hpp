@@ -112,7 +112,8 @@ std::string to_json(const Thruster& m);
 std::string to_json(const Teensy& m);
 std::string to_json(const I2cBus& m);
 std::string to_json(const LogEvent& m);
-// foxglove.FrameTransform of the vehicle ("caracara") in "world" from yaw, pitch, roll.
+// foxglove.FrameTransform of the vehicle ("caracara", body FLU) in "world" (ENU, north +y) from the
+// Teensy's yaw (clockwise), pitch (nose up) and roll (right side down), through core/frames.
 std::string attitude_json(uint64_t time_ns, double yaw, double pitch, double roll);
 
 // The SeaBotix fault names of a FAULT byte ("overtemp", "stall", ...).
