@@ -237,6 +237,11 @@ def table(results):
         if name in ("e2e_bridge", "e2e_cockpit"):
             add(by["bridge Debian 12" if name == "e2e_bridge" else "cockpit Debian 12"], t)
             continue
+        if name == "npm_bridge":
+            # The setup test that installs the bridge's and the cockpit's npm packages
+            # (FIXTURES_SETUP, label bridge): the bridge row's; npm_ros is e2e_ros's, in e2e.
+            add(by["bridge Debian 12"], t)
+            continue
         if name in ("system_debs", "system_nspawn"):
             suite = by["system Debian 12"]
         elif "kernel" in ls:
