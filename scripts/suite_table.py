@@ -254,7 +254,8 @@ def table(results):
             suite = by["soak"]
         elif "release" in ls:
             suite = by["release (version)"]
-        elif name == "layers":
+        elif name in ("layers", "bounds_lint"):
+            # The lints on the sources: the layering rules, and the bounds file (tests/bounds_lint.py).
             suite = by["layers"]
         elif name == "readme_suites":
             suite = by["README CI table"]
