@@ -254,7 +254,7 @@ def table(results):
             suite = by["soak"]
         elif "release" in ls:
             suite = by["release (version)"]
-        elif name in ("layers", "bounds_lint"):
+        elif name in ("layers", "bounds_lint", "bounds_lint_test"):
             # The lints on the sources: the layering rules, and the bounds file (tests/bounds_lint.py).
             suite = by["layers"]
         elif name == "readme_suites":

@@ -122,7 +122,7 @@ def python_findings(path):
                 pair(node.args[0], node.args[1], node.lineno)
             elif name in ("assertTrue", "assertFalse") and node.args:
                 compares(node.args[0], node.lineno)
-    return found
+    return sorted(found)
 
 
 JS_ASSERT = re.compile(r"\bassert(?:\.ok)?\(")
