@@ -6,8 +6,9 @@ token on TCP; and the bridge's bounds (issue 35): a Kill and a close while anoth
 a full dive directory, floods from a client that does not read (bounds.test.mjs, on a second
 bridge on TCP), and stalled tokenless connections beside the pilots.
 
-The npm packages are pinned in package-lock.json and installed with `npm ci`, cached under
-/var/cache/caracara-npm. Under CI (CI=true) a missing node, npm or sshd fails the test.
+The npm packages are pinned in package-lock.json and installed with `npm ci` (cached under
+/var/cache/caracara-npm) by CTest's setup test npm_bridge (tests/npm_packages.py) before this
+test starts; the test only checks them. Under CI (CI=true) a missing node, npm or sshd fails it.
 """
 import os
 import shutil
