@@ -30,7 +30,7 @@ sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
 
 import harness  # noqa: E402
 from harness import missing, npm_ci  # noqa: E402
-from bounds import CLIENT_LOSS_ZERO_MS_MAX  # noqa: E402
+from bounds import CLIENT_LOSS_ZERO_MS_MAX, ORIENTATION_TO_JUDGE_MIN_RAD  # noqa: E402
 from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, angle_diff, poll, speed_byte  # noqa: E402
 from test_failsafes import kill_edges, orders  # noqa: E402
 from vehicle_motion import START_HEADING_RAD, judge, place  # noqa: E402
@@ -409,8 +409,8 @@ class RosTestCase(VehicleTestCase):
             samples, _, _, _ = self.listen(2, ORIENTATION_TOPICS, during=lambda: during(pitch=0.5, roll=0.5))
         finally:
             rig.motion()
-        self.assertGreater(min(a[1][1] for a in attitude), 0.15, "not nose up enough to judge")
-        self.assertGreater(min(a[1][2] for a in attitude), 0.15, "not rolled right enough to judge")
+        self.assertGreater(min(a[1][1] for a in attitude), ORIENTATION_TO_JUDGE_MIN_RAD, "not nose up enough to judge")
+        self.assertGreater(min(a[1][2] for a in attitude), ORIENTATION_TO_JUDGE_MIN_RAD, "not rolled right enough to judge")
         self.check_orientation(samples, attitude, convention, world, body)
         # A clockwise turn (the seed's yaw, + clockwise seen from above).
         rig.reset()
