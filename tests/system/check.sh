@@ -601,9 +601,8 @@ check "caracara-ros may not own org.caracara.Vehicle1 (the bus policy)" \
 # The devices' group: the daemon's process has it (the unit's SupplementaryGroups=, under
 # PrivateUsers=), the two network-facing clients do not.
 check "caracarad runs with the devices' group caracara-io" in_groups "$(unit caracarad MainPID)" caracara caracara-io
-check "caracara-bridge and caracara-ros run without caracara-io" \
-  bash -c '! grep -qw "$(getent group caracara-io | cut -d: -f3)" <(sed -n "s/^Groups://p" /proc/$1/status /proc/$2/status)' _ \
-  "$(unit caracara-bridge MainPID)" "$(unit caracara-ros MainPID)"
+clients_without_io() { ! in_groups "$(unit caracara-bridge MainPID)" caracara-io && ! in_groups "$(unit caracara-ros MainPID)" caracara-io; }
+check "caracara-bridge and caracara-ros run without caracara-io" clients_without_io
 # Held to the bridge's bound (EXPOSURE_MAX); the network DDS needs (PrivateNetwork=no, AF_INET,
 # an allow list of private ranges) is 0.9 of it, which the bridge, on a Unix socket, does not pay.
 sec=$(systemd-analyze security --no-pager caracara-ros.service 2>&1)
