@@ -176,7 +176,7 @@ def table(results):
     systemable = ROOT and AMD64
     suites = [Suite("unit", "normal"), Suite("integration", "normal"), Suite("e2e", "normal"),
               Suite("bridge Debian 12", "normal"), Suite("cockpit Debian 12", "normal"),
-              Suite("soak", "normal"), Suite("layers", "normal"), Suite("README CI table", "normal"),
+              Suite("soak", "normal"), Suite("layers", "normal"), Suite("docs from records", "normal"),
               Suite("release (version)", "normal"),
               Suite("system Debian 12", "normal", systemable, need_root),
               Suite("kernel Debian 12", "normal", systemable, need_root),
@@ -257,8 +257,9 @@ def table(results):
         elif name in ("layers", "bounds_lint", "bounds_lint_test"):
             # The lints on the sources: the layering rules, and the bounds file (tests/bounds_lint.py).
             suite = by["layers"]
-        elif name == "readme_suites":
-            suite = by["README CI table"]
+        elif name in ("readme_suites", "doc_figures", "bench_report"):
+            # README's CI table, the quoted figures and the benchmark tables against their records.
+            suite = by["docs from records"]
         else:
             suite = by["unit"]
         add(suite, t)

@@ -74,6 +74,10 @@ sanitize_suite() {
 }
 
 step normal run_suite normal "$top/build"
+# The figures the normal step's tests printed, as the record the docs quote (bench/figures.json;
+# scripts/doc_figures.py --write then rewrites README.md and docs/ from it, CTest doc_figures
+# checks them).
+[ ! -f "$results/normal.xml" ] || /usr/bin/python3 "$top/scripts/doc_figures.py" --record "$results/normal.xml" || failed=1
 step cross cross_suite
 step arm64-packages arm64_packages
 step sanitize sanitize_suite

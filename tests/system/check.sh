@@ -443,7 +443,7 @@ died=$(unit caracarad ExecMainExitTimestampMonotonic)
 last=$(last_zero_us_since "$idx")
 info "SIGKILL (Restart=no): process gone at ${died} us, last zero order at ${last} us"
 ms=$(( (last - died) / 1000 ))
-echo "BOUND: SIGKILL, no restart: $ms ms from the daemon's death to the last zero order"
+figure system.sigkill_no_restart_zero_ms "$ms" ms "SIGKILL, no restart: from the daemon's death to the last zero order"
 check "Restart=no, SIGKILL: the last zero order within ZEROING_STEP_MS_MAX ($ZEROING_STEP_MS_MAX ms) of the death ($ms ms)" \
   within_bound "SIGKILL, no restart" "$ms" "$ZEROING_STEP_MS_MAX"
 stop_ctl
@@ -479,7 +479,7 @@ check "SIGKILL, restart: the zeroing step zeroed all eight thrusters before syst
   step_zeroed_all
 last=$(step_zeros | awk 'BEGIN { m = 0 } $2 > m { m = $2 } END { print m }')
 ms=$(( (last - died) / 1000 ))
-echo "BOUND: SIGKILL, restarted: $ms ms from the daemon's death to the zeroing step's last zero order"
+figure system.sigkill_restart_zero_ms "$ms" ms "SIGKILL, restarted: from the daemon's death to the zeroing step's last zero order"
 check "SIGKILL, restart: the step's last zero order within ZEROING_STEP_MS_MAX ($ZEROING_STEP_MS_MAX ms) of the death ($ms ms)" \
   within_bound "SIGKILL, restarted" "$( [ "$last" -gt 0 ] && echo "$ms")" "$ZEROING_STEP_MS_MAX"
 check "the journal has this SIGKILL's zeroing step's report (after a cursor taken before the kill)" \
@@ -500,7 +500,7 @@ check "SIGSTOP past WatchdogSec=5s: systemd ends and restarts the daemon" wait_u
 check "SIGSTOP: zero orders to all eight thrusters arrive" every_thruster_zeroed_since "$idx"
 last=$(zero_orders_since "$idx" | awk 'NR <= 8 { if ($2 > m) m = $2 } END { printf "%.0f", m / 1000 }')
 ms=$(( (last - t_stop) / 1000 ))
-echo "BOUND: SIGSTOP (watchdog): $ms ms from the SIGSTOP to the zeroing step's last zero order (WatchdogSec=5s)"
+figure system.watchdog_zero_ms "$ms" ms "SIGSTOP (watchdog, WatchdogSec=5s): to the zeroing step's last zero order"
 check "SIGSTOP: the last zero order within WATCHDOG_ZERO_MS_MAX ($WATCHDOG_ZERO_MS_MAX ms) of the SIGSTOP ($ms ms)" \
   within_bound "SIGSTOP (watchdog)" "$ms" "$WATCHDOG_ZERO_MS_MAX"
 check "the journal names this SIGSTOP's watchdog timeout (after a cursor taken before the stop)" \
