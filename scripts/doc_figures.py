@@ -198,10 +198,11 @@ def fuzz_table(rec):
            + ("every harness passed" if not failed else "**failed: " + ", ".join(failed) + "**")
            + f", **{total:,} executions** in all, the smallest {min((r.get('executions', 0) for _, r in rows), default=0):,}:",
            "",
-           "    harness       executions  seconds   cov     ft  corpus files  limit                finished"]
+           "    harness          executions  seconds   cov     ft  corpus files  limit                finished"]
     for h, r in rows:
-        out.append(f"    {h:<12} {r.get('executions', 0):>11,} {r.get('seconds', 0):>8} {r.get('cov', 0):>5,} "
-                   f"{r.get('ft', 0):>6,} {r.get('corpus_files', 0):>13,}  {r.get('limit', ''):<20} "
+        cov, ft = (f"{r[k]:,}" if r.get(k) is not None else "-" for k in ("cov", "ft"))
+        out.append(f"    {h:<15} {r.get('executions', 0):>11,} {r.get('seconds', 0):>8} {cov:>5} "
+                   f"{ft:>6} {r.get('corpus_files', 0):>13,}  {r.get('limit', ''):<20} "
                    f"{str(r.get('finished', ''))[:16]}")
     out.append(FUZZ_END)
     return "\n".join(out)
