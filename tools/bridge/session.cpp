@@ -4,6 +4,7 @@
 #include "tools/bridge/dive_worker.hpp"
 #include "tools/bridge/static_files.hpp"
 
+#include "tools/client/same_secret.hpp"
 #include "tools/foxglove/channels.hpp"
 
 #include <boost/algorithm/string/predicate.hpp>
@@ -49,16 +50,6 @@ std::string token_of(const http::request<http::string_body>& req) {
         return "";
     const auto end = target.find('&', q);
     return std::string(target.substr(q + 6, end == std::string_view::npos ? std::string_view::npos : end - q - 6));
-}
-
-// Compares in a time that does not depend on where the first difference is.
-bool same(const std::string& a, const std::string& b) {
-    if (a.size() != b.size())
-        return false;
-    unsigned char diff = 0;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        diff |= static_cast<unsigned char>(a[i] ^ b[i]);
-    return diff == 0;
 }
 
 bool offers_subprotocol(const http::request<http::string_body>& req) {
@@ -191,7 +182,7 @@ void Session::on_request(boost::system::error_code ec) {
             StaticFiles(config_.cockpit_dir).respond(request_)));
     if (!origin_taken(upgrade))
         return;
-    if (!config_.token.empty() && !same(token_of(request_), config_.token))
+    if (!config_.token.empty() && !client::same_secret(token_of(request_), config_.token))
         return reject(http::status::unauthorized, "caracara-bridge: a valid token is required");
     if (!upgrade) {
         // Listing and converting take their time: on the worker, never on this (the I/O) thread.
