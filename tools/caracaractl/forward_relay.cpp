@@ -23,7 +23,8 @@ namespace {
 constexpr std::size_t kMaxHead = 16 * 1024;        // a request head past this is refused (431)
 constexpr std::size_t kMaxBuffered = 256 * 1024;   // read no further one way while this waits
 constexpr std::size_t kMaxWaitingForHead = 64;     // past this, a new connection closes the oldest
-constexpr std::size_t kMaxConnections = 512;       // past this, a new connection is closed at once
+constexpr std::size_t kMaxConnections = 256;       // past this, a new connection is closed at once (2 fds each)
+constexpr int kRefusalsLoggedPerSecond = 10;       // the rest counted, so a flood cannot bury the terminal
 constexpr auto kHeadTimeout = std::chrono::seconds(5);
 constexpr auto kAnswerTimeout = std::chrono::seconds(5);  // to read a refusal, or to close after the vehicle's end
 
@@ -129,6 +130,15 @@ void ForwardRelay::refuse(Conn& c, const std::string& answer) {
     c.deadline = Clock::now() + kAnswerTimeout;
 }
 
+void ForwardRelay::new_log_window(Clock::time_point now) {
+    if (now - log_window_ < std::chrono::seconds(1))
+        return;
+    if (unlogged_ > 0)
+        std::fprintf(stderr, "caracaractl: %d more connections to localhost:%u refused\n", unlogged_, port_);
+    log_window_ = now;
+    logged_ = unlogged_ = 0;
+}
+
 void ForwardRelay::on_head(Conn& c) {
     const std::string_view head(c.to_upstream.data(), c.to_upstream.find("\r\n\r\n") + 4);
     const ForwardKey::Judgement j = key_.judge(head);
@@ -140,8 +150,12 @@ void ForwardRelay::on_head(Conn& c) {
             const char* why = j.verdict == ForwardKey::Verdict::NoKey    ? "without the key"
                               : j.verdict == ForwardKey::Verdict::WrongKey ? "with a wrong key"
                                                                            : "not an HTTP request";
-            std::fprintf(stderr, "caracaractl: refused a connection to localhost:%u %s%s%s%s; nothing was relayed\n",
-                         port_, why, origin.empty() ? "" : " (from a page of ", origin.c_str(), origin.empty() ? "" : ")");
+            new_log_window(Clock::now());
+            if (++logged_ <= kRefusalsLoggedPerSecond)
+                std::fprintf(stderr, "caracaractl: refused a connection to localhost:%u %s%s%s%s; nothing was relayed\n",
+                             port_, why, origin.empty() ? "" : " (from a page of ", origin.c_str(), origin.empty() ? "" : ")");
+            else
+                ++unlogged_;
         }
         return refuse(c, key_.answer(j));
     }
@@ -219,6 +233,8 @@ void ForwardRelay::run_once(int timeout_ms, bool accepting) {
     std::vector<pollfd> fds;
     std::vector<std::pair<int, int>> at; // each connection's client and upstream entries in fds (-1: none)
     auto now = Clock::now();
+    if (unlogged_ > 0)
+        new_log_window(now);
     if (accepting)
         fds.push_back({listen_fd_, POLLIN, 0});
     for (const Conn& c : conns_) {
@@ -241,10 +257,12 @@ void ForwardRelay::run_once(int timeout_ms, bool accepting) {
             const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(c.deadline - now).count();
             timeout_ms = static_cast<int>(std::clamp<long long>(left + 1, 0, timeout_ms));
         }
+        // A side with nothing to wait for is left out (a negative fd): a socket whose peer has
+        // closed reports POLLHUP whatever is asked, and would wake this loop until the other side ends.
         at.emplace_back(static_cast<int>(fds.size()), c.upstream >= 0 ? static_cast<int>(fds.size()) + 1 : -1);
-        fds.push_back({c.client, cev, 0});
+        fds.push_back({cev ? c.client : -1, cev, 0});
         if (c.upstream >= 0)
-            fds.push_back({c.upstream, uev, 0});
+            fds.push_back({uev ? c.upstream : -1, uev, 0});
     }
     if (::poll(fds.data(), fds.size(), timeout_ms) < 0 && errno != EINTR)
         return;

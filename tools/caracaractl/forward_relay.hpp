@@ -44,12 +44,16 @@ private:
     // False when the connection is done (closed).
     bool step(Conn& c, short client_events, short upstream_events);
     static void close_conn(Conn& c);
+    // Past a second since the window began: says how many refusals went unlogged, starts another.
+    void new_log_window(Clock::time_point now);
 
     int listen_fd_ = -1;
     uint16_t port_;
     std::string upstream_;
     ForwardKey key_;
     std::list<Conn> conns_;
+    Clock::time_point log_window_{}; // refusals logged in the second from here
+    int logged_ = 0, unlogged_ = 0;
 };
 
 } // namespace caracara::ctl
