@@ -3,6 +3,7 @@
 #include "tools/client/client.hpp"
 #include "tools/client/same_secret.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <optional>
@@ -50,6 +51,15 @@ std::optional<std::string_view> value_of(std::string_view list, char sep, std::s
     return found;
 }
 
+bool is_control(char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }
+
+// The client's bytes as a log shows them: a control byte as '?', so that a header cannot forge a line.
+std::string printable(std::string_view s) {
+    std::string out(s);
+    std::replace_if(out.begin(), out.end(), is_control, '?');
+    return out;
+}
+
 std::string response(const char* status, const std::string& headers, const std::string& body) {
     return std::string("HTTP/1.1 ") + status + "\r\nServer: caracaractl\r\nCache-Control: no-store\r\n" + headers +
            "Content-Type: text/plain; charset=utf-8\r\nContent-Length: " + std::to_string(body.size()) +
@@ -78,7 +88,9 @@ ForwardKey::Judgement ForwardKey::judge(std::string_view head) const {
         !line.substr(sp2 + 1).starts_with("HTTP/1."))
         return j;
     const std::string_view target = line.substr(sp1 + 1, sp2 - sp1 - 1);
-    if (!target.starts_with('/'))
+    // No control byte in the request line: the target goes back out in a redirect's Location,
+    // where a line break would add headers of the client's choosing (fuzz_bridge_http found it).
+    if (!target.starts_with('/') || std::any_of(line.begin(), line.end(), is_control))
         return j;
     bool upgrade = false;
     std::optional<std::string_view> cookie;
@@ -92,7 +104,7 @@ ForwardKey::Judgement ForwardKey::judge(std::string_view head) const {
         else if (iequals(name, "cookie"))
             cookie = cookie ? cookie : value_of(value, ';', cookie_name());
         else if (iequals(name, "origin"))
-            j.origin = std::string(value.substr(0, 200));
+            j.origin = printable(value.substr(0, 200));
     });
     const auto q = target.find('?');
     const std::string_view path = target.substr(0, q), query = q == std::string_view::npos ? "" : target.substr(q + 1);
