@@ -1,5 +1,8 @@
 #include "tools/ros/dds_participant.hpp"
 
+#include "tools/ros/enclave.hpp"
+
+#include <cstdio>
 #include <stdexcept>
 
 namespace caracara::ros {
@@ -21,12 +24,37 @@ DdsParticipant::DdsParticipant(const RosConfig& c) {
             throw std::runtime_error(error(("DDS domain on interface " + c.interface).c_str(), domain_));
     }
     dds_qos_t* q = dds_create_qos();
-    static const char kEnclave[] = "enclave=/;";
-    dds_qset_userdata(q, kEnclave, sizeof kEnclave - 1);
+    std::string enclave = "/";
+    try {
+        if (!c.security.empty()) {
+            const std::string module = AuditWatch::module_path();
+            const Enclave e(c.security, c.security_plugins, module);
+            audit_ = std::make_unique<AuditWatch>(module, c.security_plugins);
+            if (!e.exposed().empty())
+                std::fprintf(stderr, "caracara-ros: warning: %s is readable by every user of this machine (chmod 600 "
+                                     "it, owned by caracara-ros)\n", e.exposed().front().c_str());
+            e.apply(q);
+            enclave = e.name();
+        }
+    } catch (...) {
+        dds_delete_qos(q);
+        if (domain_ > 0)
+            dds_delete(domain_);
+        throw;
+    }
+    // The enclave as rmw_cyclonedds announces it (`ros2 node info` groups by it).
+    const std::string user_data = "enclave=" + enclave + ";";
+    dds_qset_userdata(q, user_data.data(), user_data.size());
     participant_ = dds_create_participant(domain, q, nullptr);
     dds_delete_qos(q);
-    if (participant_ < 0)
-        throw std::runtime_error(error("DDS participant", participant_));
+    if (participant_ < 0) {
+        if (domain_ > 0)
+            dds_delete(domain_);
+        // Cyclone has logged why (a certificate, a signature, a permission) just before.
+        throw std::runtime_error(error(c.security.empty() ? "DDS participant"
+                                                          : ("DDS participant with the enclave " + c.security).c_str(),
+                                       participant_));
+    }
     try {
         discovery_info_ = std::make_unique<DiscoveryInfo>(participant_, c);
     } catch (...) {
@@ -41,6 +69,11 @@ DdsParticipant::~DdsParticipant() {
     dds_delete(participant_);
     if (domain_ > 0)
         dds_delete(domain_);
+}
+
+void DdsParticipant::watch(sd_event* event) {
+    if (audit_)
+        audit_->start(event, participant_);
 }
 
 dds_entity_t DdsParticipant::topic(const dds_topic_descriptor_t* desc, const std::string& ros_name) {
