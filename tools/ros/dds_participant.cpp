@@ -15,6 +15,16 @@ std::string error(const char* what, dds_return_t r) { return std::string(what) +
 
 DdsParticipant::DdsParticipant(const RosConfig& c) {
     dds_domainid_t domain = c.domain_id;
+    // The enclave first: a missing file is named before any DDS.
+    std::unique_ptr<Enclave> enclave;
+    if (!c.security.empty()) {
+        const std::string module = AuditWatch::module_path();
+        enclave = std::make_unique<Enclave>(c.security, c.security_plugins, module);
+        audit_ = std::make_unique<AuditWatch>(module, c.security_plugins);
+        if (!enclave->exposed().empty())
+            std::fprintf(stderr, "caracara-ros: warning: %s is readable by every user of this machine (chmod 600 "
+                                 "it, owned by caracara-ros)\n", enclave->exposed().front().c_str());
+    }
     if (!c.interface.empty()) {
         // The one interface it may use, multicast on it (SPDP) even on a loopback interface.
         const std::string xml = "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"" +
@@ -24,26 +34,10 @@ DdsParticipant::DdsParticipant(const RosConfig& c) {
             throw std::runtime_error(error(("DDS domain on interface " + c.interface).c_str(), domain_));
     }
     dds_qos_t* q = dds_create_qos();
-    std::string enclave = "/";
-    try {
-        if (!c.security.empty()) {
-            const std::string module = AuditWatch::module_path();
-            const Enclave e(c.security, c.security_plugins, module);
-            audit_ = std::make_unique<AuditWatch>(module, c.security_plugins);
-            if (!e.exposed().empty())
-                std::fprintf(stderr, "caracara-ros: warning: %s is readable by every user of this machine (chmod 600 "
-                                     "it, owned by caracara-ros)\n", e.exposed().front().c_str());
-            e.apply(q);
-            enclave = e.name();
-        }
-    } catch (...) {
-        dds_delete_qos(q);
-        if (domain_ > 0)
-            dds_delete(domain_);
-        throw;
-    }
+    if (enclave)
+        enclave->apply(q);
     // The enclave as rmw_cyclonedds announces it (`ros2 node info` groups by it).
-    const std::string user_data = "enclave=" + enclave + ";";
+    const std::string user_data = "enclave=" + (enclave ? enclave->name() : std::string("/")) + ";";
     dds_qset_userdata(q, user_data.data(), user_data.size());
     participant_ = dds_create_participant(domain, q, nullptr);
     dds_delete_qos(q);
