@@ -64,22 +64,33 @@ def build_peer(distro):
     npm_ci(HERE)
     idl = subprocess.run(["node", "msg_to_idl.mjs", distro] + TYPES, cwd=HERE, check=True, capture_output=True,
                          text=True).stdout
-    with open(os.path.join(HERE, "peer.cpp")) as f:
-        src = f.read()
-    key = hashlib.sha256((idl + src + str(fastdds3)).encode()).hexdigest()[:16]
-    out = os.path.join(BUILD_DIR, "tests", "ros", "peer-%s-%s" % (distro, key))
-    exe = os.path.join(out, "peer")
+
+    def make(out, exe):
+        with open(os.path.join(out, "ros_h.idl"), "w") as f:
+            f.write(idl)
+        # fastddsgen 4 would add XTypes type objects: the peer matches by type name, as ROS 2 does.
+        subprocess.run(["fastddsgen", "-replace"] + (["-no-typeobjectsupport"] if fastdds3 else []) +
+                       ["-d", out, os.path.join(out, "ros_h.idl")], check=True, stdout=subprocess.DEVNULL)
+        generated = sorted(os.path.join(out, n) for n in os.listdir(out) if n.endswith(".cxx"))
+        subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, os.path.join(HERE, "peer.cpp")] + generated +
+                       ["-lfastdds" if fastdds3 else "-lfastrtps", "-lfastcdr", "-o", exe], check=True)
+    return built_once("peer-" + distro, "peer", idl + str(fastdds3), ["peer.cpp"], make)
+
+
+def built_once(name, program, inputs, sources, make):
+    """The test program `program` built into the build tree once per source: make(out, exe)
+    builds it in the directory `out` (NAME-key), keyed by `inputs` and the text of `sources`
+    (files of tests/ros)."""
+    text = inputs
+    for source in sources:
+        with open(os.path.join(HERE, source)) as f:
+            text += f.read()
+    out = os.path.join(BUILD_DIR, "tests", "ros", "%s-%s" % (name, hashlib.sha256(text.encode()).hexdigest()[:16]))
+    exe = os.path.join(out, program)
     if os.path.exists(exe):
         return exe
     os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, "ros_h.idl"), "w") as f:
-        f.write(idl)
-    # fastddsgen 4 would add XTypes type objects: the peer matches by type name, as ROS 2 does.
-    subprocess.run(["fastddsgen", "-replace"] + (["-no-typeobjectsupport"] if fastdds3 else []) +
-                   ["-d", out, os.path.join(out, "ros_h.idl")], check=True, stdout=subprocess.DEVNULL)
-    generated = sorted(os.path.join(out, n) for n in os.listdir(out) if n.endswith(".cxx"))
-    subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, os.path.join(HERE, "peer.cpp")] + generated +
-                   ["-lfastdds" if fastdds3 else "-lfastrtps", "-lfastcdr", "-o", exe + ".tmp"], check=True)
+    make(out, exe + ".tmp")
     os.rename(exe + ".tmp", exe)
     return exe
 
@@ -104,28 +115,19 @@ def build_secure_peer():
     npm_ci(HERE)
     idl = subprocess.run(["node", "msg_to_idl.mjs", "humble", "geometry_msgs/Wrench", "std_msgs/Empty"], cwd=HERE,
                          check=True, capture_output=True, text=True).stdout
-    srcs = [os.path.join(HERE, n) for n in ("secure_peer.cpp", "permissive_ac.c")]
-    text = ""
-    for name in srcs:
-        with open(name) as f:
-            text += f.read()
-    key = hashlib.sha256((idl + text + plugins).encode()).hexdigest()[:16]
-    out = os.path.join(BUILD_DIR, "tests", "ros", "secure-peer-" + key)
-    exe = os.path.join(out, "secure_peer")
-    if os.path.exists(exe):
-        return exe
-    os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, "sp.idl"), "w") as f:
-        f.write(idl)
-    subprocess.run(["idlc", "sp.idl"], cwd=out, check=True)
-    subprocess.run(["gcc", "-c", "-O1", "sp.c", "-o", "sp.o"], cwd=out, check=True)
-    permissive = os.path.join(out, "libpermissive_ac.so")
-    subprocess.run(["gcc", "-shared", "-fPIC", "-O1", '-DPLUGINS="%s"' % plugins, srcs[1], "-ldl", "-o", permissive],
-                   check=True)
-    subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, '-DPLUGINS="%s"' % plugins, '-DPERMISSIVE="%s"' % permissive,
-                    srcs[0], os.path.join(out, "sp.o"), "-lddsc", "-o", exe + ".tmp"], check=True)
-    os.rename(exe + ".tmp", exe)
-    return exe
+
+    def make(out, exe):
+        with open(os.path.join(out, "sp.idl"), "w") as f:
+            f.write(idl)
+        subprocess.run(["idlc", "sp.idl"], cwd=out, check=True)
+        subprocess.run(["gcc", "-c", "-O1", "sp.c", "-o", "sp.o"], cwd=out, check=True)
+        permissive = os.path.join(out, "libpermissive_ac.so")
+        subprocess.run(["gcc", "-shared", "-fPIC", "-O1", '-DPLUGINS="%s"' % plugins,
+                        os.path.join(HERE, "permissive_ac.c"), "-ldl", "-o", permissive], check=True)
+        subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, '-DPLUGINS="%s"' % plugins,
+                        '-DPERMISSIVE="%s"' % permissive, os.path.join(HERE, "secure_peer.cpp"),
+                        os.path.join(out, "sp.o"), "-lddsc", "-o", exe], check=True)
+    return built_once("secure-peer", "secure_peer", idl + plugins, ["secure_peer.cpp", "permissive_ac.c"], make)
 
 
 def doc_blocks():
@@ -924,6 +926,30 @@ class ConfigTest(unittest.TestCase):
                 code, err = self.run_ros(d, '[ros]\ncommands = true\n[network]\ninterface = "lo"\n')
                 self.assertIsNone(code, err)
                 self.assertNotIn("warning", err)
+
+    def test_open_governance_refused(self):
+        """A keystore whose governance admits unauthenticated participants, or does not control who
+        writes, leaves the command topics open: caracara-ros refuses to start with it, naming the
+        topic and the rule, though every file is signed as it should be."""
+        network_is_private()
+        blocks = doc_blocks()
+        for rule, bad, why in (("allow_unauthenticated_participants", "true", "it admits unauthenticated participants"),
+                               ("enable_write_access_control", "false", "it does not control who writes on it")):
+            with self.subTest(rule=rule), tempfile.TemporaryDirectory() as d:
+                ks = os.path.join(d, "keystore")
+                make_keystore(ks, {"/caracara/ros": blocks["vehicle"]})
+                gov = os.path.join(ks, "enclaves", "governance.xml")
+                with open(gov) as f:
+                    text = f.read()
+                with open(gov, "w") as f:
+                    f.write(re.sub(r"<%s>\w+</%s>" % (rule, rule), "<%s>%s</%s>" % (rule, bad, rule), text))
+                # Signed again by the permissions CA, as the keystore's owner would.
+                subprocess.run(["openssl", "smime", "-sign", "-text", "-in", gov, "-out", gov[:-4] + ".p7s", "-signer",
+                                os.path.join(ks, "public", "permissions_ca.cert.pem"), "-inkey",
+                                os.path.join(ks, "private", "permissions_ca.key.pem")], check=True, capture_output=True)
+                code, err = self.run_ros(d, '[ros]\nsecurity = "%s"\n' % os.path.join(ks, "enclaves", "caracara", "ros"))
+                self.assertEqual(code, 1, err)
+                self.assertIn("ros.security: the enclave's governance leaves rt/caracara/kill open: " + why, err)
 
     def test_bad_security_settings_refused_by_name(self):
         """A relative enclave path is refused by name; an enclave with a file missing stops it at

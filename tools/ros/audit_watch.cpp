@@ -52,7 +52,8 @@ AuditWatch::AuditWatch(const std::string& module, const std::string& plugins) {
     auto configure = reinterpret_cast<void (*)(const char*, void (*)(const char*))>(dlsym(lib_, "caracara_audit_configure"));
     overdue_ = reinterpret_cast<decltype(overdue_)>(dlsym(lib_, "caracara_audit_overdue"));
     known_ = reinterpret_cast<decltype(known_)>(dlsym(lib_, "caracara_audit_known"));
-    if (!configure || !overdue_ || !known_) {
+    open_ = reinterpret_cast<decltype(open_)>(dlsym(lib_, "caracara_audit_open"));
+    if (!configure || !overdue_ || !known_ || !open_) {
         dlclose(lib_);
         throw std::runtime_error("the DDS Security audit module " + module + " is not caracara-ros's");
     }
@@ -62,6 +63,15 @@ AuditWatch::AuditWatch(const std::string& module, const std::string& plugins) {
 AuditWatch::~AuditWatch() {
     timer_.reset();
     // The module stays loaded: Cyclone's participant, gone by now, held it too.
+}
+
+void AuditWatch::require_protected(const std::string& topic) const {
+    static const char* const kWhy[] = {"", "it admits unauthenticated participants (allow_unauthenticated_participants)",
+                                       "it does not control who writes on it (enable_write_access_control)",
+                                       "no reader was made on it under DDS Security"};
+    if (const int why = open_(topic.c_str()); why != 0)
+        throw std::runtime_error("ros.security: the enclave's governance leaves " + topic + " open: " +
+                                 kWhy[why < 4 ? why : 3] + "; a command topic takes only permitted writers");
 }
 
 void AuditWatch::start(sd_event* event, dds_entity_t participant) {

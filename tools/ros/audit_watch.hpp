@@ -27,6 +27,11 @@ public:
     // Watches the participant's peers on `event`, from now on.
     void start(sd_event* event, dds_entity_t participant);
 
+    // Throws std::runtime_error when the governance lets a writer the permissions do not allow
+    // reach our reader on `topic` (a DDS topic name): unauthenticated participants admitted, or
+    // no write access control on it. A command topic must be closed to them.
+    void require_protected(const std::string& topic) const;
+
     // The module found for this executable: next to it (a build tree), else where it is installed.
     static std::string module_path();
 
@@ -37,6 +42,7 @@ private:
     void* lib_ = nullptr;
     void (*overdue_)(double, void (*)(const char*)) = nullptr;
     bool (*known_)(const char*) = nullptr;
+    int (*open_)(const char*) = nullptr;
     dds_entity_t participants_ = 0;
     std::string own_;
     caracara::SourcePtr timer_;

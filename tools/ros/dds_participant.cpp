@@ -65,6 +65,11 @@ DdsParticipant::~DdsParticipant() {
         dds_delete(domain_);
 }
 
+void DdsParticipant::require_protected(const std::string& ros_name) const {
+    if (audit_)
+        audit_->require_protected("rt" + ros_name);
+}
+
 void DdsParticipant::watch(sd_event* event) {
     if (audit_)
         audit_->start(event, participant_);

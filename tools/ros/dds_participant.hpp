@@ -24,6 +24,9 @@ public:
     DdsParticipant& operator=(const DdsParticipant&) = delete;
 
     dds_entity_t handle() const { return participant_; }
+    // With DDS Security: throws std::runtime_error unless only writers whose permissions allow
+    // it reach the reader on ROS topic `ros_name` (audit_watch.hpp). Without: nothing.
+    void require_protected(const std::string& ros_name) const;
     // With DDS Security: logs the peers it refuses, from now on, on `event`.
     void watch(sd_event* event);
     // A writer of `desc` on ROS topic `ros_name` ("/caracara/imu" -> "rt/caracara/imu").

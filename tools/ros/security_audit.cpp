@@ -39,6 +39,12 @@ DDS_Security_authentication_process_handshake real_process_handshake;
 DDS_Security_access_control_validate_remote_permissions real_validate_remote_permissions;
 DDS_Security_access_control_check_remote_datawriter real_check_remote_datawriter;
 DDS_Security_access_control_check_remote_participant real_check_remote_participant;
+DDS_Security_access_control_get_participant_sec_attributes real_get_participant_sec_attributes;
+DDS_Security_access_control_get_datareader_sec_attributes real_get_datareader_sec_attributes;
+
+// What the governance makes of this participant and of its readers, for caracara_audit_open().
+bool unauthenticated_allowed = false;
+std::map<std::string, bool> reader_write_protected; // by topic
 
 struct Real {
     void* lib = nullptr;
@@ -196,16 +202,55 @@ DDS_Security_boolean check_remote_datawriter(dds_security_access_control* instan
     return ok;
 }
 
-bool load(Real& real, const char* file, const char* init, const char* finalize) {
+DDS_Security_boolean get_participant_sec_attributes(dds_security_access_control* instance,
+                                                    const DDS_Security_PermissionsHandle permissions_handle,
+                                                    DDS_Security_ParticipantSecurityAttributes* attributes,
+                                                    DDS_Security_SecurityException* ex) {
+    const bool ok = real_get_participant_sec_attributes(instance, permissions_handle, attributes, ex);
+    if (ok) {
+        std::lock_guard l(mutex);
+        unauthenticated_allowed = attributes->allow_unauthenticated_participants;
+    }
+    return ok;
+}
+
+DDS_Security_boolean get_datareader_sec_attributes(dds_security_access_control* instance,
+                                                   const DDS_Security_PermissionsHandle permissions_handle,
+                                                   const DDS_Security_char* topic_name,
+                                                   const DDS_Security_PartitionQosPolicy* partition,
+                                                   const DDS_Security_DataTagQosPolicy* data_tag,
+                                                   DDS_Security_EndpointSecurityAttributes* attributes,
+                                                   DDS_Security_SecurityException* ex) {
+    const bool ok =
+        real_get_datareader_sec_attributes(instance, permissions_handle, topic_name, partition, data_tag, attributes, ex);
+    if (ok && topic_name) {
+        std::lock_guard l(mutex);
+        reader_write_protected[topic_name] = attributes->is_write_protected;
+    }
+    return ok;
+}
+
+// The plugin's entry `slot` kept as `real`, `ours` called in its place.
+template <typename F>
+void wrap(F& slot, F& real, F ours) {
+    real = slot;
+    slot = ours;
+}
+
+// Loads the real plugin `file` and runs its `init`: the table it makes is in *context.
+int init_real(Real& real, const char* file, const char* init, const char* finalize, const char* argument,
+              void** context, struct ddsi_domaingv* gv) {
     const std::string path = plugins + "/" + file;
     real.lib = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!real.lib) {
         say(std::string("cannot load ") + path + ": " + dlerror());
-        return false;
+        return -1;
     }
     real.init = reinterpret_cast<decltype(real.init)>(dlsym(real.lib, init));
     real.finalize = reinterpret_cast<decltype(real.finalize)>(dlsym(real.lib, finalize));
-    return real.init && real.finalize;
+    if (!real.init || !real.finalize)
+        return -1;
+    return real.init(argument, context, gv);
 }
 
 } // namespace
@@ -238,6 +283,20 @@ __attribute__((visibility("default"))) void caracara_audit_overdue(double second
     }
 }
 
+// Why a reader of ours on `topic` (a DDS topic name) would take samples from a writer its
+// permissions do not allow: 0 none (authenticated writers only, their permissions checked), 1
+// the governance admits unauthenticated participants, 2 it does not control who writes on the
+// topic, 3 no such reader was made under security.
+__attribute__((visibility("default"))) int caracara_audit_open(const char* topic) {
+    std::lock_guard l(mutex);
+    const auto it = reader_write_protected.find(topic);
+    if (it == reader_write_protected.end())
+        return 3;
+    if (unauthenticated_allowed)
+        return 1;
+    return it->second ? 0 : 2;
+}
+
 // Whether a remote participant (its 12-byte GUID prefix, hex) has begun authenticating.
 __attribute__((visibility("default"))) bool caracara_audit_known(const char* guid) {
     std::lock_guard l(mutex);
@@ -249,20 +308,15 @@ __attribute__((visibility("default"))) bool caracara_audit_known(const char* gui
 
 __attribute__((visibility("default"))) int caracara_init_authentication(const char* argument, void** context,
                                                                          struct ddsi_domaingv* gv) {
-    if (!load(auth, "libdds_security_auth.so", "init_authentication", "finalize_authentication"))
-        return -1;
-    const int r = auth.init(argument, context, gv);
-    if (r != 0)
+    if (const int r = init_real(auth, "libdds_security_auth.so", "init_authentication", "finalize_authentication",
+                                argument, context, gv);
+        r != 0)
         return r;
     auto* a = static_cast<dds_security_authentication*>(*context);
-    real_validate_remote_identity = a->validate_remote_identity;
-    real_begin_handshake_request = a->begin_handshake_request;
-    real_begin_handshake_reply = a->begin_handshake_reply;
-    real_process_handshake = a->process_handshake;
-    a->validate_remote_identity = validate_remote_identity;
-    a->begin_handshake_request = begin_handshake_request;
-    a->begin_handshake_reply = begin_handshake_reply;
-    a->process_handshake = process_handshake;
+    wrap(a->validate_remote_identity, real_validate_remote_identity, validate_remote_identity);
+    wrap(a->begin_handshake_request, real_begin_handshake_request, begin_handshake_request);
+    wrap(a->begin_handshake_reply, real_begin_handshake_reply, begin_handshake_reply);
+    wrap(a->process_handshake, real_process_handshake, process_handshake);
     return 0;
 }
 
@@ -272,18 +326,16 @@ __attribute__((visibility("default"))) int caracara_finalize_authentication(void
 
 __attribute__((visibility("default"))) int caracara_init_access_control(const char* argument, void** context,
                                                                          struct ddsi_domaingv* gv) {
-    if (!load(access_control, "libdds_security_ac.so", "init_access_control", "finalize_access_control"))
-        return -1;
-    const int r = access_control.init(argument, context, gv);
-    if (r != 0)
+    if (const int r = init_real(access_control, "libdds_security_ac.so", "init_access_control",
+                                "finalize_access_control", argument, context, gv);
+        r != 0)
         return r;
     auto* a = static_cast<dds_security_access_control*>(*context);
-    real_validate_remote_permissions = a->validate_remote_permissions;
-    real_check_remote_participant = a->check_remote_participant;
-    real_check_remote_datawriter = a->check_remote_datawriter;
-    a->validate_remote_permissions = validate_remote_permissions;
-    a->check_remote_participant = check_remote_participant;
-    a->check_remote_datawriter = check_remote_datawriter;
+    wrap(a->validate_remote_permissions, real_validate_remote_permissions, validate_remote_permissions);
+    wrap(a->check_remote_participant, real_check_remote_participant, check_remote_participant);
+    wrap(a->check_remote_datawriter, real_check_remote_datawriter, check_remote_datawriter);
+    wrap(a->get_participant_sec_attributes, real_get_participant_sec_attributes, get_participant_sec_attributes);
+    wrap(a->get_datareader_sec_attributes, real_get_datareader_sec_attributes, get_datareader_sec_attributes);
     return 0;
 }
 
