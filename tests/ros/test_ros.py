@@ -16,6 +16,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -63,24 +64,88 @@ def build_peer(distro):
     npm_ci(HERE)
     idl = subprocess.run(["node", "msg_to_idl.mjs", distro] + TYPES, cwd=HERE, check=True, capture_output=True,
                          text=True).stdout
-    with open(os.path.join(HERE, "peer.cpp")) as f:
-        src = f.read()
-    key = hashlib.sha256((idl + src + str(fastdds3)).encode()).hexdigest()[:16]
-    out = os.path.join(BUILD_DIR, "tests", "ros", "peer-%s-%s" % (distro, key))
-    exe = os.path.join(out, "peer")
+
+    def make(out, exe):
+        with open(os.path.join(out, "ros_h.idl"), "w") as f:
+            f.write(idl)
+        # fastddsgen 4 would add XTypes type objects: the peer matches by type name, as ROS 2 does.
+        subprocess.run(["fastddsgen", "-replace"] + (["-no-typeobjectsupport"] if fastdds3 else []) +
+                       ["-d", out, os.path.join(out, "ros_h.idl")], check=True, stdout=subprocess.DEVNULL)
+        generated = sorted(os.path.join(out, n) for n in os.listdir(out) if n.endswith(".cxx"))
+        subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, os.path.join(HERE, "peer.cpp")] + generated +
+                       ["-lfastdds" if fastdds3 else "-lfastrtps", "-lfastcdr", "-o", exe], check=True)
+    return built_once("peer-" + distro, "peer", idl + str(fastdds3), ["peer.cpp"], make)
+
+
+def built_once(name, program, inputs, sources, make):
+    """The test program `program` built into the build tree once per source: make(out, exe)
+    builds it in the directory `out` (NAME-key), keyed by `inputs` and the text of `sources`
+    (files of tests/ros)."""
+    text = inputs
+    for source in sources:
+        with open(os.path.join(HERE, source)) as f:
+            text += f.read()
+    out = os.path.join(BUILD_DIR, "tests", "ros", "%s-%s" % (name, hashlib.sha256(text.encode()).hexdigest()[:16]))
+    exe = os.path.join(out, program)
     if os.path.exists(exe):
         return exe
     os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, "ros_h.idl"), "w") as f:
-        f.write(idl)
-    # fastddsgen 4 would add XTypes type objects: the peer matches by type name, as ROS 2 does.
-    subprocess.run(["fastddsgen", "-replace"] + (["-no-typeobjectsupport"] if fastdds3 else []) +
-                   ["-d", out, os.path.join(out, "ros_h.idl")], check=True, stdout=subprocess.DEVNULL)
-    generated = sorted(os.path.join(out, n) for n in os.listdir(out) if n.endswith(".cxx"))
-    subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, os.path.join(HERE, "peer.cpp")] + generated +
-                   ["-lfastdds" if fastdds3 else "-lfastrtps", "-lfastcdr", "-o", exe + ".tmp"], check=True)
+    make(out, exe + ".tmp")
     os.rename(exe + ".tmp", exe)
     return exe
+
+
+def security_plugins():
+    """Where Debian puts Cyclone DDS's security plugins (libddsc0debian, Debian 12 and 13 alike)."""
+    arch = subprocess.run(["gcc", "-print-multiarch"], capture_output=True, text=True).stdout.strip()
+    plugins = "/usr/lib/%s/libddsc0debian" % arch  # this machine's, not a cross build's (:arm64)
+    if not os.path.exists(os.path.join(plugins, "libdds_security_auth.so")):
+        missing("Cyclone DDS's security plugins are needed (libddsc0debian: %s/libdds_security_auth.so)" % plugins)
+    return plugins
+
+
+def build_secure_peer():
+    """The DDS Security peer (secure_peer.cpp): Cyclone DDS with the real security plugins, its
+    types made by idlc from the ROS 2 definitions as published; with permissive_ac.c, the access
+    control of a rogue stack that writes whatever its permissions say. Built once per source."""
+    for tool in ("idlc", "gcc", "g++", "node"):
+        if not shutil.which(tool):
+            missing(tool + " is needed (scripts/deps.sh: cyclonedds-tools, cyclonedds-dev, nodejs)")
+    plugins = security_plugins()
+    npm_ci(HERE)
+    idl = subprocess.run(["node", "msg_to_idl.mjs", "humble", "geometry_msgs/Wrench", "std_msgs/Empty"], cwd=HERE,
+                         check=True, capture_output=True, text=True).stdout
+
+    def make(out, exe):
+        with open(os.path.join(out, "sp.idl"), "w") as f:
+            f.write(idl)
+        subprocess.run(["idlc", "sp.idl"], cwd=out, check=True)
+        subprocess.run(["gcc", "-c", "-O1", "sp.c", "-o", "sp.o"], cwd=out, check=True)
+        permissive = os.path.join(out, "libpermissive_ac.so")
+        subprocess.run(["gcc", "-shared", "-fPIC", "-O1", '-DPLUGINS="%s"' % plugins,
+                        os.path.join(HERE, "permissive_ac.c"), "-ldl", "-o", permissive], check=True)
+        subprocess.run(["g++", "-std=c++17", "-O1", "-I" + out, '-DPLUGINS="%s"' % plugins,
+                        '-DPERMISSIVE="%s"' % permissive, os.path.join(HERE, "secure_peer.cpp"),
+                        os.path.join(out, "sp.o"), "-lddsc", "-o", exe], check=True)
+    return built_once("secure-peer", "secure_peer", idl + plugins, ["secure_peer.cpp", "permissive_ac.c"], make)
+
+
+def doc_blocks():
+    """docs/ros2.md's blocks marked <!-- test_ros: NAME -->: the keystore as users make it."""
+    with open(os.path.join(SOURCE, "docs", "ros2.md")) as f:
+        return dict(re.findall(r"<!-- test_ros: (\w+) -->\n```\w+\n(.*?)```", f.read(), re.S))
+
+
+def make_keystore(path, enclaves):
+    """A keystore made with openssl alone, by docs/ros2.md's own commands: its CA, governance and
+    one enclave per name, each with the <publish>/<subscribe> rules given."""
+    blocks = doc_blocks()
+    env = dict(os.environ, KEYSTORE=path)
+    subprocess.run(["bash", "-e", "-c", blocks["keystore"]], env=env, check=True, capture_output=True)
+    for name, allow in enclaves.items():
+        subprocess.run(["bash", "-e", "-c", blocks["enclave"]], env=dict(env, ENCLAVE=name, ALLOW=allow), check=True,
+                       capture_output=True)
+    return blocks
 
 
 class Codec:
@@ -436,6 +501,141 @@ class RosTestCase(VehicleTestCase):
                 self.assertGreater(min(steps), -0.02, "yaw went the other way during the turn: %s" % steps)
 
 
+class SecurePeer:
+    """The DDS Security peer running (secure_peer.cpp) until the block ends (then SIGKILLed, if
+    still running): WHO is an enclave directory, "rogue:" one, or "none". Its output: text(), and
+    lines() as JSON, during the block and after it."""
+
+    def __init__(self, exe, who, mode, *args):
+        self.out = tempfile.TemporaryFile("w+")
+        self.final = None
+        self.p = subprocess.Popen([exe, who, mode] + [str(a) for a in args], stdout=self.out,
+                                  stderr=subprocess.STDOUT, text=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        if self.p.poll() is None:
+            self.p.send_signal(signal.SIGKILL)
+        self.p.wait(10)
+        self.final = self.text()
+        self.out.close()
+
+    def text(self):
+        if self.final is not None:
+            return self.final
+        self.out.seek(0)
+        return self.out.read()
+
+    def lines(self):
+        return [json.loads(line) for line in self.text().splitlines() if line.startswith("{")]
+
+
+# An identity from another CA, refused by caracara-ros's side of the handshake (it replies, and
+# finds the certificate not from its CA) or by the peer's (it gave up: caracara-ros's request
+# goes unanswered). Which side replies follows from the certificates' subjects (Cyclone's
+# adjusted GUIDs): with /caracara/ros's, /intruder's the first way, /pilot's the second.
+OTHER_CA_REFUSED = (r"participant [0-9a-f]{24} refused: (not authenticated within|authentication failed: "
+                    r"Certificate not valid)")
+
+
+class SecurityTest(RosTestCase):
+    """[ros] security = an SROS2 enclave (docs/ros2.md, DDS Security), commands on: two keystores
+    made with openssl alone by the docs' own commands (two CAs), peers with Cyclone DDS's real
+    security plugins. A permitted pilot drives and kills; a valid identity without publish
+    permission (a rogue stack that writes anyway), an identity from the other CA and a peer with
+    no security move nothing, their kills are not taken, and caracara-ros logs each. Judged by the
+    simulator's wire log and caracara-ros's log. CommandsTest.test_cyclone_peer_without_security_drives
+    is the control: the same unsecured peer drives a vehicle without security."""
+    COMMANDS = True
+
+    @classmethod
+    def setUpClass(cls):
+        network_is_private()
+        cls.secure_peer = build_secure_peer()
+        cls.keys = tempfile.mkdtemp(prefix="caracara-keystores-")
+        cls.addClassCleanup(shutil.rmtree, cls.keys, True)
+        blocks = doc_blocks()
+        observer = "<publish><topics><topic>rt/caracara/kill</topic></topics></publish>"
+        make_keystore(os.path.join(cls.keys, "a"), {"/caracara/ros": blocks["vehicle"], "/pilot": blocks["pilot"],
+                                                    "/observer": observer})
+        make_keystore(os.path.join(cls.keys, "b"), {"/pilot": blocks["pilot"], "/intruder": blocks["pilot"]})
+        cls.ROS_CONFIG = 'security = "%s"\n' % os.path.join(cls.keys, "a", "enclaves", "caracara", "ros")
+        super().setUpClass()
+
+    def setUp(self):
+        self.rig.rearm()
+
+    def enclave(self, keystore, name):
+        return os.path.join(self.keys, keystore, "enclaves", name.lstrip("/"))
+
+    def secured(self, who, mode, *args):
+        return SecurePeer(self.secure_peer, who, mode, *args)
+
+    def test_permitted_pilot_drives(self):
+        rig = self.rig
+        self.assertIn("DDS Security on, enclave " + self.enclave("a", "/caracara/ros"), rig.log("caracara-ros"))
+        since = rig.wire_next()
+        with self.secured(self.enclave("a", "/pilot"), "wrench", 0.5, 0, 0, 0, 0, 0, 20):
+            poll(lambda: nonzero_orders(rig.wire_log(since)[1]), 20, message="the permitted pilot's Wrench never moved a "
+                 "thruster:\n" + rig.log("caracara-ros"))
+        rig.wait_sim_zero()
+        log = rig.log("caracara-ros")
+        self.assertRegex(log, r"DDS Security: participant [0-9a-f]{24} authenticated")
+        self.assertIn("commands as a pilot", log)
+
+    def test_refused_peers_move_nothing_and_are_logged(self):
+        rig = self.rig
+        cases = [("valid identity, no publish permission (a rogue stack)", "rogue:" + self.enclave("a", "/observer"),
+                  "on rt/caracara/cmd_wrench refused: its signed permissions do not allow publishing it"),
+                 # The other CA's two identities: caracara-ros's side of the handshake refuses the
+                 # first, the peer's side the second (OTHER_CA_REFUSED).
+                 ("identity from another CA (refused by the vehicle's side)", self.enclave("b", "/intruder"),
+                  "refused: authentication failed: Certificate not valid"),
+                 ("identity from another CA (refused by the peer's side)", self.enclave("b", "/pilot"),
+                  "refused: not authenticated within"),
+                 ("no DDS Security", "none", "refused: it has no DDS Security")]
+        for what, who, line in cases:
+            with self.subTest(what):
+                before = rig.log("caracara-ros")
+                since = rig.wire_next()
+                with self.secured(who, "wrench", 0.5, 0, 0, 0, 0, 0, 20) as p:
+                    poll(lambda: len(re.findall(line, rig.log("caracara-ros"))) > len(re.findall(line, before)), 20,
+                         message="no refusal logged for the peer with %s:\n%s" % (what, rig.log("caracara-ros")))
+                    # It goes on writing meanwhile: nothing of it may move a thruster.
+                    poll(lambda: sum(1 for o in p.lines() if o.get("ok")) >= 40, 10, message="the peer did not write")
+                self.assertEqual(nonzero_orders(rig.wire_log(since)[1]), [], what)
+                self.assertEqual(rig.motor_values(), [0] * MOTORS)
+                after = rig.log("caracara-ros")
+                self.assertEqual(after.count("commands as a pilot"), before.count("commands as a pilot"), what)
+                # The peer made its writer and wrote all along: the refusal was the vehicle's (for
+                # the rogue, its writer refused by the vehicle's access control: the line above).
+                self.assertNotIn("no writer", p.text())
+        self.assertEqual(rig.vget("State"), "ready")
+
+    def test_kill_follows_the_governance(self):
+        """A kill from a peer the governance refuses (another CA, no security) is not taken; one
+        from a valid identity allowed to publish kill (and nothing else) is."""
+        rig = self.rig
+        for what, who, line in (("identity from another CA", self.enclave("b", "/pilot"), OTHER_CA_REFUSED),
+                                ("no DDS Security", "none", "it has no DDS Security")):
+            with self.subTest(what):
+                before = len(re.findall(line, rig.log("caracara-ros")))
+                since = rig.wire_next()
+                with self.secured(who, "kill", 1000, 5):
+                    poll(lambda: len(re.findall(line, rig.log("caracara-ros"))) > before, 20,
+                         message="no refusal logged for the kill of the peer with " + what)
+                    time.sleep(1)  # a few more of its kills
+                self.assertEqual(rig.vget("State"), "ready", what)
+                self.assertEqual(kill_edges(rig.wire_log(since)[1]), [], what)
+        since = rig.wire_next()
+        with self.secured(self.enclave("a", "/observer"), "kill", 1000, 5):
+            rig.wait_state("killed")
+        self.assertIn("kill from DDS", rig.log("caracara-ros"))
+        poll(lambda: kill_edges(rig.wire_log(since)[1]), 5, message="no kill output edge")
+
+
 class BytesTest(unittest.TestCase):
     """Fast CDR (the peer's generated types) and rosmsg2-serialization give the same bytes for a
     fixed sample of every type, for Humble's and Jazzy's definitions."""
@@ -693,6 +893,96 @@ class ConfigTest(unittest.TestCase):
                     self.assertEqual(r.returncode, 2, r.stderr)
                     self.assertIn(conf + ": " + message, r.stderr)
 
+    def run_ros(self, d, toml, *args):
+        """caracara-ros with the config `toml`: its exit status and stderr; one still running after
+        a few seconds (it started) is stopped with SIGTERM and reported as None."""
+        exe = os.path.join(BUILD_DIR, "tools", "ros", "caracara-ros")
+        conf = os.path.join(d, "ros.toml")
+        with open(conf, "w") as f:
+            f.write(toml)
+        p = subprocess.Popen(harness.EMULATOR + [exe, "--config", conf, "--bus-address", "unix:path=" +
+                             os.path.join(d, "none")] + list(args), stderr=subprocess.PIPE, text=True)
+        try:
+            return p.wait(5), p.communicate()[1]
+        except subprocess.TimeoutExpired:
+            p.terminate()
+            return None, p.communicate(timeout=15)[1]
+
+    def test_commands_without_security_refused_off_loopback(self):
+        """commands = true (or --commands) with no DDS Security on an interface other than loopback
+        is refused at start, naming the interface, before any DDS; insecure_commands = true in so
+        many words lets it run, with a warning; on loopback it runs."""
+        network_is_private()
+        # A tether of the namespace's own (a veth pair, nothing outside it), gone after the test.
+        subprocess.run(["ip", "link", "add", "tether0", "type", "veth", "peer", "name", "tether1"], check=True)
+        self.addCleanup(subprocess.run, ["ip", "link", "del", "tether0"])
+        subprocess.run(["ip", "addr", "add", "10.99.0.1/24", "dev", "tether0"], check=True)
+        for link in ("tether0", "tether1"):
+            subprocess.run(["ip", "link", "set", link, "up", "multicast", "on"], check=True)
+        with tempfile.TemporaryDirectory() as d:
+            for toml, args, iface in (('[ros]\ncommands = true\n[network]\ninterface = "tether0"\n', [], "tether0"),
+                                      ('[ros]\n[network]\ninterface = "tether0"\n', ["--commands"], "tether0"),
+                                      ('[ros]\ncommands = true\n[network]\ninterface = ""\n', [], "(any: none named)")):
+                with self.subTest(toml=toml, args=args):
+                    code, err = self.run_ros(d, toml, *args)
+                    self.assertEqual(code, 2, err)
+                    self.assertIn("commands are refused without DDS Security on interface %s: set ros.security" % iface,
+                                  err)
+                    self.assertNotIn("domain 0", err)
+            with self.subTest("insecure_commands = true"):
+                code, err = self.run_ros(d, '[ros]\ncommands = true\ninsecure_commands = true\n[network]\n'
+                                         'interface = "tether0"\n')
+                self.assertIsNone(code, err)
+                self.assertIn("commands on, DDS Security off", err)
+                self.assertIn("warning: commands from anyone who reaches interface tether0: no DDS Security", err)
+            with self.subTest("loopback"):
+                code, err = self.run_ros(d, '[ros]\ncommands = true\n[network]\ninterface = "lo"\n')
+                self.assertIsNone(code, err)
+                self.assertNotIn("warning", err)
+
+    def test_open_governance_refused(self):
+        """A keystore whose governance admits unauthenticated participants, or does not control who
+        writes, leaves the command topics open: caracara-ros refuses to start with it, naming the
+        topic and the rule, though every file is signed as it should be."""
+        network_is_private()
+        blocks = doc_blocks()
+        for rule, bad, why in (("allow_unauthenticated_participants", "true", "it admits unauthenticated participants"),
+                               ("enable_write_access_control", "false", "it does not control who writes on it")):
+            with self.subTest(rule=rule), tempfile.TemporaryDirectory() as d:
+                ks = os.path.join(d, "keystore")
+                make_keystore(ks, {"/caracara/ros": blocks["vehicle"]})
+                gov = os.path.join(ks, "enclaves", "governance.xml")
+                with open(gov) as f:
+                    text = f.read()
+                with open(gov, "w") as f:
+                    f.write(re.sub(r"<%s>\w+</%s>" % (rule, rule), "<%s>%s</%s>" % (rule, bad, rule), text))
+                # Signed again by the permissions CA, as the keystore's owner would.
+                subprocess.run(["openssl", "smime", "-sign", "-text", "-in", gov, "-out", gov[:-4] + ".p7s", "-signer",
+                                os.path.join(ks, "public", "permissions_ca.cert.pem"), "-inkey",
+                                os.path.join(ks, "private", "permissions_ca.key.pem")], check=True, capture_output=True)
+                code, err = self.run_ros(d, '[ros]\nsecurity = "%s"\n' % os.path.join(ks, "enclaves", "caracara", "ros"))
+                self.assertEqual(code, 1, err)
+                self.assertIn("ros.security: the enclave's governance leaves rt/caracara/kill open: " + why, err)
+
+    def test_bad_security_settings_refused_by_name(self):
+        """A relative enclave path is refused by name; an enclave with a file missing stops it at
+        start, naming the file; insecure_commands must be a boolean."""
+        with tempfile.TemporaryDirectory() as d:
+            code, err = self.run_ros(d, '[ros]\nsecurity = "keystore/enclaves/x"\n')
+            self.assertEqual(code, 2, err)
+            self.assertIn('ros.security must be the absolute path of an SROS2 enclave directory ("keystore/enclaves/x")',
+                          err)
+            code, err = self.run_ros(d, '[ros]\ninsecure_commands = "yes"\n')
+            self.assertEqual(code, 2, err)
+            self.assertIn("ros.insecure_commands must be true or false", err)
+            enclave = os.path.join(d, "enclaves", "caracara", "ros")
+            os.makedirs(enclave)
+            for f in ("identity_ca.cert.pem", "cert.pem", "key.pem", "permissions_ca.cert.pem", "governance.p7s"):
+                open(os.path.join(enclave, f), "w").close()
+            code, err = self.run_ros(d, '[ros]\nsecurity = "%s"\n' % enclave)
+            self.assertEqual(code, 1, err)
+            self.assertIn("ros.security: %s/permissions.p7s is missing or unreadable" % enclave, err)
+
 
 class CommandsTest(RosTestCase):
     COMMANDS = True
@@ -724,6 +1014,18 @@ class CommandsTest(RosTestCase):
                     w = json.loads(json.dumps(ZERO_WRENCH))
                     w[part][comp] = demand
                     judge(self, self.rig, motion, self.wrench_hold(w), "Wrench %s.%s=%+.1f" % (part, comp, demand))
+
+    def test_cyclone_peer_without_security_drives(self):
+        """The control of SecurityTest: the Cyclone peer it refuses when it has no security drives
+        the vehicle here (no security), and kills it: what SecurityTest sees is the security."""
+        rig = self.rig
+        peer = build_secure_peer()
+        since = rig.wire_next()
+        with SecurePeer(peer, "none", "wrench", 0.5, 0, 0, 0, 0, 0, 20):
+            poll(lambda: nonzero_orders(rig.wire_log(since)[1]), 20, message="the unsecured Cyclone peer did not drive")
+        rig.wait_sim_zero()
+        with SecurePeer(peer, "none", "kill", 20, 5):
+            rig.wait_state("killed")
 
     def test_per_thruster_values(self):
         rig = self.rig

@@ -585,7 +585,8 @@ check "pilot: the installed cockpit (/usr/share/caracara/cockpit) is served on t
 check "pilot: the bridge lists the recorded dives (/var/log/caracara, read only)" \
   as pilot perl -e "$HTTP_GET" /dives/ "["
 
-# --- 7c. caracara-ros: its own user in the pilots' group, the daemon's name denied (issue 46) ------------
+# --- 7c. caracara-ros: its own user in the pilots' group, the daemon's name denied, commands
+# without DDS Security refused off loopback (issue 46) ------------
 if [ -d "$DEBS" ]; then
   rc=0
   (cd "$DEBS" && apt_get install ./caracara-ros_*.deb) || rc=$?
@@ -622,6 +623,24 @@ ros_as_hardened_as_the_bridge() {
 }
 check "systemd-analyze security caracara-ros.service: no item open that the bridge closes, but the network's; exposure ${ros_exposure:-?} <= $EXPOSURE_MAX" \
   ros_as_hardened_as_the_bridge
+# Commands without DDS Security on an interface other than loopback: refused at start (exit 2),
+# named in the unit's journal, and not restarted (RestartPreventExitStatus=2); then the shipped
+# config runs again.
+cp /etc/caracara/ros.toml /etc/caracara/ros.toml.keep
+printf '[ros]\ncommands = true\n[network]\ninterface = "eth0"\n' >/etc/caracara/ros.toml
+c=$(cursor)
+systemctl restart caracara-ros 2>/dev/null || true
+sleep 3 # past RestartSec=1s: a restart would have come
+ros_refused() {
+  [ "$(unit caracara-ros ExecMainStatus)" = 2 ] && [ "$(unit caracara-ros NRestarts)" = 0 ] &&
+    ! systemctl is-active -q caracara-ros &&
+    journalctl --after-cursor="$c" -u caracara-ros -o cat --no-pager 2>/dev/null |
+      grep -qF "commands are refused without DDS Security on interface eth0"
+}
+check "caracara-ros refuses commands without DDS Security on eth0: exit 2, in its journal, not restarted" ros_refused
+mv /etc/caracara/ros.toml.keep /etc/caracara/ros.toml
+systemctl reset-failed caracara-ros 2>/dev/null || true
+check "caracara-ros starts again with the shipped config" timeout 60 systemctl start caracara-ros
 systemctl stop caracara-ros
 if [ -d "$DEBS" ]; then
   rc=0

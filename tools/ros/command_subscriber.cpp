@@ -78,16 +78,30 @@ CommandSubscriber::CommandSubscriber(sd_event* event, DdsParticipant& dds, const
         thrust_reader_ = dds.reader(&std_msgs_msg_dds__Float64MultiArray__desc, ros_topic(config_, "cmd_thrust"),
                                     Profile::SensorReader, listener_);
     }
+    // Under DDS Security, every command topic (the kill's too: it follows the same governance)
+    // only from writers whose signed permissions allow it.
+    try {
+        for (const char* name : {"kill", "cmd_wrench", "cmd_thrust"})
+            if (config_.commands || std::string(name) == "kill")
+                dds.require_protected(ros_topic(config_, name));
+    } catch (...) {
+        release(); // no destructor runs for a constructor that throws: Cyclone must not call into it
+        throw;
+    }
 }
 
-CommandSubscriber::~CommandSubscriber() {
+CommandSubscriber::~CommandSubscriber() { release(); }
+
+void CommandSubscriber::release() {
     for (const dds_entity_t r : {kill_reader_, wrench_reader_, thrust_reader_})
         if (r > 0)
             dds_set_listener(r, nullptr);
     dds_delete_listener(listener_);
+    listener_ = nullptr;
     wake_.reset();
     if (wake_fd_ >= 0)
         close(wake_fd_);
+    wake_fd_ = -1;
 }
 
 void CommandSubscriber::on_dds(dds_entity_t, void* arg) {

@@ -27,6 +27,7 @@ private:
     static int on_wake(sd_event_source* s, int fd, uint32_t revents, void* userdata);
     static void on_dds(dds_entity_t reader, void* arg);
     static void on_matched(dds_entity_t reader, const dds_publication_matched_status_t status, void* arg);
+    void release(); // the listener off the readers, the wake-up closed; the destructor's, and a failed constructor's
     void drain();
     void take_kills();
     void take_wrenches();

@@ -96,6 +96,11 @@ int main(int argc, char** argv) {
         if (const std::string e = caracara::ros::load_config(config_path, config); !e.empty())
             return usage(e);
     config.commands = config.commands || commands_flag;
+    if (const std::string e = caracara::ros::commands_refusal(config, caracara::ros::is_loopback(config.interface));
+        !e.empty()) {
+        std::fprintf(stderr, "caracara-ros: %s\n", e.c_str());
+        return 2;
+    }
 
     sd_event* raw = nullptr;
     if (sd_event_default(&raw) < 0)
@@ -113,8 +118,13 @@ int main(int argc, char** argv) {
         caracara::ros::TelemetryPublisher telemetry(event.get(), dds, config);
         caracara::ros::CommandSubscriber commands(event.get(), dds, config, [&] { kill_over(telemetry.bus(), config.bus); });
         telemetry.start();
-        std::fprintf(stderr, "caracara-ros: domain %u, namespace %s, commands %s\n", config.domain_id,
-                     config.ros_namespace.empty() ? "/" : config.ros_namespace.c_str(), config.commands ? "on" : "off");
+        dds.watch(event.get());
+        std::fprintf(stderr, "caracara-ros: domain %u, namespace %s, commands %s, DDS Security %s%s\n", config.domain_id,
+                     config.ros_namespace.empty() ? "/" : config.ros_namespace.c_str(), config.commands ? "on" : "off",
+                     config.security.empty() ? "off" : "on, enclave ", config.security.c_str());
+        if (config.commands && config.security.empty() && !caracara::ros::is_loopback(config.interface))
+            std::fprintf(stderr, "caracara-ros: warning: commands from anyone who reaches interface %s: no DDS Security "
+                                 "(ros.insecure_commands = true)\n", config.interface.empty() ? "(any)" : config.interface.c_str());
         sd_notify(0, "READY=1");
         const int r = sd_event_loop(event.get());
         sd_notify(0, "STOPPING=1");

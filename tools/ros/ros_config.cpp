@@ -1,5 +1,7 @@
 #include "tools/ros/ros_config.hpp"
 
+#include <ifaddrs.h>
+#include <net/if.h>
 #include <toml++/toml.h>
 
 namespace caracara::ros {
@@ -34,7 +36,7 @@ std::string load_config(const std::string& path, RosConfig& c) {
     for (const auto& [key, _] : ros.as_table() ? *ros.as_table() : toml::table{}) {
         static const char* const known[] = {"namespace", "domain_id", "range_layout", "commands", "world_frame",
                                             "base_frame", "frame_convention", "publish_odom_tf", "range_min_m",
-                                            "range_max_m", "range_fov_rad"};
+                                            "range_max_m", "range_fov_rad", "security", "security_plugins", "insecure_commands"};
         bool ok = false;
         for (const char* k : known)
             ok = ok || key.str() == k;
@@ -61,6 +63,17 @@ std::string load_config(const std::string& path, RosConfig& c) {
     }
     if (std::string e = read_bool(path, ros, "commands", c.commands); !e.empty())
         return e;
+    if (std::string e = read_bool(path, ros, "insecure_commands", c.insecure_commands); !e.empty())
+        return e;
+    if (const toml::node* n = ros["security"].node()) {
+        const auto v = n->value_exact<std::string>();
+        if (!v || v->empty() || (*v)[0] != '/')
+            return path + ": ros.security must be the absolute path of an SROS2 enclave directory" +
+                   (v ? " (\"" + *v + "\")" : "");
+        c.security = *v;
+    }
+    if (auto v = ros["security_plugins"].value<std::string>())
+        c.security_plugins = *v;
     if (auto v = ros["world_frame"].value<std::string>())
         c.world_frame = *v;
     if (auto v = ros["base_frame"].value<std::string>())
@@ -83,6 +96,31 @@ std::string load_config(const std::string& path, RosConfig& c) {
     if (auto v = t["network"]["interface"].value<std::string>())
         c.interface = *v;
     return "";
+}
+
+std::string commands_refusal(const RosConfig& c, bool loopback) {
+    if (!c.commands || !c.security.empty() || loopback || c.insecure_commands)
+        return "";
+    // Plain DDS authenticates nobody: anyone who reaches the interface could drive the vehicle.
+    return "commands are refused without DDS Security on interface " +
+           (c.interface.empty() ? std::string("(any: none named)") : c.interface) +
+           ": set ros.security to an SROS2 enclave (docs/ros2.md), or ros.insecure_commands = true to let anyone "
+           "on that network drive";
+}
+
+bool is_loopback(const std::string& interface) {
+    ifaddrs* all = nullptr;
+    if (interface.empty() || getifaddrs(&all) != 0)
+        return false;
+    bool loopback = false, found = false;
+    for (const ifaddrs* a = all; a; a = a->ifa_next)
+        if (a->ifa_name && interface == a->ifa_name) {
+            found = true;
+            loopback = (a->ifa_flags & IFF_LOOPBACK) != 0;
+            break;
+        }
+    freeifaddrs(all);
+    return found && loopback;
 }
 
 std::string ros_topic(const RosConfig& c, const std::string& name) {

@@ -1,5 +1,6 @@
 // caracara-ros's settings: the ROS namespace and domain, the Range layout (Humble or Jazzy),
-// whether commands are taken, the frames and their convention, and the network DDS may use. Read from a TOML file
+// whether commands are taken, the frames and their convention, the network DDS may use and the
+// SROS2 enclave that secures it. Read from a TOML file
 // (/etc/caracara/ros.toml; docs/ros2.md lists every key) and the command line.
 #pragma once
 
@@ -19,6 +20,12 @@ struct RosConfig {
     uint32_t domain_id = 0;           // ROS_DOMAIN_ID, else 0; the file's domain_id wins
     RangeLayout range_layout = RangeLayout::Humble; // also ros_discovery_info's Gid: 24 bytes, Jazzy's 16
     bool commands = false;            // Wrench and per-thruster commands; kill is always taken
+    // An SROS2 enclave directory (keystore/enclaves/<path>): DDS Security on, "" = off.
+    std::string security;
+    // Where libdds_security_{auth,ac,crypto}.so are: Debian's libddsc0debian directory, found at build time.
+    std::string security_plugins = CARACARA_DDS_SECURITY_PLUGINS;
+    // Commands with no security on an interface other than loopback: refused unless this says so.
+    bool insecure_commands = false;
     // The one network interface DDS uses: loopback until the config names the tether ("" = Cyclone picks).
     std::string interface = "lo";
     std::string world_frame = kDefaultWorldFrame;
@@ -35,6 +42,13 @@ struct RosConfig {
 
 // Reads `path` into `config`; returns "" or what is wrong with the file (named key and value).
 std::string load_config(const std::string& path, RosConfig& config);
+
+// "" when the settings may run, else why not: commands on, security off, on an interface that is not
+// loopback (`loopback`: what is_loopback(config.interface) said) and no insecure_commands = true.
+std::string commands_refusal(const RosConfig& config, bool loopback);
+
+// Whether `interface` is a loopback interface of this machine ("" is not: Cyclone picks any).
+bool is_loopback(const std::string& interface);
 
 // The ROS topic name under the namespace ("state" -> "/caracara/state"; "/diagnostics" stays).
 std::string ros_topic(const RosConfig& config, const std::string& name);
