@@ -1,4 +1,4 @@
-// The text of a TOML file before it is parsed (caracarad's configuration, the simulator's).
+// The text of a TOML file before it is parsed (caracarad's configuration, the simulator's, caracara-ros's).
 #pragma once
 
 #include <string>

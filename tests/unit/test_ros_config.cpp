@@ -2,6 +2,9 @@
 
 #include "tests/catch.hpp"
 
+#include <cstdlib>
+#include <unistd.h>
+
 using caracara::ros::commands_refusal;
 using caracara::ros::RosConfig;
 
@@ -43,4 +46,36 @@ TEST_CASE("the default settings may run: commands off, loopback") {
     CHECK(c.interface == "lo");
     CHECK_FALSE(c.insecure_commands);
     CHECK(c.security.empty());
+}
+
+namespace {
+// The settings read from `text` as caracara-ros reads its file: "" or the message.
+std::string load(const std::string& text, RosConfig& c) {
+    char path[] = "/tmp/caracara-ros-config-XXXXXX";
+    const int fd = ::mkstemp(path);
+    REQUIRE(fd >= 0);
+    REQUIRE(::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()));
+    ::close(fd);
+    const std::string e = caracara::ros::load_config(path, c);
+    ::unlink(path);
+    return e;
+}
+} // namespace
+
+TEST_CASE("values beyond their types: names ROS takes, distances a Range carries, an interface name (fuzz_ros_config)") {
+    RosConfig c;
+    CHECK(load("[ros]\nnamespace = \"/sub/caracara_1\"\nbase_frame = \"caracara/base_link\"\n", c).empty());
+    CHECK(c.ros_namespace == "/sub/caracara_1");
+    for (const char* bad : {"[ros]\nnamespace = \"/a b\"\n", "[ros]\nnamespace = \"/a//b\"\n", "[ros]\nnamespace = \"/a/\"\n",
+                            "[ros]\nnamespace = \"/1a\"\n", "[ros]\nworld_frame = \"\"\n", "[ros]\nbase_frame = \"/base\"\n",
+                            "[ros]\nworld_frame = \"odom\"\nbase_frame = \"odom\"\n", "[ros]\nrange_min_m = 5.0\nrange_max_m = 1.0\n",
+                            "[ros]\nrange_max_m = nan\n", "[ros]\nrange_fov_rad = 4.0\n",
+                            "[network]\ninterface = \"a-name-longer-than-15\"\n", "[network]\ninterface = \"eth0:1\"\n",
+                            "[ros]\nnamespace = \"/caracara\"\u03fb\n"}) {
+        RosConfig d;
+        const std::string e = load(bad, d);
+        INFO(bad);
+        CHECK(e.starts_with("/tmp/caracara-ros-config-"));
+        CHECK(e.find(": ") != std::string::npos);
+    }
 }
