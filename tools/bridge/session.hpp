@@ -7,11 +7,15 @@
 // with the reason. It takes one of the client slots only once its request and token are
 // good; /dives/ requests are answered by the DiveWorker. When it goes (closed, dropped,
 // refused), its D-Bus connection closes with it, and caracarad zeroes the thrust it commanded.
+// Its commands but Kill need the pilot's seat (PilotSeat): refused by name without it; when
+// another client takes the seat over, this client's D-Bus connection is replaced by a new one,
+// so caracarad zeroes what it commanded (and ends its motor test or detection) at once.
 #pragma once
 
 #include "tools/bridge/client_protocol.hpp"
 #include "tools/bridge/client_slots.hpp"
 #include "tools/bridge/command_link.hpp"
+#include "tools/bridge/pilot_seat.hpp"
 #include "tools/bridge/send_queue.hpp"
 #include "tools/bridge/telemetry.hpp"
 
@@ -23,6 +27,7 @@
 #include <boost/beast/websocket/stream.hpp>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace caracara::bridge {
@@ -45,7 +50,7 @@ public:
     using Socket = boost::asio::generic::stream_protocol::socket;
 
     Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry,
-            ClientSlots& slots, DiveWorker& dives);
+            ClientSlots& slots, DiveWorker& dives, PilotSeat& seat);
     void start();
     // Still waiting for its HTTP request (BridgeServer bounds these apart from the client slots).
     bool waiting_for_request() const { return !got_request_; }
@@ -67,6 +72,16 @@ private:
     void read();
     void on_frame(boost::system::error_code ec);
     void handle(const Outcome& outcome);
+    // A new D-Bus connection for this client's commands (throws when the bus cannot be reached).
+    void open_link();
+    // The connection replaced by a new one when this client no longer holds the seat.
+    void renew_link();
+    // A command that needs the seat, sent when this client holds it (or took it free).
+    void command(const Command& c);
+    void seat_command(const Command& c);
+    void seat_refused(std::string_view topic, const std::string& error, const std::string& why);
+    // Another client took the seat over: this client's commands go with its connection.
+    void lost_seat();
     void send_text(std::string text);
     void queue(Frame f);
     void write_next();
@@ -82,6 +97,9 @@ private:
     Telemetry& telemetry_;
     ClientSlots& slots_;
     DiveWorker& dives_;
+    PilotSeat& seat_;
+    std::optional<PilotSeat::ClientId> seat_id_; // from the upgrade on
+    std::string refusal_logged_;                 // the seat's holder when this client's refusal was logged
     std::shared_ptr<void> slot_; // a client slot, held from the upgrade on
     boost::beast::flat_buffer buffer_;
     boost::beast::http::request<boost::beast::http::string_body> request_;
