@@ -279,12 +279,13 @@ test("one pilot's seat: a second Foxglove client is refused by name and moves no
   const since = wireNext();
   a.publish(a.publisher("/command/kill"), {});
   await poll(() => killEdges(since).length, 5000, "A's kill on the kill output");
+  await a.waitFor("/vehicle/state", (s) => s.state === "killed");
   // B leaves: the seat is free, and A hears it.
   await b.close();
   await poll(() => seatNews(a).some((m) => m.change === "left" && m.holder === ""), 5000, "A told the seat is free");
   a.publish(a.publisher("/command/clear_kill"), {});
+  await poll(() => seatNews(a).at(-1).yours && seatNews(a).at(-1).change === "claimed", 5000, "A's clear-kill taking the free seat");
   await a.waitFor("/vehicle/state", (s) => s.state === "ready", 20000);
-  assert.equal(seatNews(a).at(-1).yours, true, "A's clear-kill took the free seat");
   await a.close();
 });
 
