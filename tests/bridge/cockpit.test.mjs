@@ -589,7 +589,11 @@ test("one armed page per vehicle: a second page shows who holds the seat, cannot
   const expected = forwardMotion(forwardDemand(-0.6));
   await poll(() => wireIs(expected), 10000, "page A driving");
   await a.page.waitForFunction(() => document.getElementById("seat").textContent === "this page", { timeout: 5000 });
-  const b = await open();
+  // B in a second Chromium, as on another laptop: a second tab of A's window would hide A, and a
+  // hidden page does not drive.
+  const laptop = await launch();
+  try {
+  const b = await openCockpit(laptop.browser, HTTP);
   // B: who holds the seat (A, by the name it gave), the banner, and the take-over offered.
   await b.page.waitForFunction(() => document.getElementById("seat").dataset.holder === "other", { timeout: 5000 });
   const holderA = await text(b.page, "#seat");
@@ -653,6 +657,9 @@ test("one armed page per vehicle: a second page shows who holds the seat, cannot
   await poll(allZero, 2000, "zero once B's page closed");
   await a.page.waitForFunction(() => document.getElementById("seat").dataset.holder === "free", { timeout: 5000 });
   assert.equal(await a.page.$eval("#take-seat", (e) => e.hidden), true);
+  } finally {
+    await laptop.close();
+  }
   await deadman(a.page, false);
   await stick(a.page, 0);
   await a.page.close();
