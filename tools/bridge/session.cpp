@@ -107,7 +107,9 @@ std::string advertise() {
 Session::Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry,
                  ClientSlots& slots, DiveWorker& dives, PilotSeat& seat)
     : io_(io), ws_(std::move(socket)), timer_(io), config_(config), telemetry_(telemetry), slots_(slots),
-      dives_(dives), seat_(seat), protocol_(fg::channels().size()), queue_(config.max_queued, config.max_reply_bytes) {}
+      dives_(dives), seat_(seat, {[this](std::string t) { send_text(std::move(t)); },
+                                  [this](const Command& c) { if (link_) link_->send(c, true); }, [this] { renew_link(); }}),
+      protocol_(fg::channels().size()), queue_(config.max_queued, config.max_reply_bytes) {}
 
 void Session::start() {
     close_after(kRequestTimeout);
@@ -218,31 +220,8 @@ void Session::on_accept(boost::system::error_code ec) {
     open_ = true;
     send_text(server_info());
     send_text(advertise());
-    // Told who holds the pilot's seat now and at each change: a status whose id is the seat's topic.
-    seat_id_ = seat_.join(
-        [weak = weak_from_this()](const PilotSeat::News& n) {
-            if (auto self = weak.lock()) {
-                self->refusal_logged_.clear();
-                self->send_text(status_json(0,
-                                            nlohmann::json{{"holder", n.holder}, {"yours", n.yours},
-                                                           {"change", std::string(name_of(n.change))}, {"by", n.by}}
-                                                .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
-                                            command_topic_name(CommandKind::Seat)));
-            }
-        },
-        [weak = weak_from_this()] {
-            if (auto self = weak.lock())
-                self->lost_seat();
-        });
+    seat_.join(); // told who holds the pilot's seat now and at each change
     read();
-}
-
-void Session::lost_seat() {
-    if (ended_)
-        return;
-    std::fprintf(stderr, "caracara-bridge: %s lost the pilot's seat to a take-over: its commands end with its bus connection\n",
-                 seat_.label(*seat_id_).c_str());
-    renew_link();
 }
 
 void Session::renew_link() {
@@ -252,67 +231,6 @@ void Session::renew_link() {
         open_link();
     } catch (const std::exception&) {
         end("its bus connection could not be opened again after it lost the pilot's seat");
-    }
-}
-
-void Session::seat_refused(std::string_view topic, const std::string& error, const std::string& why) {
-    const std::string text = std::string(topic) + " refused: org.caracara.Bridge.Error." + error + ": " + why;
-    send_text(status_json(2, text));
-    // Logged once per holder of the seat: a teleop panel refused at 20 Hz is one line, not twenty a second.
-    const std::string holder = seat_.holder() ? seat_.label(*seat_.holder()) : "";
-    if (refusal_logged_ == holder + "|" + std::string(topic))
-        return;
-    refusal_logged_ = holder + "|" + std::string(topic);
-    std::fprintf(stderr, "caracara-bridge: %s: %s (logged once until the seat changes)\n", seat_.label(*seat_id_).c_str(),
-                 text.c_str());
-}
-
-void Session::command(const Command& c) {
-    const CommandSpec& spec = command_spec(c.kind);
-    if (spec.seat == CommandSeat::Needed) {
-        const PilotSeat::Answer a = seat_.command(*seat_id_);
-        if (!a.ok)
-            return seat_refused(spec.topic, "SeatTaken",
-                                "the pilot's seat is held by " + a.holder +
-                                    "; take it over with /command/seat {\"action\":\"take-over\"} (docs/foxglove.md)");
-    }
-    if (link_)
-        link_->send(c);
-}
-
-void Session::seat_command(const Command& c) {
-    const std::string_view topic = command_topic_name(CommandKind::Seat);
-    const auto action = parse_name<SeatAction>(std::get<std::string>(c.args.at(0)));
-    if (const std::string& name = std::get<std::string>(c.args.at(1)); !name.empty())
-        seat_.name(*seat_id_, name);
-    const std::string me = seat_.label(*seat_id_);
-    const std::optional<PilotSeat::ClientId> before = seat_.holder();
-    switch (*action) {
-    case SeatAction::Claim:
-        if (const PilotSeat::Answer a = seat_.ask(*seat_id_, SeatAction::Claim); !a.ok)
-            seat_refused(topic, "SeatTaken",
-                         "the pilot's seat is held by " + a.holder + "; only \"take-over\" takes it from its holder");
-        return;
-    case SeatAction::TakeOver:
-        if (before && *before != *seat_id_ && link_) {
-            // The vehicle held at zero by the new holder before the old one's connection goes, so
-            // it is a pilot at once (no pilot-lost kill for the handover); refused when killed or
-            // surfacing, where nothing is driven anyway.
-            link_->send(Command{CommandKind::Motion, {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}}, true);
-            const std::string from = seat_.label(*before);
-            std::fprintf(stderr, "caracara-bridge: the pilot's seat: %s took it over from %s\n", me.c_str(), from.c_str());
-        }
-        seat_.ask(*seat_id_, SeatAction::TakeOver);
-        return;
-    case SeatAction::Release:
-        if (const PilotSeat::Answer a = seat_.ask(*seat_id_, SeatAction::Release); !a.ok) {
-            seat_refused(topic, "NotSeatHolder",
-                         a.holder.empty() ? "the pilot's seat is free" : "the pilot's seat is held by " + a.holder);
-            return;
-        }
-        // Released: what it commanded goes with its connection, as when it leaves.
-        renew_link();
-        return;
     }
 }
 
@@ -346,12 +264,10 @@ void Session::on_frame(boost::system::error_code ec) {
 void Session::handle(const Outcome& outcome) {
     for (const std::string& reply : outcome.replies)
         send_text(reply);
-    if (outcome.command && seat_id_) {
-        if (outcome.command->kind == CommandKind::Seat)
-            seat_command(*outcome.command);
-        else
-            command(*outcome.command);
-    }
+    if (outcome.command && outcome.command->kind == CommandKind::Seat)
+        seat_.ask(*outcome.command);
+    else if (outcome.command && seat_.allows(*outcome.command) && link_)
+        link_->send(*outcome.command);
     for (const uint32_t channel : outcome.subscribed)
         if (const Payload latest = telemetry_.latest(channel - 1))
             deliver(channel - 1, 0, latest);
@@ -410,11 +326,9 @@ void Session::end(const char* why, bool tell_client) {
     if (ended_)
         return;
     ended_ = true;
-    // The pilot's D-Bus connection goes now: caracarad zeroes what this client commanded; then
-    // the seat is free, and the others are told.
+    // The pilot's D-Bus connection goes now: caracarad zeroes what this client commanded; then the seat is free.
     link_.reset();
-    if (seat_id_)
-        seat_.leave(*seat_id_);
+    seat_.leave();
     if (why)
         std::fprintf(stderr, "caracara-bridge: closing a client: %s\n", why);
     if (!tell_client || !open_) {

@@ -7,15 +7,14 @@
 // with the reason. It takes one of the client slots only once its request and token are
 // good; /dives/ requests are answered by the DiveWorker. When it goes (closed, dropped,
 // refused), its D-Bus connection closes with it, and caracarad zeroes the thrust it commanded.
-// Its commands but Kill need the pilot's seat (PilotSeat): refused by name without it; when
-// another client takes the seat over, this client's D-Bus connection is replaced by a new one,
-// so caracarad zeroes what it commanded (and ends its motor test or detection) at once.
+// Its commands but Kill need the pilot's seat (SeatGate); when it loses the seat its D-Bus
+// connection is replaced, so caracarad zeroes what it commanded at once.
 #pragma once
 
 #include "tools/bridge/client_protocol.hpp"
 #include "tools/bridge/client_slots.hpp"
 #include "tools/bridge/command_link.hpp"
-#include "tools/bridge/pilot_seat.hpp"
+#include "tools/bridge/seat_gate.hpp"
 #include "tools/bridge/send_queue.hpp"
 #include "tools/bridge/telemetry.hpp"
 
@@ -27,7 +26,6 @@
 #include <boost/beast/websocket/stream.hpp>
 #include <chrono>
 #include <memory>
-#include <optional>
 #include <string>
 
 namespace caracara::bridge {
@@ -76,12 +74,6 @@ private:
     void open_link();
     // The connection replaced by a new one when this client no longer holds the seat.
     void renew_link();
-    // A command that needs the seat, sent when this client holds it (or took it free).
-    void command(const Command& c);
-    void seat_command(const Command& c);
-    void seat_refused(std::string_view topic, const std::string& error, const std::string& why);
-    // Another client took the seat over: this client's commands go with its connection.
-    void lost_seat();
     void send_text(std::string text);
     void queue(Frame f);
     void write_next();
@@ -97,9 +89,7 @@ private:
     Telemetry& telemetry_;
     ClientSlots& slots_;
     DiveWorker& dives_;
-    PilotSeat& seat_;
-    std::optional<PilotSeat::ClientId> seat_id_; // from the upgrade on
-    std::string refusal_logged_;                 // the seat's holder when this client's refusal was logged
+    SeatGate seat_; // joined from the upgrade on
     std::shared_ptr<void> slot_; // a client slot, held from the upgrade on
     boost::beast::flat_buffer buffer_;
     boost::beast::http::request<boost::beast::http::string_body> request_;
