@@ -1,9 +1,11 @@
 // caracara-bridge's pilot's seat (tools/bridge/pilot_seat.hpp): one holder; a free seat taken by
 // a claim (a first command), a held one only by a take-over, which its holder hears of first;
-// every client told each change; the seat free once its holder releases it or leaves.
+// every client told each change; the seat free once its holder releases it or leaves. And a
+// client's side of it (tools/bridge/seat_gate.hpp).
 #include "tests/catch.hpp"
 #include "tools/bridge/command.hpp"
 #include "tools/bridge/pilot_seat.hpp"
+#include "tools/bridge/seat_gate.hpp"
 
 #include <string>
 #include <vector>
@@ -140,4 +142,61 @@ TEST_CASE("every command but Kill and the seat's own needs the seat", "[bridge]"
         INFO(std::string(command_spec(kind).topic));
         CHECK((command_spec(kind).seat == CommandSeat::Anyone) == anyone);
     }
+}
+
+// A client's side of the seat (tools/bridge/seat_gate.hpp): what it lets through, what it tells.
+namespace {
+
+struct Client {
+    std::vector<std::string> texts;  // status messages sent to it
+    std::vector<std::string> events; // "zero" (its quiet zero motion), "renew" (its connection replaced)
+    caracara::bridge::SeatGate gate;
+    explicit Client(PilotSeat& seat)
+        : gate(seat, {[this](std::string t) { texts.push_back(std::move(t)); },
+                      [this](const caracara::bridge::Command& c) {
+                          CHECK(c.kind == CommandKind::Motion);
+                          for (const auto& a : c.args)
+                              CHECK(std::get<double>(a) == 0.0);
+                          events.push_back("zero");
+                      },
+                      [this] { events.push_back("renew"); }}) {}
+};
+
+caracara::bridge::Command cmd(CommandKind k, std::string_view json) { return *caracara::bridge::parse_command(k, json).command; }
+
+} // namespace
+
+TEST_CASE("a gate lets the holder's commands through, refuses another's by name, lets any kill through", "[bridge]") {
+    PilotSeat seat;
+    Client a(seat), b(seat);
+    a.gate.join();
+    b.gate.join();
+    REQUIRE(a.texts.size() == 1);
+    CHECK(a.texts[0] == R"({"id":"/command/seat","level":0,"message":"{\"by\":\"\",\"change\":\"now\",\"holder\":\"\",\"yours\":false}","op":"status"})");
+    CHECK(a.gate.allows(cmd(CommandKind::Drive, R"({"forward":0.5})"))); // a free seat: taken
+    CHECK_FALSE(b.gate.allows(cmd(CommandKind::Motion, "{}")));
+    CHECK(b.texts.back().find(R"(/command/motion refused: org.caracara.Bridge.Error.SeatTaken: the pilot's seat is held by client #1)") !=
+          std::string::npos);
+    CHECK(b.gate.allows(cmd(CommandKind::Kill, "{}")));
+    // The take-over: the new holder's zero first, then the old holder's connection replaced.
+    b.gate.ask(cmd(CommandKind::Seat, R"({"action":"take-over","name":"teleop"})"));
+    CHECK(b.events == std::vector<std::string>{"zero"});
+    CHECK(a.events == std::vector<std::string>{"renew"});
+    CHECK(a.texts.back().find(R"(\"change\":\"taken-over\")") != std::string::npos);
+    CHECK(a.texts.back().find(R"(\"by\":\"client #2 (teleop)\")") != std::string::npos);
+    CHECK_FALSE(a.gate.allows(cmd(CommandKind::ClearKill, "{}")));
+    // Released by its holder: its connection replaced, the seat free; a release by another refused.
+    a.gate.ask(cmd(CommandKind::Seat, R"({"action":"release"})"));
+    CHECK(a.texts.back().find("NotSeatHolder") != std::string::npos);
+    b.gate.ask(cmd(CommandKind::Seat, R"({"action":"release"})"));
+    CHECK(b.events == std::vector<std::string>{"zero", "renew"});
+    CHECK_FALSE(seat.holder());
+    // Gone: nothing more through it, and a gate destroyed is never called.
+    b.gate.leave();
+    CHECK_FALSE(b.gate.allows(cmd(CommandKind::Kill, "{}")));
+    {
+        Client c(seat);
+        c.gate.join();
+    }
+    CHECK(a.gate.allows(cmd(CommandKind::Drive, "{}"))); // every client told: none gone wrong
 }
