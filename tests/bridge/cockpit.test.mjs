@@ -523,11 +523,12 @@ test("a failsafe shows in the header's banner, on screen when scrolled, and stop
     const shown = await countdown(page, surfacing, /^SURFACING: water in the thruster \(thruster 3\)\. Ascent: (\d+\.\d) s left/);
     assert.ok(shown.seconds <= SURFACE_MS / 1000 && shown.seconds >= SURFACE_MS / 1000 - 1,
               `the ascent's countdown began at ${shown.seconds} s, not the configured ${SURFACE_MS} ms`);
+    // The daemon says "ready" while its failsafe drives: the page's state says surfacing, in red, not a green ready.
+    const [daemonState, shownState] = await Promise.all([vget("State"),
+      page.$eval("#state", (e) => [e.textContent, getComputedStyle(e).color])]);
+    assert.equal(daemonState, "ready");
+    assert.deepEqual(shownState, ["surfacing", "rgb(224, 36, 44)"], "the state's words and colour (--red)");
     await page.waitForFunction(() => document.getElementById("arm").dataset.arm === "release", { timeout: 2000 });
-    // The daemon says "ready" while its failsafe drives: the page's state says surfacing, not a green ready.
-    assert.equal(vget("State"), "ready");
-    assert.equal(await text(page, "#state"), "surfacing");
-    assert.equal(await page.$eval("#state", (e) => getComputedStyle(e).color), "rgb(224, 36, 44)", "the state's colour (--red)");
     const s0 = await sent(page);
     await sleep(1000);
     assert.equal(await sent(page), s0, "motion sent while surfacing");
