@@ -53,11 +53,16 @@ test("a client closed while another lists a full dive directory is zeroed within
 async function deafClient() {
   const ws = new WebSocket(URL, ["foxglove.websocket.v1"]);
   const c = { ws, statuses: 0, closed: null };
-  ws.on("message", (data, binary) => { if (!binary && JSON.parse(data).op === "status") c.statuses += 1; });
+  // Its error replies (the pilot's seat, told at the connection, is a status of level 0).
+  ws.on("message", (data, binary) => {
+    if (binary) return;
+    const m = JSON.parse(data);
+    if (m.op === "status" && m.level === 2) c.statuses += 1;
+  });
   ws.on("close", (code, reason) => { c.closed = { code, reason: reason.toString() }; });
   let greeted = 0;
   await new Promise((resolve, reject) => {
-    ws.on("message", (data, binary) => { if (!binary && ++greeted === 2) resolve(); }); // serverInfo, advertise
+    ws.on("message", (data, binary) => { if (!binary && ++greeted === 3) resolve(); }); // serverInfo, advertise, the seat
     ws.on("error", reject);
   });
   ws._socket.pause(); // read nothing more: the bridge's writes back up

@@ -37,6 +37,10 @@ function keepPublishing(c, id, msg, everyMs = 100) {
   return () => clearInterval(timer);
 }
 
+// Orders other than zero to a thruster on the wire since a wire log index.
+const nonZero = (since) => wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3 &&
+  DEFAULT_MT.includes(e.addr << 1) && e.data[0] !== ZERO);
+
 // The SPEED bytes of the seed's x (port) demand v: a Twist's linear.y (left, REP 103) of v.
 const xMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in X_AXIS ? speedByte(X_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
 
@@ -118,6 +122,7 @@ test("a published Twist (linear.y, left: the seed's port) reaches the wire as th
              "the pilot-lost failsafe on /events");
   watcher.publish(watcher.publisher("/command/clear_kill"), {});
   await watcher.waitFor("/vehicle/state", (s) => s.state === "ready", 20000);
+  await watcher.close(); // its clear-kill took the free pilot's seat: it goes with it
 });
 
 test("kill from a client, a refused command as a status with the daemon's error name, events as foxglove.Log", async () => {
@@ -152,6 +157,7 @@ test("kill from a client, a refused command as a status with the daemon's error 
   c.publish(test, { thruster: 8, value: 500 });
   await c.waitStatus((s) => s.level === 2 && s.message.startsWith(`/command/motor_test refused: ${ERR}OutOfRange`));
   assert.deepEqual(wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3 && e.data[0] !== ZERO), []);
+  await c.close();
 });
 
 test("the seed's flat axes on /command/motion are refused by name, never read as a Twist; /command/drive takes a pilot's words", async () => {
@@ -180,6 +186,7 @@ test("the seed's flat axes on /command/motion are refused by name, never read as
   }
   c.publish(drive, {});
   await poll(() => simSpeeds().every((v) => v === ZERO), 5000, "zero");
+  await c.close();
 });
 
 test("a second client keeps its own pilot rules; while it is connected, another leaving kills nothing", async () => {
@@ -190,6 +197,9 @@ test("a second client keeps its own pilot rules; while it is connected, another 
   await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(0.2)), 10000, "A's motion");
   const controllerA = (await a.waitFor("/vehicle/state", (s) => s.controller !== "")).controller;
   stopA();
+  // A holds the pilot's seat: B takes it over, in so many words.
+  b.publish(b.publisher("/command/seat"), { action: "take-over" });
+  await poll(() => seatNews(b).some((n) => n.yours), 5000, "the seat B's");
   const stopB = keepPublishing(b, b.publisher("/command/motion"), { linear: { y: -0.2 } });
   try {
     await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(-0.2)), 10000, "B's motion");
@@ -208,6 +218,77 @@ test("a second client keeps its own pilot rules; while it is connected, another 
   }
   await b.close();
   await poll(() => simSpeeds().every((s) => s === ZERO), 2000, "zero once B left");
+});
+
+// What a client heard of the pilot's seat: the bridge's statuses whose id is /command/seat.
+const seatNews = (c) => c.statuses.filter((s) => s.id === "/command/seat").map((s) => JSON.parse(s.message));
+
+test("one pilot's seat: a second Foxglove client is refused by name and moves nothing; an explicit take-over is told to the holder at once and zeroes its thrust; its leaving frees the seat", async () => {
+  await rearm();
+  const a = await client();
+  const b = await client();
+  // Each is told the seat when it joins: free.
+  await poll(() => seatNews(a).length && seatNews(b).length, 5000, "the seat told at the join");
+  assert.deepEqual(seatNews(b)[0], { holder: "", yours: false, change: "now", by: "" });
+  // A's first motion takes the free seat; B hears who holds it.
+  const stopA = keepPublishing(a, a.publisher("/command/motion"), { linear: { y: 0.2 } }, 50);
+  try {
+    await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(xMotion(0.2)), 10000, "A's motion");
+    const holder = (await poll(() => seatNews(b).find((n) => n.change === "claimed"), 5000, "B told of A's claim")).holder;
+    assert.match(holder, /^client #\d+$/);
+    assert.equal(seatNews(a).at(-1).yours, true);
+    // B without the seat: motion, drive, thrust, clear-kill, a claim: each refused by name, and
+    // nothing of B's on the wire (A's motion alone, throughout).
+    const since = wireNext();
+    const n = b.statuses.length;
+    for (const [topic, msg] of [["/command/motion", { linear: { y: -0.9 } }], ["/command/drive", { forward: 0.9 }],
+      ["/command/thrust", { values: [3000, 3000, 3000, 3000, 3000, 3000, 3000, 3000] }], ["/command/clear_kill", {}],
+      ["/command/seat", { action: "claim" }]]) {
+      const id = b.publisher(topic);
+      for (let i = 0; i < 5; i++) { b.publish(id, msg); await sleep(50); }
+      const r = await poll(() => b.statuses.slice(n).find((s) => s.level === 2 && s.message.startsWith(`${topic} refused`)), 5000,
+                           `${topic} refused`);
+      assert.match(r.message, new RegExp(`^${topic} refused: org\\.caracara\\.Bridge\\.Error\\.SeatTaken: the pilot's seat is held by ${holder}[;]`));
+    }
+    const a02 = new Set(xMotion(0.2));
+    const others = wireLog(since).filter((e) => e.bus === "i2c" && !e.read && e.data.length === 3 && DEFAULT_MT.includes(e.addr << 1) &&
+      !a02.has(e.data[0]));
+    assert.deepEqual(others, [], "an order on the wire that is not A's");
+    assert.deepEqual(simSpeeds(), xMotion(0.2));
+    // B takes it over, in so many words: A told at once, A's thrust zeroed (B holds the vehicle
+    // at zero), A's commands refused from then on.
+    const sinceTake = wireNext();
+    const takenAt = process.hrtime.bigint();
+    b.publish(b.publisher("/command/seat"), { action: "take-over", name: "teleop on the laptop" });
+    const told = await poll(() => seatNews(a).find((m) => m.change === "taken-over"), 5000, "A told of the take-over");
+    assert.deepEqual(told, { holder: told.by, yours: false, change: "taken-over", by: told.by });
+    assert.match(told.by, /^client #\d+ \(teleop on the laptop\)$/);
+    const driven = new Set(Object.keys(X_AXIS).map((i) => DEFAULT_MT[i] >> 1));
+    const zeros = await poll(() => firstZeros(sinceTake, driven), 5000, "A's thrust zeroed");
+    const zeroedAt = zeros.reduce((x, y) => (x > y ? x : y));
+    const ms = Number(zeroedAt - takenAt) / 1e6;
+    console.log(`# take-over published to A's zeros on the wire: ${ms.toFixed(1)} ms`);
+    assert.ok(ms <= bound("CLIENT_LOSS_ZERO_MS_MAX"), `A zeroed ${ms} ms after the take-over`);
+    await a.waitStatus((s) => s.level === 2 && s.message.startsWith("/command/motion refused: org.caracara.Bridge.Error.SeatTaken"));
+    await sleep(300);
+    assert.ok(simSpeeds().every((v) => v === ZERO), "A's motion after the take-over");
+    // From the take-over's zeros on (A's orders before them are A's motion still going out).
+    assert.deepEqual(nonZero(sinceTake).filter((e) => e.time_ns > zeroedAt), [], "A's motion on the wire after the take-over");
+  } finally {
+    stopA();
+  }
+  // Kill needs no seat: A (without it) kills.
+  const since = wireNext();
+  a.publish(a.publisher("/command/kill"), {});
+  await poll(() => killEdges(since).length, 5000, "A's kill on the kill output");
+  await a.waitFor("/vehicle/state", (s) => s.state === "killed");
+  // B leaves: the seat is free, and A hears it.
+  await b.close();
+  await poll(() => seatNews(a).some((m) => m.change === "left" && m.holder === ""), 5000, "A told the seat is free");
+  a.publish(a.publisher("/command/clear_kill"), {});
+  await poll(() => seatNews(a).at(-1).yours && seatNews(a).at(-1).change === "claimed", 5000, "A's clear-kill taking the free seat");
+  await a.waitFor("/vehicle/state", (s) => s.state === "ready", 20000);
+  await a.close();
 });
 
 test("bad input: a status error or a close, never a crash, never a command", async () => {

@@ -139,6 +139,7 @@ test("the page shows the state and the values the simulator reports, loading not
 // The SPEED bytes of a "forward" demand v: the seed's y axis, as the mixing has it.
 const forwardMotion = (v) => [...Array(MOTORS).keys()].map((i) => (i in Y_AXIS ? speedByte(Y_AXIS[i] * Math.round(v * MOTOR_MAX)) : ZERO));
 const allZero = () => simSpeeds().every((s) => s === ZERO);
+const wireIs = (speeds) => JSON.stringify(simSpeeds()) === JSON.stringify(speeds);
 // A page armed on purpose and driving forward (the stick at -0.6) on a freshly armed vehicle.
 async function drivingPage() {
   await rearm();
@@ -180,19 +181,52 @@ test("a scripted gamepad: the left stick forward reaches the wire as the seed's 
   await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving again");
   await setPad(page, () => { window.__pad.connected = false; window.dispatchEvent(new Event("gamepaddisconnected")); });
   await poll(allZero, 2000, "zero once the gamepad is unplugged");
-  // Plugged in and held again, then the page hidden (another tab): zero, and nothing sent.
-  await setPad(page, () => { window.__pad.connected = true; });
-  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving again");
-  await page.evaluate(() => {
-    Object.defineProperty(document, "visibilityState", { value: "hidden", configurable: true });
+  // Plugged back in with the deadman and the stick held all along: nothing moves (the pilot arms
+  // again on purpose), also with the deadman released and pressed again while the stick is forward.
+  await notUntilArmedAgain(page, async () => {
+    await setPad(page, () => { window.__pad.connected = true; window.dispatchEvent(new Event("gamepadconnected")); });
+  }, "the gamepad plugged back in");
+  // Armed on purpose: it drives; then the page hidden (another tab): zero, and nothing sent.
+  await armPad(page);
+  await stick(page, -0.6);
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving once armed again");
+  const visibility = (state) => page.evaluate((state) => {
+    Object.defineProperty(document, "visibilityState", { value: state, configurable: true });
     document.dispatchEvent(new Event("visibilitychange"));
-  });
+  }, state);
+  await visibility("hidden");
   await poll(allZero, 2000, "zero once the page is hidden");
   const sent3 = await page.evaluate(() => window.cockpit.sent);
   await sleep(500);
   assert.equal(await page.evaluate(() => window.cockpit.sent), sent3, "nothing sent while hidden");
+  // Shown again, deadman and stick held: nothing moves until armed on purpose.
+  await notUntilArmedAgain(page, () => visibility("visible"), "the page shown again");
+  await armPad(page);
+  await stick(page, -0.6);
+  await poll(() => JSON.stringify(simSpeeds()) === JSON.stringify(expected), 10000, "driving once armed again");
+  await deadman(page, false);
+  await stick(page, 0);
   await page.close();
 });
+
+// After `change` (the deadman and the stick forward held through it), nothing on the wire and no
+// command sent, the page asking to release and centre; nor with the deadman released and pressed
+// again while the stick stays forward.
+async function notUntilArmedAgain(page, change, what) {
+  const since = wireNext();
+  const sent0 = await sent(page);
+  await change();
+  await page.waitForFunction(() => /release the deadman and centre the sticks/.test(document.getElementById("arm").textContent),
+    { timeout: 2000 });
+  await sleep(800);
+  await deadman(page, false);
+  await sleep(300);
+  await deadman(page, true);
+  await sleep(600);
+  assert.equal(await arm(page), "release", `${what}: armed with the stick forward`);
+  assert.deepEqual(nonZeroOrders(since), [], `${what}: thrust on the wire before arming on purpose`);
+  assert.equal(await sent(page), sent0, `${what}: a motion command sent before arming on purpose`);
+}
 
 test("the mapping and the gain (selector and d-pad) are editable and kept in the browser's storage", async () => {
   const { page } = await open();
@@ -489,6 +523,11 @@ test("a failsafe shows in the header's banner, on screen when scrolled, and stop
     const shown = await countdown(page, surfacing, /^SURFACING: water in the thruster \(thruster 3\)\. Ascent: (\d+\.\d) s left/);
     assert.ok(shown.seconds <= SURFACE_MS / 1000 && shown.seconds >= SURFACE_MS / 1000 - 1,
               `the ascent's countdown began at ${shown.seconds} s, not the configured ${SURFACE_MS} ms`);
+    // The daemon says "ready" while its failsafe drives: the page's state says surfacing, in red, not a green ready.
+    const [daemonState, shownState] = await Promise.all([vget("State"),
+      page.$eval("#state", (e) => [e.textContent, getComputedStyle(e).color])]);
+    assert.equal(daemonState, "ready");
+    assert.deepEqual(shownState, ["surfacing", "rgb(224, 36, 44)"], "the state's words and colour (--red)");
     await page.waitForFunction(() => document.getElementById("arm").dataset.arm === "release", { timeout: 2000 });
     const s0 = await sent(page);
     await sleep(1000);
@@ -543,6 +582,92 @@ test("the controller in words: the commanding process by name, \"this page\" whi
   await page.close();
 });
 
+test("one armed page per vehicle: a second page shows who holds the seat, cannot drive, is refused by the bridge by name; its explicit take-over shows on the first at once and zeroes it", async () => {
+  await rearm();
+  const a = await open();
+  await armPad(a.page);
+  await stick(a.page, -0.6);
+  const expected = forwardMotion(forwardDemand(-0.6));
+  await poll(() => wireIs(expected), 10000, "page A driving");
+  await a.page.waitForFunction(() => document.getElementById("seat").textContent === "this page", { timeout: 5000 });
+  // B in a second Chromium, as on another laptop: a second tab of A's window would hide A, and a
+  // hidden page does not drive.
+  const laptop = await launch();
+  try {
+  const b = await openCockpit(laptop.browser, HTTP);
+  // B: who holds the seat (A, by the name it gave), the banner, and the take-over offered.
+  await b.page.waitForFunction(() => document.getElementById("seat").dataset.holder === "other", { timeout: 5000 });
+  const holderA = await text(b.page, "#seat");
+  assert.match(holderA, /^client #\d+ \(cockpit, .*opened \d\d:\d\d:\d\d\)$/);
+  assert.match(await text(b.page, '#banner li[data-kind="seat"]'), new RegExp(`^SEAT: ${holderA.replace(/[()]/g, "\\$&")} holds the pilot's seat`));
+  assert.equal(await b.page.$eval("#take-seat", (e) => e.hidden), false);
+  assert.equal(await a.page.$eval("#take-seat", (e) => e.hidden), true);
+  // B's pilot arms as on purpose with the deadman and a stick of its own: B never arms, sends
+  // nothing, and nothing but A's motion is on the wire.
+  const since = wireNext();
+  await b.page.evaluate(() => { window.__pad.buttons[4] = { pressed: false, touched: false, value: 0 }; window.__pad.axes.fill(0); });
+  await sleep(300);
+  await deadman(b.page, true);
+  await stick(b.page, 0.9); // backward, full: nothing like A's on the wire
+  await sleep(800);
+  assert.equal(await arm(b.page), "release");
+  assert.equal(await sent(b.page), 0, "B sent motion without the seat");
+  assert.match(await text(b.page, "#arm"), /another page drives: take the seat over to drive/);
+  await shotView(b.page, "seat-held");
+  // The bridge enforces it, not only the page: B's own client publishes drive past the page's check.
+  await b.page.evaluate(() => { for (let i = 0; i < 10; i++) window.cockpit.client.publish("/command/drive", { forward: -0.9 }); });
+  await b.page.waitForFunction(() => /bridge: \/command\/drive refused: org\.caracara\.Bridge\.Error\.SeatTaken: the pilot's seat is held by client #/
+    .test(document.getElementById("events").textContent), { timeout: 5000 });
+  await sleep(300);
+  const aBytes = new Set(expected);
+  assert.deepEqual(nonZeroOrders(since).filter((e) => !aBytes.has(e.data[0])), [], "B's thrust on the wire");
+  assert.ok(wireIs(expected), "A's motion held throughout");
+  // B takes the seat over (asked first): A shows it at once, stops, and its thrust is zeroed.
+  await b.page.click("#take-seat");
+  await onScreen(b.page, "#confirm-seat-yes");
+  assert.match(await text(b.page, "#confirm-seat"), new RegExp(`Take the pilot's seat from ${holderA.replace(/[()]/g, "\\$&")}\\?`));
+  const sinceTake = wireNext();
+  const takenAt = process.hrtime.bigint(); // CLOCK_MONOTONIC, as the wire log's times
+  await b.page.click("#confirm-seat-yes");
+  await a.page.waitForSelector('#banner li[data-kind="seat-lost"]', { timeout: 5000 });
+  const shownMs = Number(process.hrtime.bigint() - takenAt) / 1e6;
+  console.log(`# take-over confirmed on page B to page A's banner: ${shownMs.toFixed(0)} ms`);
+  assert.ok(shownMs <= bound("COCKPIT_SEAT_TAKEN_SHOWN_MS_MAX"), `A showed the take-over ${shownMs} ms after it`);
+  assert.match(await text(a.page, '#banner li[data-kind="seat-lost"]'), /^SEAT TAKEN OVER by client #\d+ \(cockpit, .*\) at \d\d:\d\d:\d\d: this page no longer drives/);
+  assert.equal(await arm(a.page), "release");
+  assert.match(await text(a.page, "#events"), /seat: taken over by client #/);
+  const driven = new Set(Object.keys(Y_AXIS).map((i) => DEFAULT_MT[i] >> 1));
+  const zeros = await poll(() => firstZeros(sinceTake, driven), 5000, "A's thrust zeroed at the take-over");
+  const zeroedAt = zeros.reduce((x, y) => (x > y ? x : y));
+  const zeroMs = Number(zeroedAt - takenAt) / 1e6;
+  console.log(`# take-over confirmed on page B to A's zeros on the wire: ${zeroMs.toFixed(1)} ms`);
+  assert.ok(zeroMs <= bound("COCKPIT_SEAT_TAKEN_SHOWN_MS_MAX"), `A zeroed ${zeroMs} ms after the take-over`);
+  await onScreen(a.page, '#banner li[data-kind="seat-lost"]');
+  await shotView(a.page, "seat-taken-over");
+  // A's pilot still holds the deadman and the stick: nothing from A; B not armed yet: nothing at all.
+  const sentA = await sent(a.page);
+  await sleep(700);
+  assert.equal(await sent(a.page), sentA, "A sent motion after losing the seat");
+  assert.deepEqual(nonZeroOrders(sinceTake).filter((e) => e.time_ns > zeroedAt), [],
+                   "thrust on the wire after the take-over's zeros, before B armed");
+  // B arms on purpose and drives backward with its own stick.
+  await armPad(b.page);
+  await stick(b.page, 0.5);
+  await poll(() => wireIs(forwardMotion(forwardDemand(0.5))), 10000, "B driving");
+  assert.equal(await text(b.page, "#seat"), "this page");
+  // A may take it back the same way only; B's page closed frees it (and its thrust goes).
+  await b.page.close();
+  await poll(allZero, 2000, "zero once B's page closed");
+  await a.page.waitForFunction(() => document.getElementById("seat").dataset.holder === "free", { timeout: 5000 });
+  assert.equal(await a.page.$eval("#take-seat", (e) => e.hidden), true);
+  } finally {
+    await laptop.close();
+  }
+  await deadman(a.page, false);
+  await stick(a.page, 0);
+  await a.page.close();
+});
+
 test("phone (412 px) and tablet widths: no sideways scrolling; KILL and the state on screen at every scroll position; the Clear-kill question fully on screen", async () => {
   const { page } = await open();
   for (const [w, h, name] of [[412, 915, "phone-412"], [800, 1280, "tablet-800"], [1024, 768, "tablet-1024"], [1400, 900, "desktop"]]) {
@@ -591,7 +716,6 @@ test("two tabs fetch the dive list once per change between them, not once each p
 // test_cockpit.py's rig mounts thruster 2 reversed in the simulator, with a short detection.
 const REVERSED = 2;
 const onlyOn = (thruster, value) => [...Array(MOTORS).keys()].map((i) => (i === thruster ? speedByte(value) : ZERO));
-const wireIs = (speeds) => JSON.stringify(simSpeeds()) === JSON.stringify(speeds);
 const addrOf = (i) => DEFAULT_MT[i] >> 1;
 
 // The commissioning panel scrolled to just under the sticky header.

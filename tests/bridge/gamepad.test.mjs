@@ -1,9 +1,11 @@
 // The cockpit's gamepad mapping (tools/cockpit/gamepad.js) alone, under node: the dead zone and
 // expo curve, the terms, the deadman, the clamp, and the mapping kept in (a stand-in for) the
-// browser's storage. Run by test_cockpit.py; the browser test drives the same code to the wire.
+// browser's storage; and the banner's lines of the pilot's seat (tools/cockpit/words.js). Run by
+// test_cockpit.py; the browser test drives the same code to the wire.
 import { test } from "node:test";
 import assert from "node:assert/strict";
 import { DEFAULT_MAPPING, KEY, loadMapping, parseTerms, sample, saveMapping, shape, stepGain } from "../../tools/cockpit/gamepad.js";
+import { banner } from "../../tools/cockpit/words.js";
 
 const near = (a, b) => assert.ok(Math.abs(a - b) < 1e-9, `${a} != ${b}`);
 function pad({ axes = [0, 0, 0, 0], pressed = [], values = {} } = {}) {
@@ -110,4 +112,23 @@ test("the kill and clear-kill buttons are in the mapping, each a button of its o
   assert.equal(loadMapping(st).mapping.clear_kill, 9);
   assert.throws(() => saveMapping({ ...DEFAULT_MAPPING, clear_kill: 4 }, st), /a button each/);
   assert.throws(() => saveMapping({ ...DEFAULT_MAPPING, kill: 40 }, st), /kill must be/);
+});
+
+test("the banner and the pilot's seat: who holds it when another does, a take-over from this page in red, names escaped", () => {
+  const ready = { state: "ready", failsafes: [], surfacing_ms: -1, pilot_lost_left_ms: -1, motor_test: { thruster: -1 } };
+  const base = { state: ready, up: true, lostMs: 0, killNotSentMs: null, refusal: null };
+  assert.deepEqual(banner({ ...base, seat: { holder: "", yours: false } }), [], "a free seat: nothing to say");
+  assert.deepEqual(banner({ ...base, seat: { holder: "client #1 (cockpit)", yours: true } }), [], "this page's: nothing");
+  const held = banner({ ...base, seat: { holder: "client #2 (<b>x</b>)", yours: false } });
+  assert.equal(held.length, 1);
+  assert.equal(held[0].kind, "seat");
+  assert.equal(held[0].level, "warn");
+  assert.match(held[0].text, /^SEAT: client #2 \(&lt;b&gt;x&lt;\/b&gt;\) holds the pilot's seat; this page does not drive/);
+  const at = new Date(2026, 11, 5, 14, 2, 11).getTime();
+  const lost = banner({ ...base, seat: { holder: "client #3", yours: false }, seatLost: { by: "client #3", at } });
+  assert.deepEqual(lost.map((l) => [l.kind, l.level]), [["seat-lost", "alarm"]], "the take-over said once, in red");
+  assert.equal(lost[0].text, "SEAT TAKEN OVER by client #3 at 14:02:11: this page no longer drives (its thrust was zeroed)");
+  // A refusal for want of the seat is the seat's line, not a "Motion refused" beside it.
+  assert.deepEqual(banner({ ...base, refusal: "SeatTaken", seat: { holder: "client #3", yours: false } }).map((l) => l.kind), ["seat"]);
+  assert.deepEqual(banner({ ...base, refusal: "Surfacing" }).map((l) => l.kind), ["refused"]);
 });

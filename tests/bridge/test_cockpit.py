@@ -9,6 +9,7 @@ The sticks are judged by where the simulated vehicle went (tests/e2e/vehicle_mot
 on a rig of their own whose thrusters are all mounted as configured.
 """
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -53,6 +54,16 @@ class CockpitTest(BridgeRig, unittest.TestCase):
                   CARACARA_CHROMIUM=CHROMIUM, CARACARA_ARTIFACTS=artifacts, CARACARA_FORWARD_PID=str(forward.pid),
                   CARACARA_DIVES_DIR=self.rig.dives_dir)
         self.assertIsNone(self.bridge.poll(), "the bridge survived the cockpit")
+        # The pilot's seat (cockpit.test.mjs's two pages): the refusal of the page without it and
+        # the take-over, each logged by the bridge in words, the refusal once, not once a command.
+        with open(os.path.join(self.rig.dir, "caracara-bridge.log"), errors="replace") as f:
+            log = f.read()
+        # (the page without the seat has not named itself: it names itself when it claims or takes over)
+        refused = re.findall(r"(client #\d+)(?: \([^)]*\))?: /command/drive refused: "
+                             r"org\.caracara\.Bridge\.Error\.SeatTaken: the pilot's seat is held by (client #\d+)", log)
+        self.assertTrue(refused, "the seat's refusal not logged: %s" % self.bridge_output())
+        self.assertEqual(len(refused), len(set(refused)), "a refusal logged more than once per client and holder")
+        self.assertRegex(log, r"the pilot's seat: client #\d+ \(cockpit, [^)]*\) took it over from client #\d+")
 
     def test_other_origins_and_the_forward_key_in_chromium(self):
         # Issue 46: through caracaractl bridge's forward (its key), to the rig's bridge (its Origin

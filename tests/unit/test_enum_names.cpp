@@ -22,6 +22,7 @@
 #include "sim/teensy_frame_record.hpp"
 #include "sim/teensy_model.hpp"
 #include "tests/catch.hpp"
+#include "tools/bridge/pilot_seat.hpp"
 
 #include <set>
 #include <string>
@@ -113,6 +114,8 @@ TEST_CASE("every enum's values have one name each, and each name reads back") {
     check_names<sim::I2cBusModel::Hang>("sim::I2cBusModel::Hang");
     check_names<sim::TeensyFrameOutcome>("sim::TeensyFrameOutcome");
     check_names<sim::TeensyTaskState>("sim::TeensyTaskState");
+    check_names<bridge::SeatAction>("bridge::SeatAction");
+    check_names<bridge::SeatChange>("bridge::SeatChange");
 }
 
 TEST_CASE("names that are a contract keep their spelling") {

@@ -82,7 +82,7 @@ void BridgeServer::accept() {
             return;
         }
         make_room_for_a_request();
-        auto s = std::make_shared<Session>(io_, std::move(socket), session_, telemetry_, slots_, dives_);
+        auto s = std::make_shared<Session>(io_, std::move(socket), session_, telemetry_, slots_, dives_, seat_);
         sessions_.push_back(s);
         s->start();
         accept();

@@ -3,11 +3,13 @@
 // connection becomes a Session; the Telemetry's messages go to every session. A connection
 // takes a client slot only once its request and token are good (ClientSlots); before that it
 // has a few seconds (Session), and at most kMaxWaitingForRequest wait at once (a new one
-// closes the oldest), so stalled or tokenless connections never lock out a pilot.
+// closes the oldest), so stalled or tokenless connections never lock out a pilot. One pilot's
+// seat (PilotSeat) for all of them.
 #pragma once
 
 #include "tools/bridge/client_slots.hpp"
 #include "tools/bridge/dive_worker.hpp"
+#include "tools/bridge/pilot_seat.hpp"
 #include "tools/bridge/session.hpp"
 #include "tools/bridge/telemetry.hpp"
 
@@ -48,6 +50,7 @@ private:
     Telemetry telemetry_;
     ClientSlots slots_;
     DiveWorker dives_;
+    PilotSeat seat_; // one pilot's seat for every client of this bridge: the vehicle's
     boost::asio::basic_socket_acceptor<boost::asio::generic::stream_protocol> acceptor_;
     boost::asio::steady_timer accept_retry_; // after a failed accept (no descriptor left)
     std::list<std::weak_ptr<Session>> sessions_;

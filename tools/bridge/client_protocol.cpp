@@ -1,5 +1,7 @@
 #include "tools/bridge/client_protocol.hpp"
 
+#include "tools/foxglove/channels.hpp"
+
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
@@ -22,6 +24,28 @@ std::string status_json(int level, std::string_view message, std::string_view id
     if (!id.empty())
         j["id"] = std::string(id);
     return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string ClientProtocol::server_info() {
+    return nlohmann::json{{"op", "serverInfo"},
+                          {"name", "caracara-bridge"},
+                          {"capabilities", {"clientPublish"}},
+                          {"supportedEncodings", {"json"}},
+                          {"metadata", nlohmann::json::object()}}
+        .dump();
+}
+
+std::string ClientProtocol::advertise() {
+    nlohmann::json list = nlohmann::json::array();
+    const auto& all = foxglove::channels();
+    for (std::size_t i = 0; i < all.size(); ++i)
+        list.push_back({{"id", i + 1},
+                        {"topic", all[i].topic},
+                        {"encoding", foxglove::kEncoding},
+                        {"schemaName", all[i].schema_name},
+                        {"schema", all[i].schema},
+                        {"schemaEncoding", foxglove::kSchemaEncoding}});
+    return nlohmann::json{{"op", "advertise"}, {"channels", list}}.dump();
 }
 
 const std::vector<uint32_t>& ClientProtocol::subscribers(uint32_t channel_id) const {

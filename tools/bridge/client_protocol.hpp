@@ -41,6 +41,11 @@ public:
     // channel_count: the server channels advertised, ids 1..channel_count.
     explicit ClientProtocol(std::size_t channel_count) : channel_count_(channel_count) {}
 
+    // The server's greeting to a client once upgraded: serverInfo (clientPublish, JSON) and the
+    // advertise of every channel of foxglove::channels() (ids from 1, in its order).
+    static std::string server_info();
+    static std::string advertise();
+
     Outcome on_text(std::string_view text);
     Outcome on_binary(std::span<const uint8_t> bytes);
 

@@ -1,6 +1,7 @@
 #include "tools/bridge/command.hpp"
 
 #include "core/frames.hpp"
+#include "tools/bridge/pilot_seat.hpp"
 
 #include <cmath>
 #include <limits>
@@ -147,6 +148,26 @@ std::string motor_test(const json& j, std::vector<CommandArg>& args) {
     return "";
 }
 
+// The pilot's seat: {"action": "claim" | "take-over" | "release", "name": the client in words}.
+std::string seat(const json& j, std::vector<CommandArg>& args) {
+    for (const auto& [key, _] : j.items())
+        if (key != "action" && key != "name")
+            return "seat takes \"action\" and \"name\", not '" + key + "'";
+    const auto action = j.find("action");
+    if (action == j.end() || !action->is_string() || !parse_name<SeatAction>(action->get_ref<const std::string&>()))
+        return "seat needs 'action': \"claim\", \"take-over\" or \"release\"";
+    args.emplace_back(action->get<std::string>());
+    const auto name = j.find("name");
+    if (name == j.end()) {
+        args.emplace_back(std::string());
+        return "";
+    }
+    if (!name->is_string() || !PilotSeat::valid_name(name->get_ref<const std::string&>()))
+        return "seat's 'name' must be up to " + std::to_string(PilotSeat::kMaxName) + " printable ASCII characters";
+    args.emplace_back(name->get<std::string>());
+    return "";
+}
+
 // Detection pulses eight thrusters, each after the vehicle settles (up to its settle timeout).
 constexpr std::chrono::milliseconds kDetectTimeout = std::chrono::minutes(10);
 
@@ -157,17 +178,18 @@ struct Row {
 
 using std::chrono::milliseconds;
 constexpr Row kCommands[] = {
-    {{CommandKind::Motion, "/command/motion", "SetMotion", CommandReply::None, milliseconds(0)}, motion},
-    {{CommandKind::Thrust, "/command/thrust", "SetThrust", CommandReply::None, milliseconds(0)}, thrust},
-    {{CommandKind::Kill, "/command/kill", "Kill", CommandReply::None, milliseconds(0)}, no_args},
-    {{CommandKind::ClearKill, "/command/clear_kill", "ClearKill", CommandReply::None, milliseconds(0)}, no_args},
-    {{CommandKind::Leds, "/command/leds", "SetLeds", CommandReply::None, milliseconds(0)}, leds},
-    {{CommandKind::Profile, "/command/profile", "SetProfile", CommandReply::None, milliseconds(0)}, profile},
-    {{CommandKind::MotorTest, "/command/motor_test", "MotorTest", CommandReply::None, milliseconds(0)}, motor_test},
+    {{CommandKind::Motion, "/command/motion", "SetMotion", CommandReply::None, CommandSeat::Needed, milliseconds(0)}, motion},
+    {{CommandKind::Thrust, "/command/thrust", "SetThrust", CommandReply::None, CommandSeat::Needed, milliseconds(0)}, thrust},
+    {{CommandKind::Kill, "/command/kill", "Kill", CommandReply::None, CommandSeat::Anyone, milliseconds(0)}, no_args},
+    {{CommandKind::ClearKill, "/command/clear_kill", "ClearKill", CommandReply::None, CommandSeat::Needed, milliseconds(0)}, no_args},
+    {{CommandKind::Leds, "/command/leds", "SetLeds", CommandReply::None, CommandSeat::Needed, milliseconds(0)}, leds},
+    {{CommandKind::Profile, "/command/profile", "SetProfile", CommandReply::None, CommandSeat::Needed, milliseconds(0)}, profile},
+    {{CommandKind::MotorTest, "/command/motor_test", "MotorTest", CommandReply::None, CommandSeat::Needed, milliseconds(0)}, motor_test},
     {{CommandKind::DetectDirections, "/command/detect_directions", "DetectDirections", CommandReply::Directions,
-      kDetectTimeout},
+      CommandSeat::Needed, kDetectTimeout},
      no_args},
-    {{CommandKind::Drive, "/command/drive", "SetMotion", CommandReply::None, milliseconds(0)}, drive},
+    {{CommandKind::Drive, "/command/drive", "SetMotion", CommandReply::None, CommandSeat::Needed, milliseconds(0)}, drive},
+    {{CommandKind::Seat, "/command/seat", nullptr, CommandReply::None, CommandSeat::Anyone, milliseconds(0)}, seat},
 };
 
 const Row& row(CommandKind kind) { return kCommands[static_cast<std::size_t>(kind)]; }
@@ -200,7 +222,7 @@ static_assert([] {
     for (std::size_t i = 0; i < std::size(kCommands); ++i)
         if (static_cast<std::size_t>(kCommands[i].spec.kind) != i)
             return false;
-    return std::size(kCommands) == static_cast<std::size_t>(CommandKind::Drive) + 1;
+    return std::size(kCommands) == static_cast<std::size_t>(CommandKind::Seat) + 1;
 }());
 
 } // namespace caracara::bridge

@@ -16,8 +16,13 @@
 namespace caracara::bridge {
 
 // Motion: a Twist in REP 103 body FLU (Foxglove); Drive: a pilot's words (the cockpit). Both are
-// SetMotion, converted by core/frames (docs/frames.md).
-enum class CommandKind : uint8_t { Motion, Thrust, Kill, ClearKill, Leds, Profile, MotorTest, DetectDirections, Drive };
+// SetMotion, converted by core/frames (docs/frames.md). Seat: the bridge's own pilot's seat
+// (tools/bridge/pilot_seat.hpp), no D-Bus call.
+enum class CommandKind : uint8_t { Motion, Thrust, Kill, ClearKill, Leds, Profile, MotorTest, DetectDirections, Drive, Seat };
+
+// Who may send a command: only the client in the pilot's seat (taking it when free), or anyone
+// (a kill, and asking for the seat).
+enum class CommandSeat : uint8_t { Needed, Anyone };
 
 // What a successful reply carries back to the client that sent the command.
 enum class CommandReply : uint8_t {
@@ -25,7 +30,7 @@ enum class CommandReply : uint8_t {
     Directions, // DetectDirections' a(sddddd)s, as JSON (docs/foxglove.md)
 };
 
-// One D-Bus argument: int32 'i', byte 'y', double 'd', string 's', int32 array 'ai'.
+// One D-Bus argument (a Seat command's: its action's name, then the client's name or ""): int32 'i', byte 'y', double 'd', string 's', int32 array 'ai'.
 using CommandArg = std::variant<int32_t, uint8_t, double, std::string, std::vector<int32_t>>;
 
 struct Command {
@@ -41,8 +46,9 @@ struct CommandParse {
 struct CommandSpec {
     CommandKind kind;
     std::string_view topic;           // "/command/motion"
-    const char* member;               // the org.caracara.Vehicle1 method
+    const char* member;               // the org.caracara.Vehicle1 method; null: the bridge's own (Seat)
     CommandReply reply;
+    CommandSeat seat;
     std::chrono::milliseconds timeout; // the reply's; 0: sd-bus's default (25 s)
 };
 

@@ -49,6 +49,7 @@ std::string directions_json(sd_bus_message* m) {
 struct CommandLink::Pending {
     CommandLink* link;
     CommandKind kind;
+    bool quiet;
 };
 
 CommandLink::CommandLink(boost::asio::io_context& io, const caracara::dbus::BusChoice& bus, Refused on_refused,
@@ -74,6 +75,8 @@ int CommandLink::on_reply(sd_bus_message* m, void* userdata, sd_bus_error*) {
     auto* p = static_cast<Pending*>(userdata);
     const CommandSpec& spec = command_spec(p->kind);
     if (sd_bus_message_is_method_error(m, nullptr)) {
+        if (p->quiet)
+            return 0;
         const sd_bus_error* e = sd_bus_message_get_error(m);
         p->link->on_refused_(spec.topic, e && e->name ? e->name : "", e && e->message ? e->message : "");
         return 0;
@@ -91,7 +94,7 @@ int CommandLink::on_reply(sd_bus_message* m, void* userdata, sd_bus_error*) {
     return 0;
 }
 
-void CommandLink::send(const Command& c) {
+void CommandLink::send(const Command& c, bool quiet) {
     const CommandSpec& spec = command_spec(c.kind);
     sd_bus_message* raw = nullptr;
     int r = sd_bus_message_new_method_call(bus_.get(), &raw, names::kBusName, names::kRootPath, names::kVehicleIface,
@@ -102,7 +105,7 @@ void CommandLink::send(const Command& c) {
     for (const CommandArg& arg : c.args)
         if (r >= 0)
             r = std::visit(Append{call.get()}, arg);
-    auto* pending = new Pending{this, c.kind};
+    auto* pending = new Pending{this, c.kind, quiet};
     sd_bus_slot* slot = nullptr;
     const auto timeout_us = static_cast<uint64_t>(std::chrono::microseconds(spec.timeout).count());
     if (r >= 0)

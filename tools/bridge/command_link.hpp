@@ -28,7 +28,9 @@ public:
                 Answered on_answered, std::function<void()> on_lost);
     ~CommandLink();
 
-    void send(const Command& c);
+    // quiet: a refusal is not told (the bridge's own zero at a take-over of the seat, which a
+    // killed vehicle refuses with nothing to stop).
+    void send(const Command& c, bool quiet = false);
     // The connection's unique bus name (the daemon's Controller when this client commands).
     std::string unique_name() const;
 

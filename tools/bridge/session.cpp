@@ -71,34 +71,14 @@ bool offers_subprotocol(const http::request<http::string_body>& req) {
     return false;
 }
 
-std::string server_info() {
-    return nlohmann::json{{"op", "serverInfo"},
-                          {"name", "caracara-bridge"},
-                          {"capabilities", {"clientPublish"}},
-                          {"supportedEncodings", {"json"}},
-                          {"metadata", nlohmann::json::object()}}
-        .dump();
-}
-
-std::string advertise() {
-    nlohmann::json list = nlohmann::json::array();
-    const auto& all = fg::channels();
-    for (std::size_t i = 0; i < all.size(); ++i)
-        list.push_back({{"id", i + 1},
-                        {"topic", all[i].topic},
-                        {"encoding", fg::kEncoding},
-                        {"schemaName", all[i].schema_name},
-                        {"schema", all[i].schema},
-                        {"schemaEncoding", fg::kSchemaEncoding}});
-    return nlohmann::json{{"op", "advertise"}, {"channels", list}}.dump();
-}
-
 } // namespace
 
 Session::Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry,
-                 ClientSlots& slots, DiveWorker& dives)
+                 ClientSlots& slots, DiveWorker& dives, PilotSeat& seat)
     : io_(io), ws_(std::move(socket)), timer_(io), config_(config), telemetry_(telemetry), slots_(slots),
-      dives_(dives), protocol_(fg::channels().size()), queue_(config.max_queued, config.max_reply_bytes) {}
+      dives_(dives), seat_(seat, {[this](std::string t) { send_text(std::move(t)); },
+                                  [this](const Command& c) { if (link_) link_->send(c, true); }, [this] { renew_link(); }}),
+      protocol_(fg::channels().size()), queue_(config.max_queued, config.max_reply_bytes) {}
 
 void Session::start() {
     close_after(kRequestTimeout);
@@ -203,14 +183,7 @@ void Session::on_request(boost::system::error_code ec) {
         return reject(http::status::service_unavailable,
                       "caracara-bridge: " + std::to_string(slots_.max()) + " clients are connected already");
     try {
-        link_ = std::make_unique<CommandLink>(
-            io_, config_.bus,
-            [this](std::string_view topic, const std::string& name, const std::string& message) {
-                send_text(status_json(2, std::string(topic) + " refused: " + name + (message.empty() ? "" : ": " + message)));
-            },
-            [this](std::string_view topic, const std::string& json) { send_text(status_json(0, json, topic)); },
-            // Not from inside the link's own processing: the session ends on the next turn.
-            [this] { boost::asio::post(io_, [self = shared_from_this()] { self->end("the bus connection closed"); }); });
+        open_link();
     } catch (const std::exception& e) {
         return reject(http::status::service_unavailable, std::string("caracara-bridge: ") + e.what());
     }
@@ -227,13 +200,35 @@ void Session::on_request(boost::system::error_code ec) {
     ws_.async_accept(request_, [self = shared_from_this()](boost::system::error_code e) { self->on_accept(e); });
 }
 
+void Session::open_link() {
+    link_ = std::make_unique<CommandLink>(
+        io_, config_.bus,
+        [this](std::string_view topic, const std::string& name, const std::string& message) {
+            send_text(status_json(2, std::string(topic) + " refused: " + name + (message.empty() ? "" : ": " + message)));
+        },
+        [this](std::string_view topic, const std::string& json) { send_text(status_json(0, json, topic)); },
+        // Not from inside the link's own processing: the session ends on the next turn.
+        [this] { boost::asio::post(io_, [self = shared_from_this()] { self->end("the bus connection closed"); }); });
+}
+
 void Session::on_accept(boost::system::error_code ec) {
     if (ec)
         return end("handshake failed");
     open_ = true;
-    send_text(server_info());
-    send_text(advertise());
+    send_text(ClientProtocol::server_info());
+    send_text(ClientProtocol::advertise());
+    seat_.join(); // told who holds the pilot's seat now and at each change
     read();
+}
+
+void Session::renew_link() {
+    // The old connection goes: caracarad zeroes what it commanded, ends its motor test or detection.
+    link_.reset();
+    try {
+        open_link();
+    } catch (const std::exception&) {
+        end("its bus connection could not be opened again after it lost the pilot's seat");
+    }
 }
 
 void Session::read() {
@@ -266,7 +261,9 @@ void Session::on_frame(boost::system::error_code ec) {
 void Session::handle(const Outcome& outcome) {
     for (const std::string& reply : outcome.replies)
         send_text(reply);
-    if (outcome.command && link_)
+    if (outcome.command && outcome.command->kind == CommandKind::Seat)
+        seat_.ask(*outcome.command);
+    else if (outcome.command && seat_.allows(*outcome.command) && link_)
         link_->send(*outcome.command);
     for (const uint32_t channel : outcome.subscribed)
         if (const Payload latest = telemetry_.latest(channel - 1))
@@ -326,8 +323,9 @@ void Session::end(const char* why, bool tell_client) {
     if (ended_)
         return;
     ended_ = true;
-    // The pilot's D-Bus connection goes now: caracarad zeroes what this client commanded.
+    // The pilot's D-Bus connection goes now: caracarad zeroes what this client commanded; then the seat is free.
     link_.reset();
+    seat_.leave();
     if (why)
         std::fprintf(stderr, "caracara-bridge: closing a client: %s\n", why);
     if (!tell_client || !open_) {

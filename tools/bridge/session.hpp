@@ -7,12 +7,15 @@
 // with the reason. It takes one of the client slots only once its request and token are
 // good; /dives/ requests are answered by the DiveWorker. When it goes (closed, dropped,
 // refused), its D-Bus connection closes with it, and caracarad zeroes the thrust it commanded.
+// Its commands but Kill need the pilot's seat (SeatGate); when it loses the seat its D-Bus
+// connection is replaced, so caracarad zeroes what it commanded at once.
 #pragma once
 
 #include "tools/bridge/client_protocol.hpp"
 #include "tools/bridge/client_slots.hpp"
 #include "tools/bridge/command_link.hpp"
 #include "tools/bridge/origin_check.hpp"
+#include "tools/bridge/seat_gate.hpp"
 #include "tools/bridge/send_queue.hpp"
 #include "tools/bridge/telemetry.hpp"
 
@@ -47,7 +50,7 @@ public:
     using Socket = boost::asio::generic::stream_protocol::socket;
 
     Session(boost::asio::io_context& io, Socket socket, const SessionConfig& config, Telemetry& telemetry,
-            ClientSlots& slots, DiveWorker& dives);
+            ClientSlots& slots, DiveWorker& dives, PilotSeat& seat);
     void start();
     // Still waiting for its HTTP request (BridgeServer bounds these apart from the client slots).
     bool waiting_for_request() const { return !got_request_; }
@@ -71,6 +74,10 @@ private:
     void read();
     void on_frame(boost::system::error_code ec);
     void handle(const Outcome& outcome);
+    // A new D-Bus connection for this client's commands (throws when the bus cannot be reached).
+    void open_link();
+    // The connection replaced by a new one when this client no longer holds the seat.
+    void renew_link();
     void send_text(std::string text);
     void queue(Frame f);
     void write_next();
@@ -86,6 +93,7 @@ private:
     Telemetry& telemetry_;
     ClientSlots& slots_;
     DiveWorker& dives_;
+    SeatGate seat_; // joined from the upgrade on
     std::shared_ptr<void> slot_; // a client slot, held from the upgrade on
     boost::beast::flat_buffer buffer_;
     boost::beast::http::request<boost::beast::http::string_body> request_;

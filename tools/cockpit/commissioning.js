@@ -164,12 +164,13 @@ export class Commissioning {
     return false;
   }
 
-  // The connection closed: the daemon ended a detection of this connection (Busy) and zeroed its test.
-  lost() {
+  // The connection closed, or the seat went to another page (the bridge replaced this page's
+  // connection): the daemon ended a detection of that connection (Busy) and zeroed its test.
+  lost(why = "the connection to the bridge closed") {
     this.stop();
     if (this.detecting) {
       this.detectEnded("lost");
-      this.$("detect-status").textContent = "ended: the connection to the bridge closed";
+      this.$("detect-status").textContent = `ended: ${why}`;
     }
   }
 

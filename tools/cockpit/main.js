@@ -19,12 +19,19 @@ let lastMessageAt = 0;     // performance.now() of the last message from the bri
 let connected = false;
 let lostAt = null;         // performance.now() when the link was first seen lost; null while fresh
 // Arming on purpose (docs/cockpit.md): after a page load, a reconnect, a kill, a Clear kill, a
-// state other than ready or a refused motion command, nothing is sent until the pilot has
-// released the deadman with the sticks centred ("release") and pressed it again ("press").
+// state other than ready, a refused motion command, the gamepad gone or another one, the page
+// hidden, or the pilot's seat lost, nothing is sent until the pilot has released the deadman
+// with the sticks centred ("release") and pressed it again ("press").
 const ARM_RELEASE = "release", ARM_PRESS = "press", ARM_ARMED = "armed";
+// The pilot's seat (docs/cockpit.md): the bridge lets one client command at a time and tells
+// every client who holds it, in a status whose id is this topic.
+const SEAT_TOPIC = "/command/seat";
+// How this page is named to the others (the bridge takes up to 64 printable ASCII characters).
+const PAGE_NAME = `cockpit, ${navigator.platform || "a browser"}, opened ${new Date().toTimeString().slice(0, 8)}`
+  .replace(/[^\x20-\x7e]/g, " ").slice(0, 64);
 const cockpit = { state: null, motors: null, thrusters: [], teensy: null, i2c: null, sent: 0, kills: 0,
   arm: ARM_RELEASE, killNotSentAt: null, refusal: null, clearHeldSince: null, connects: 0,
-  stateAt: 0, pilotLostMs: null };
+  stateAt: 0, pilotLostMs: null, seat: null, seatLost: null, pad: null, name: PAGE_NAME };
 window.cockpit = cockpit;  // for the tests and the curious
 const dives = new DiveList($("dives"), $("dive-plot"), token);
 const commissioning = new Commissioning((topic, obj) => client?.publish(topic, obj) ?? false,
@@ -42,7 +49,7 @@ const fresh = () => connected && lastMessageAt !== 0 && performance.now() - last
 let retries = 0;
 function connect() {
   client = new FoxgloveClient(wsUrl, {
-    onOpen: () => { connected = true; retries = 0; cockpit.connects++; disarm(); },
+    onOpen: () => { connected = true; retries = 0; cockpit.connects++; cockpit.seat = null; disarm(); },
     onMessage: (topic, msg) => { lastMessageAt = performance.now(); show(topic, msg); },
     onStatus: (level, text, id) => bridgeStatus(level, text, id),
     onClose: () => {
@@ -50,6 +57,7 @@ function connect() {
       commissioning.lost();
       // What the vehicle is now is unknown: the old state is not kept as if it were current.
       cockpit.state = null;
+      cockpit.seat = null; // the seat goes with the connection: the bridge frees it
       disarm();
       // Soon the first time (a dropped connection comes back within pilot-lost's persistence), then calmly.
       setTimeout(connect, retries++ ? 2000 : 250);
@@ -61,6 +69,7 @@ function connect() {
 // A refusal of the bridge or the daemon: a motion command refused (a failsafe's ascent, a kill
 // on the way) stops the sending and makes one event, not one per command.
 function bridgeStatus(level, text, id) {
+  if (id === SEAT_TOPIC) return seatNews(JSON.parse(text));
   if (id && commissioning.answer(id, text)) return;
   commissioning.refused(text); // shown in its panel, and logged below
   const refused = /^\/command\/(drive|motion|thrust) refused: \S*?([A-Za-z]+)(?::|$)/.exec(text);
@@ -71,6 +80,37 @@ function bridgeStatus(level, text, id) {
     if (!first) return;
   }
   logEvent(level >= 2 ? 4 : 2, "bridge", text, Date.now());
+}
+
+// The seat as the bridge says: {holder ("" free), yours, change, by}. Lost to another page's
+// take-over: said at once in the banner, and this page arms anew (it no longer drives).
+function seatNews(n) {
+  const had = cockpit.seat?.yours;
+  cockpit.seat = n;
+  if (n.yours) cockpit.seatLost = null;
+  if (had && !n.yours) {
+    driving = false; // its connection was replaced: the bridge zeroed what it commanded
+    disarm();
+    commissioning.lost("the pilot's seat was taken over");
+    if (n.change === "taken-over") {
+      cockpit.seatLost = { by: n.by, at: Date.now() };
+      logEvent(4, "seat", `taken over by ${n.by}: this page no longer drives`, Date.now());
+    }
+  } else if (n.change !== "now" && !n.yours) {
+    logEvent(2, "seat", n.holder ? `${n.holder} holds the pilot's seat` : `the pilot's seat is free (${n.by} ${n.change})`, Date.now());
+  }
+  showSeat();
+  showArming();
+}
+// This page may command: the seat is its own, or free (its first command takes it).
+const seatOpen = () => Boolean(cockpit.seat && (cockpit.seat.yours || cockpit.seat.holder === ""));
+
+function showSeat() {
+  const n = cockpit.seat;
+  const other = Boolean(connected && n && n.holder && !n.yours);
+  $("seat").textContent = !connected || !n ? "unknown" : n.yours ? "this page" : n.holder || "free";
+  $("seat").dataset.holder = !connected || !n ? "unknown" : n.yours ? "this page" : n.holder ? "other" : "free";
+  $("take-seat").hidden = !other;
 }
 
 function showLink() {
@@ -86,6 +126,7 @@ function showLink() {
   el.textContent = up ? "connected"
     : `${connected ? "NO DATA" : "CONNECTION LOST"}${age === null ? "" : ` — last message ${age} s ago`}`;
   showStateWords(up);
+  showSeat();
   showBanner(up);
   showArming();
 }
@@ -94,9 +135,11 @@ function showLink() {
 function showStateWords(up) {
   const m = cockpit.state;
   const state = up && m ? m.state : "unknown";
-  $("state").textContent = state;
-  $("state").className = `state ${state}`;
-  $("state").title = m && !up ? `last known: ${m.state}` : "";
+  // A failsafe's ascent drives the vehicle: the daemon's "ready" is no pilot's, and not shown as such.
+  const shown = state === "ready" && surfacing(m) ? "surfacing" : state;
+  $("state").textContent = shown;
+  $("state").className = `state ${shown}`;
+  $("state").title = m && !up ? `last known: ${m.state}` : shown !== state ? "a failsafe drives the vehicle up (the daemon's state: ready)" : "";
   const source = up && m ? m.kill_source : "";
   $("kill-source").textContent = up && m ? killSourceWords(source) : "unknown";
   $("kill-source").dataset.source = source;
@@ -108,6 +151,7 @@ function showBanner(up) {
     state: cockpit.state, up, lostMs: lostAt === null ? 0 : performance.now() - lostAt,
     killNotSentMs: cockpit.killNotSentAt === null ? null : performance.now() - cockpit.killNotSentAt,
     refusal: cockpit.refusal, sinceStateMs: performance.now() - cockpit.stateAt, pilotLostMs: cockpit.pilotLostMs,
+    seat: connected ? cockpit.seat : null, seatLost: cockpit.seatLost,
   });
   const list = $("banner");
   const html = items.map((i) => `<li class="${i.level}" data-kind="${i.kind}">${i.text}</li>`).join("");
@@ -121,7 +165,8 @@ function showArming() {
   let text = "";
   if (!p) text = "no gamepad";
   else if (!fresh() || cockpit.state?.state !== "ready") text = "not ready: nothing is sent";
-  else if (cockpit.state.surfacing_ms >= 0) text = "surfacing: the vehicle refuses motion";
+  else if (surfacing(cockpit.state)) text = "surfacing: the vehicle refuses motion";
+  else if (!seatOpen()) text = cockpit.seat ? "another page drives: take the seat over to drive" : "waiting for the seat";
   else if (cockpit.arm === ARM_RELEASE) text = "to drive: release the deadman and centre the sticks";
   else if (cockpit.arm === ARM_PRESS) text = "to drive: press the deadman";
   else text = "armed: the deadman drives";
@@ -146,6 +191,9 @@ function show(topic, m) {
   }
 }
 
+// A surface failsafe's ascent runs (the daemon refuses motion meanwhile).
+const surfacing = (m) => Boolean(m && (m.surfacing_ms >= 0 || m.ascent_left_ms >= 0));
+
 function showState(m) {
   const before = cockpit.state;
   cockpit.state = m;
@@ -153,9 +201,9 @@ function showState(m) {
   // Configuration, not state: kept through a lost link, whose countdown it is.
   if (m.pilot_lost_ms >= 0) cockpit.pilotLostMs = m.pilot_lost_ms;
   // Not ready, or surfacing: what was armed is no more; the same once it changed under us.
-  if (m.state !== "ready" || m.surfacing_ms >= 0 || (before && before.state !== "ready")) disarm();
+  if (m.state !== "ready" || surfacing(m) || (before && before.state !== "ready")) disarm();
   if (m.state === "killed") cockpit.killNotSentAt = null; // killed after all (another pilot, the vehicle)
-  if (m.state === "ready" && m.surfacing_ms < 0 && before?.state !== "ready") cockpit.refusal = null;
+  if (m.state === "ready" && !surfacing(m) && before?.state !== "ready") cockpit.refusal = null;
   showStateWords(fresh());
   showArming();
   $("budget").textContent = m.budget_limit;
@@ -283,6 +331,20 @@ $("clear-kill").addEventListener("click", () => {
 $("confirm-clear").addEventListener("close", () => {
   if ($("confirm-clear").returnValue === "clear") clearKill();
 });
+// Taking the seat from another page is asked first; that page hears of it at once and stops.
+$("take-seat").addEventListener("click", () => {
+  const dialog = $("confirm-seat");
+  if (dialog.open) return;
+  $("confirm-seat-holder").textContent = cockpit.seat?.holder || "another client";
+  dialog.returnValue = "";
+  dialog.showModal();
+});
+$("confirm-seat").addEventListener("close", () => {
+  if ($("confirm-seat").returnValue !== "take") return;
+  disarm(); // drives only once armed on purpose, as after any change
+  if (client?.publish(SEAT_TOPIC, { action: "take-over", name: cockpit.name }))
+    logEvent(3, "cockpit", `took the pilot's seat over from ${cockpit.seat?.holder || "nobody"}`, Date.now());
+});
 
 // --- gamepad -------------------------------------------------------------------------------------
 let { mapping, notice: mappingNotice } = loadMapping();
@@ -326,9 +388,12 @@ function stopDriving() {
 function tick() {
   const p = document.visibilityState === "visible" ? pad() : null;
   $("pad").textContent = p ? p.id || "gamepad" : "no gamepad";
+  // Unplugged, hidden or another gamepad: what was armed is no more (armed again on purpose).
+  const key = p ? `${p.index}:${p.id}` : null;
+  if (key !== cockpit.pad) { cockpit.pad = key; disarm(); }
   if (!p) {
     cockpit.clearHeldSince = null;
-    return stopDriving();
+    return disarm();
   }
   // The gain and kill buttons act on their press, not while held.
   const press = (i) => Boolean(p.buttons[i]?.pressed);
@@ -348,7 +413,7 @@ function tick() {
   const s = sample(p, mapping);
   $("pad-motion").textContent = AXES.map((a) => `${AXIS_WORDS[a]} ${s.motion[a].toFixed(2)}`).join(" · ");
   // Not ready (killed, arming, fault, surfacing, link lost): nothing to send, and arming again.
-  const ready = fresh() && cockpit.state?.state === "ready" && !(cockpit.state.surfacing_ms >= 0);
+  const ready = fresh() && cockpit.state?.state === "ready" && !surfacing(cockpit.state) && seatOpen();
   if (!ready) {
     if (cockpit.arm !== ARM_RELEASE) cockpit.arm = ARM_RELEASE;
     return stopDriving();
@@ -357,6 +422,8 @@ function tick() {
   else if (cockpit.arm === ARM_PRESS && s.held && s.centred) {
     cockpit.arm = ARM_ARMED;
     cockpit.refusal = null; // armed again on purpose: a new refusal makes a new event
+    // A free seat is claimed (named) before the first motion; refused if another page took it first.
+    if (!cockpit.seat.yours) client?.publish(SEAT_TOPIC, { action: "claim", name: cockpit.name });
   }
   if (!s.held || cockpit.arm !== ARM_ARMED) return stopDriving();
   driving = true;
@@ -366,9 +433,11 @@ function tick() {
 }
 
 document.addEventListener("visibilitychange", () => {
-  if (document.visibilityState !== "visible") { stopDriving(); commissioning.release(); }
+  if (document.visibilityState !== "visible") { disarm(); commissioning.release(); }
 });
-window.addEventListener("gamepaddisconnected", () => stopDriving());
+// Between two ticks too: a gamepad unplugged and plugged back arms anew.
+window.addEventListener("gamepaddisconnected", () => disarm());
+window.addEventListener("gamepadconnected", () => disarm());
 window.addEventListener("pagehide", () => { stopDriving(); commissioning.release(); client?.close(); });
 
 // The mapping's motions as the page labels them.

@@ -45,10 +45,18 @@ const secondsLeft = (leftMs, sinceMs) => (Math.max(0, leftMs - sinceMs) / 1000).
 
 // [{kind, level, text}]: what keeps the vehicle from doing what the pilot asks, most urgent first.
 // `sinceStateMs`: how long ago the state came (its countdowns run on); `pilotLostMs`: the
-// daemon's pilot-lost persistence as last heard (null before the first state).
-export function banner({ state, up, lostMs, killNotSentMs, refusal, sinceStateMs = 0, pilotLostMs = null }) {
+// daemon's pilot-lost persistence as last heard (null before the first state); `seat`: the
+// bridge's last word on the pilot's seat (null: none, or no link); `seatLost`: {by, at (ms since
+// the epoch)} when another client took it over from this page.
+export function banner({ state, up, lostMs, killNotSentMs, refusal, sinceStateMs = 0, pilotLostMs = null, seat = null,
+  seatLost = null }) {
   const out = [];
   const add = (kind, level, text) => out.push({ kind, level, text: escape(text) });
+  if (seatLost && !seat?.yours)
+    add("seat-lost", "alarm", `SEAT TAKEN OVER by ${seatLost.by} at ${new Date(seatLost.at).toTimeString().slice(0, 8)}: ` +
+      "this page no longer drives (its thrust was zeroed)");
+  else if (seat?.holder && !seat.yours)
+    add("seat", "warn", `SEAT: ${seat.holder} holds the pilot's seat; this page does not drive (Take over… to drive)`);
   if (killNotSentMs !== null)
     add("kill-not-sent", "alarm", `KILL NOT SENT ${(killNotSentMs / 1000).toFixed(0)} s ago: no link to the bridge. ` +
       "Press KILL again once connected, or use the kill switch");
@@ -80,7 +88,7 @@ export function banner({ state, up, lostMs, killNotSentMs, refusal, sinceStateMs
   }
   if (state.motor_test?.thruster >= 0)
     add("motor-test", "warn", `MOTOR TEST: thruster ${state.motor_test.thruster} at ${state.motor_test.value}, the others held at zero`);
-  if (refusal && state.state === "ready" && !(state.surfacing_ms >= 0))
+  if (refusal && refusal !== "SeatTaken" && state.state === "ready" && !(state.surfacing_ms >= 0))
     add("refused", "warn", `Motion refused (${refusal}): release the deadman, centre the sticks and press it again`);
   return out;
 }
