@@ -112,3 +112,38 @@ TEST_CASE("the failsafe table: teensy-link-lost keeps the kill while it holds, b
     rig.daemon().failsafes().push(FailsafeCondition::TeensyLinkLost, false, "test: back");
     CHECK(rig.vehicle().clear_kill().ok());
 }
+
+TEST_CASE("safety-line-lost: the kill output gone under a running vehicle kills, source device, until it is back") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    rig.run_for(60);
+    rig.wire().clear();
+    rig.gpio().set_outputs_gone(true); // found by the outputs' read-back (every 100 ms)
+    REQUIRE(rig.run_until([&] { return rig.vehicle().safety().state() == SafetyState::Killed; }));
+    CHECK(rig.vehicle().kill_source_name() == "device");
+    CHECK(rig.vehicle().safety().kill_reason() == "kill output went away");
+    REQUIRE(rig.run_until([&] { return zeroed_after(rig.wire().events(), 0); }));
+    CHECK(rig.vehicle().clear_kill().status == Status::Hardware);
+    rig.gpio().set_outputs_gone(false); // asked for again once a second: back asserted, and cleared
+    REQUIRE(rig.run_until([&] { return rig.daemon().failsafes().active().empty(); }, 3000));
+    CHECK(rig.vehicle().clear_kill().ok());
+}
+
+TEST_CASE("safety-line-lost: a kill output that fails as a Kill asserts it is decided after that kill, not inside it") {
+    DaemonRig rig;
+    rig.run_until_ready();
+    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    rig.run_for(60);
+    rig.wire().clear();
+    rig.gpio().set_outputs_gone(true);
+    CHECK(rig.vehicle().kill(KillSource::DBus, "test").ok());
+    // The Kill's own sequence ran to its end: killed by D-Bus, its zeros handed down.
+    CHECK(rig.vehicle().kill_source_name() == "dbus");
+    CHECK(rig.daemon().failsafes().active().empty()); // not yet: right after the sequence
+    REQUIRE(rig.run_until([&] { return !rig.daemon().failsafes().active().empty(); }, 500));
+    CHECK(rig.daemon().failsafes().active()[0].condition == FailsafeCondition::SafetyLineLost);
+    CHECK(rig.vehicle().kill_source_name() == "dbus"); // the first kill's source is kept
+    REQUIRE(rig.run_until([&] { return zeroed_after(rig.wire().events(), 0); }));
+    rig.gpio().set_outputs_gone(false);
+}
