@@ -51,16 +51,15 @@ void FailsafeMonitor::push(FailsafeCondition c, bool holds, std::string_view rea
     if (holds)
         reasons_[static_cast<std::size_t>(c)] = reason;
     pushed_.push_back({c, holds});
+    if (!started_)
+        return; // decided at start
     // Inside a decision, whose kill is under way (the kill output lost as it was asserted, the
-    // pilots forgotten by the kill): decided at the next reading, as the thruster conditions
-    // are, so that a raised failsafe is announced before its condition clears. Before start:
-    // decided at start.
-    if (deciding_ || !started_)
-        return;
-    // Inside the Vehicle's own sequence (a ClearKill's or a D-Bus Kill's line write failed):
-    // decided as soon as that sequence returns to the loop, never halfway through it.
-    if (vehicle_.acting()) {
-        if (deferred_)
+    // pilots forgotten by the kill), or inside another of the Vehicle's sequences (a ClearKill's
+    // or a D-Bus Kill's line write failed): never halfway through it, but as soon as it returns
+    // to the loop; a condition that cleared during a decision (the pilots its kill forgot) at the
+    // next reading, as the thruster conditions do, so that the raised failsafe is announced first.
+    if (deciding_ || vehicle_.acting()) {
+        if ((holds || !deciding_) && deferred_)
             sd_event_source_set_enabled(deferred_.get(), SD_EVENT_ONESHOT);
         return;
     }

@@ -5,9 +5,9 @@
 // core/failsafe.hpp's kFailsafeTable). What the policy raises is carried out here (exclude; a
 // kill with the row's kill source; a surface by the FailsafeAscent) and told everywhere by
 // the FailsafeReport (VehicleEvents: D-Bus, the dive recorder, STATUS=; the journal, one line
-// per transition). A push that comes while this object's kill is carried out (the kill output
-// lost as it is asserted) is decided at the next reading, one inside another of the Vehicle's
-// sequences right after it: never halfway through a kill.
+// per transition). A push that comes while a kill is carried out (this object's, or another of
+// the Vehicle's sequences: the kill output lost as it is asserted) is decided right after it,
+// never halfway through it; one that clears during this object's own kill, at the next reading.
 #pragma once
 
 #include "core/failsafe_policy.hpp"
@@ -75,7 +75,7 @@ private:
     static int on_timer(sd_event_source* s, uint64_t usec, void* userdata);
     static int on_deferred(sd_event_source* s, void* userdata);
     // The re-entrancy guard: `ts` and every push waiting decided, what has held for its
-    // persistence time raised, and carried out; a push that comes meanwhile waits for the next.
+    // persistence time raised, and carried out; a push that comes meanwhile waits (push()).
     // `keep_ascent`: the ascent's reading too (the timer's).
     void decide(FailsafeTransitions ts, uint64_t now, bool keep_ascent);
     void carry_out(const FailsafeTransitions& ts, uint64_t now);
