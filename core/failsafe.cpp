@@ -22,17 +22,9 @@ FailsafeClearing condition_clearing(FailsafeCondition c) {
 }
 
 std::array<FailsafeRule, kFailsafeConditionCount> FailsafeSettings::default_rules() {
-    // Why each, for a slightly buoyant vehicle: daemon/caracarad.toml.example.
     std::array<FailsafeRule, kFailsafeConditionCount> r{};
-    r[static_cast<std::size_t>(FailsafeCondition::WaterDetect)] = {FailsafeAction::Surface, 2000};
-    r[static_cast<std::size_t>(FailsafeCondition::GroundFault)] = {FailsafeAction::Exclude, 500};
-    r[static_cast<std::size_t>(FailsafeCondition::Overtemp)] = {FailsafeAction::Exclude, 2000};
-    r[static_cast<std::size_t>(FailsafeCondition::Stall)] = {FailsafeAction::Exclude, 1000};
-    r[static_cast<std::size_t>(FailsafeCondition::Hall)] = {FailsafeAction::Exclude, 1000};
-    for (std::size_t i = static_cast<std::size_t>(FailsafeCondition::PilotLost); i < kFailsafeConditionCount; ++i)
-        r[i] = {FailsafeAction::Kill, 0};
-    // The only fixed one with a persistence of its own: the lost pilot's thrust is already zero.
-    r[static_cast<std::size_t>(FailsafeCondition::PilotLost)].persistence_ms = kPilotLostPersistenceMs;
+    for (const FailsafeRow& row : kFailsafeTable)
+        r[static_cast<std::size_t>(row.condition)] = row.default_rule;
     return r;
 }
 

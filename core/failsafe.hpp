@@ -1,10 +1,13 @@
 // Failsafes: a condition, the action it takes and how long it must hold first (the
 // [failsafe] table; daemon/caracarad.toml.example gives the defaults and why). The five
-// thruster conditions are the SeaBotix FAULT bits (SeaBotix IDS 8.4.2); the other five are
-// the daemon's own safety conditions, fixed at kill.
+// thruster conditions are the SeaBotix FAULT bits (SeaBotix IDS 8.4.2); the other six are
+// the daemon's own safety conditions, fixed at kill. kFailsafeTable below is what kills the
+// vehicle by itself: every automatic kill is one of its rows, raised by the source named
+// there and carried out by the FailsafeMonitor (daemon/failsafe), the one automatic killer.
 #pragma once
 
 #include "core/enum_names.hpp"
+#include "core/safety_state.hpp"
 
 #include <array>
 #include <cstddef>
@@ -27,8 +30,9 @@ enum class FailsafeCondition : uint8_t {
     BusLost,
     TeensyLinkLost,
     KillSwitchUnreadable,
+    SafetyLineLost,
 };
-inline constexpr std::size_t kFailsafeConditionCount = 10;
+inline constexpr std::size_t kFailsafeConditionCount = 11;
 inline constexpr std::size_t kThrusterConditionCount = 5; // WaterDetect..Hall
 inline constexpr std::array<FailsafeCondition, kThrusterConditionCount> kThrusterConditions{
     FailsafeCondition::WaterDetect, FailsafeCondition::GroundFault, FailsafeCondition::Overtemp,
@@ -50,6 +54,7 @@ struct EnumNames<FailsafeCondition> {
         {FailsafeCondition::BusLost, "bus-lost"},
         {FailsafeCondition::TeensyLinkLost, "teensy-link-lost"},
         {FailsafeCondition::KillSwitchUnreadable, "kill-switch-unreadable"},
+        {FailsafeCondition::SafetyLineLost, "safety-line-lost"},
     }};
 };
 template <>
@@ -77,6 +82,50 @@ constexpr bool condition_has_persistence(FailsafeCondition c) {
 }
 inline constexpr uint32_t kPilotLostPersistenceMs = 5000; // why: daemon/caracarad.toml.example
 inline constexpr uint32_t kPilotLostPersistenceMaxMs = 60000;
+
+struct FailsafeRule {
+    FailsafeAction action = FailsafeAction::Warn;
+    uint32_t persistence_ms = 0; // the condition must hold this long before the action
+};
+
+// One row per condition: its default rule and the source a kill by it carries (the journal's
+// "KILLED by", D-Bus KillSource, the dive file). The thruster rows are read from each status
+// reply by the FailsafeMonitor; every other row is pushed (holds / clears) by the object
+// named beside it, and handled at once.
+struct FailsafeRow {
+    FailsafeCondition condition;
+    FailsafeRule default_rule;
+    KillSource kill_source;
+};
+inline constexpr std::array<FailsafeRow, kFailsafeConditionCount> kFailsafeTable{{
+    // Why each default, for a slightly buoyant vehicle: daemon/caracarad.toml.example.
+    {FailsafeCondition::WaterDetect, {FailsafeAction::Surface, 2000}, KillSource::Failsafe},
+    {FailsafeCondition::GroundFault, {FailsafeAction::Exclude, 500}, KillSource::Failsafe},
+    {FailsafeCondition::Overtemp, {FailsafeAction::Exclude, 2000}, KillSource::Failsafe},
+    {FailsafeCondition::Stall, {FailsafeAction::Exclude, 1000}, KillSource::Failsafe},
+    {FailsafeCondition::Hall, {FailsafeAction::Exclude, 1000}, KillSource::Failsafe},
+    // daemon/vehicle/pilot_watch: the last pilot left the bus. The only fixed row with a
+    // persistence of its own: the lost pilot's thrust is already zero.
+    {FailsafeCondition::PilotLost, {FailsafeAction::Kill, kPilotLostPersistenceMs}, KillSource::Failsafe},
+    // daemon/bus/thruster_health: a thruster failed ThrusterHealth::kUnreachableAfter transfers.
+    {FailsafeCondition::ThrusterUnreachable, {FailsafeAction::Kill, 0}, KillSource::Device},
+    // daemon/recovery/bus_loss: recovery failed, or a lockup outlasted the command timeout.
+    {FailsafeCondition::BusLost, {FailsafeAction::Kill, 0}, KillSource::Bus},
+    // daemon/teensy/teensy_connection: the SPI device went, or the Teensy fell silent.
+    {FailsafeCondition::TeensyLinkLost, {FailsafeAction::Kill, 0}, KillSource::Failsafe},
+    // daemon/safety/safety_lines: the switch cannot be read (it counts as set meanwhile).
+    {FailsafeCondition::KillSwitchUnreadable, {FailsafeAction::Kill, 0}, KillSource::Switch},
+    // daemon/safety/safety_lines: the kill or power-off output cannot be written.
+    {FailsafeCondition::SafetyLineLost, {FailsafeAction::Kill, 0}, KillSource::Device},
+}};
+constexpr const FailsafeRow& failsafe_row(FailsafeCondition c) { return kFailsafeTable[static_cast<std::size_t>(c)]; }
+// A row per condition, in the enum's order.
+static_assert([] {
+    for (std::size_t i = 0; i < kFailsafeConditionCount; ++i)
+        if (kFailsafeTable[i].condition != static_cast<FailsafeCondition>(i))
+            return false;
+    return true;
+}());
 // The FAULT bit of a thruster condition (SeaBotix IDS 8.4.2, word 2).
 uint8_t condition_fault_bit(FailsafeCondition c);
 
@@ -86,11 +135,6 @@ uint8_t condition_fault_bit(FailsafeCondition c);
 // 100 C (remark 6), which the policy applies to the TEMPERATURE byte as well as the bit.
 enum class FailsafeClearing { BitClear, PowerCycle, Hysteresis };
 FailsafeClearing condition_clearing(FailsafeCondition c);
-
-struct FailsafeRule {
-    FailsafeAction action = FailsafeAction::Warn;
-    uint32_t persistence_ms = 0; // the condition must hold this long before the action
-};
 
 // [failsafe.surface]: the ascent (a heave demand on the mixing's z axis, +deeper, so
 // negative is up) for a time, then a kill.

@@ -11,15 +11,17 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
     : event_(event),
       config_(std::move(config)),
       bus_(bus_io, config_, events_),
-      lines_(event, gpio, config_.gpio),
-      teensy_(event, spi_io, config_.spi, vehicle_, events_),
-      vehicle_(config_, bus_, lines_, teensy_, events_),
+      // The failsafes, made below, are where the lines, the Teensy link, the pilot watch and the
+      // bus loss push their conditions; nothing pushes before start().
+      lines_(event, gpio, config_.gpio, failsafes_),
+      teensy_(event, spi_io, config_.spi, vehicle_, failsafes_, events_),
+      vehicle_(config_, bus_, lines_, teensy_, events_, failsafes_),
       packets_(vehicle_, teensy_),
       loop_(event, config_.control, vehicle_, bus_, teensy_, lines_, events_),
-      recovery_(event, config_, io, gpio, bus_, loop_, vehicle_, events_),
+      recovery_(event, config_, io, gpio, bus_, loop_, failsafes_, events_),
       status_(event, vehicle_, bus_, loop_),
-      failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); },
-                 [this] { return vehicle_conditions(); }, vehicle_, events_),
+      failsafes_(event, config_.failsafe, bus_.size(), [this](std::size_t i) { return reading(i); }, vehicle_,
+                 events_),
       motor_test_(config_, vehicle_, events_),
       directions_(config_, vehicle_, teensy_, failsafes_),
       preflight_(config_, bus_, teensy_, lines_),
@@ -28,16 +30,6 @@ VehicleDaemon::VehicleDaemon(sd_event* event, DeviceIo& io, DeviceIo& bus_io, De
     bus_.monitor().set_listener(&recovery_);
     events_.attach_status(&status_);
     status_.set_failsafe_summary([this] { return failsafes_.summary(); });
-}
-
-std::array<bool, kFailsafeConditionCount> VehicleDaemon::vehicle_conditions() const {
-    std::array<bool, kFailsafeConditionCount> c{};
-    c[static_cast<std::size_t>(FailsafeCondition::BusLost)] = bus_.monitor().telemetry().state == BusState::Lost;
-    c[static_cast<std::size_t>(FailsafeCondition::ThrusterUnreachable)] = bus_.health().first_unreachable().has_value();
-    c[static_cast<std::size_t>(FailsafeCondition::KillSwitchUnreadable)] = lines_.kill_switch_unreadable();
-    c[static_cast<std::size_t>(FailsafeCondition::PilotLost)] = vehicle_.safety().pilot_lost();
-    c[static_cast<std::size_t>(FailsafeCondition::TeensyLinkLost)] = teensy_.link_lost();
-    return c;
 }
 
 std::optional<FailsafeReading> VehicleDaemon::reading(std::size_t i) const {
@@ -73,7 +65,7 @@ std::string VehicleDaemon::start() {
         return e;
     if (std::string e = vehicle_.start(event_); !e.empty())
         return e;
-    bus_.health().set_gate(&vehicle_); // a thruster that stopped answering kills the vehicle
+    bus_.health().set_failsafes(&failsafes_); // a thruster that stopped answering: thruster-unreachable
     // The dive writer's file writes can wait: never ahead of the loop or the wire.
     schedule.normal();
     if (config_.recorder.enabled) {
@@ -115,7 +107,7 @@ void VehicleDaemon::shutdown() {
     if (!started_)
         return;
     started_ = false;
-    bus_.health().set_gate(nullptr);
+    bus_.health().set_failsafes(nullptr);
     loop_.stop();
     failsafes_.stop();
     motor_test_.stop();

@@ -74,9 +74,6 @@ public:
 private:
     // Thruster i's last good status reply, for the failsafes; nullopt while it does not answer.
     std::optional<FailsafeReading> reading(std::size_t i) const;
-    // The fixed conditions: bus lost, a thruster unreachable, the kill switch unreadable (each
-    // kills where it arises), pilot lost and the Teensy link lost (the failsafes kill).
-    std::array<bool, kFailsafeConditionCount> vehicle_conditions() const;
 
     sd_event* event_;
     DaemonConfig config_;

@@ -27,9 +27,12 @@ void BusMonitor::note(IoError e) {
     if (t == LockupDetector::Transfer::Ok || t == LockupDetector::Transfer::BadReply) {
         // A bad reply still crossed the bus: the thruster is at fault, not the wire.
         if (tm_.state != BusState::Ok) {
-            if (tm_.state == BusState::Lost)
+            const bool was_lost = tm_.state == BusState::Lost;
+            if (was_lost)
                 log_notice("I2C bus %s is back; the vehicle stays killed until ClearKill", device_.c_str());
             tm_.state = BusState::Ok;
+            if (was_lost && listener_)
+                listener_->bus_back();
             events_.changed(kChangeState | kChangeBus);
         }
         return;

@@ -44,6 +44,8 @@ public:
     public:
         virtual ~Listener() = default;
         virtual void bus_locked_up(const std::string& reason) = 0;
+        // A transfer got through on a bus that was lost.
+        virtual void bus_back() = 0;
     };
 
     BusMonitor(std::string device, VehicleEvents& events);

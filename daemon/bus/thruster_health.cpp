@@ -17,6 +17,8 @@ void ThrusterHealth::note(std::size_t i, IoError e, bool bus_healthy) {
         if (unreachable_[i]) {
             unreachable_[i] = false;
             log_notice("thruster %zu answers again", i);
+            if (failsafes_ && !first_unreachable())
+                failsafes_->push(FailsafeCondition::ThrusterUnreachable, false, "every thruster answers");
         }
         return;
     }
@@ -24,8 +26,8 @@ void ThrusterHealth::note(std::size_t i, IoError e, bool bus_healthy) {
     if (!bus_healthy || unreachable_[i] || ++failed_in_row_[i] < kUnreachableAfter)
         return;
     unreachable_[i] = true;
-    if (gate_)
-        gate_->device_lost(unreachable_reason(i));
+    if (failsafes_)
+        failsafes_->push(FailsafeCondition::ThrusterUnreachable, true, unreachable_reason(i));
 }
 
 void ThrusterHealth::note_status(std::size_t i, const std::optional<ThrusterStatus>& status) {
@@ -44,10 +46,10 @@ std::string ThrusterHealth::unreachable_reason(std::size_t i) const {
            " transfers in a row failed, last " + std::string(io_error_name(last_failure_[i])) + ")";
 }
 
-void ThrusterHealth::set_gate(CommandGate* gate) {
-    gate_ = gate;
-    if (const auto i = first_unreachable(); i && gate_)
-        gate_->device_lost(unreachable_reason(*i));
+void ThrusterHealth::set_failsafes(FailsafeGate* failsafes) {
+    failsafes_ = failsafes;
+    if (const auto i = first_unreachable(); i && failsafes_)
+        failsafes_->push(FailsafeCondition::ThrusterUnreachable, true, unreachable_reason(*i));
 }
 
 std::optional<std::size_t> ThrusterHealth::first_unreachable() const {

@@ -1,9 +1,9 @@
 // Each thruster's health as its transfers tell it: whether it still answers, and the fault bits
-// it last reported (logged once per change). A thruster that stops answering kills the vehicle
-// through the gate.
+// it last reported (logged once per change). A thruster that stops answering is pushed to the
+// failsafes as thruster-unreachable (they kill), and its end once every thruster answers.
 #pragma once
 
-#include "daemon/interfaces/command_gate.hpp"
+#include "daemon/interfaces/failsafe_gate.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
 #include "drivers/devices/thruster_driver.hpp"
 #include "drivers/platform/io_error.hpp"
@@ -27,8 +27,9 @@ public:
 
     ThrusterHealth(std::size_t thrusters, VehicleEvents& events);
 
-    // Told (device_lost) when a thruster becomes unreachable; at once if one already is.
-    void set_gate(CommandGate* gate);
+    // Where thruster-unreachable is pushed (null: nowhere, on the way out); told at once if one
+    // already is.
+    void set_failsafes(FailsafeGate* failsafes);
     // Thruster i's transfer ended with `e`. `bus_healthy`: the bus itself worked (BusMonitor);
     // a closed adapter (recovery) or a lost bus is the bus's failure, not this thruster's.
     void note(std::size_t i, IoError e, bool bus_healthy);
@@ -43,7 +44,7 @@ private:
     std::string unreachable_reason(std::size_t i) const;
 
     VehicleEvents& events_;
-    CommandGate* gate_ = nullptr;
+    FailsafeGate* failsafes_ = nullptr;
     std::vector<FaultSet> faults_;
     std::vector<uint32_t> failed_in_row_;
     std::vector<IoError> last_failure_;

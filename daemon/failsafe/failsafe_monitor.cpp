@@ -1,22 +1,20 @@
 #include "daemon/failsafe/failsafe_monitor.hpp"
 
 #include "core/clock.hpp"
-#include "daemon/loop/log.hpp"
 #include "drivers/platform/io_error.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace caracara {
 
 FailsafeMonitor::FailsafeMonitor(sd_event* event, const FailsafeSettings& settings, std::size_t thrusters,
-                                 Readings readings, Conditions conditions, Vehicle& vehicle, VehicleEvents& events)
-    : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)),
-      conditions_(std::move(conditions)), vehicle_(vehicle), events_(events), policy_(settings, thrusters),
-      report_(settings, events), ascent_(settings.surface, vehicle, events),
+                                 Readings readings, Vehicle& vehicle, VehicleEvents& events)
+    : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)), vehicle_(vehicle),
+      events_(events), policy_(settings, thrusters), report_(settings, events), ascent_(settings.surface, vehicle, events),
+      clearance_(policy_, vehicle, events),
       period_us_(std::max<uint64_t>(1000, std::min(kPeriodNs, vehicle.safety().config().command_timeout_ns / 2)) /
-                 1000) {
-    vehicle_.set_failsafe_gate(this);
-}
+                 1000) {}
 
 std::string FailsafeMonitor::start() {
     sd_event_source* s = nullptr;
@@ -24,8 +22,16 @@ std::string FailsafeMonitor::start() {
         return "sd_event_add_time_relative: " + errno_name(-r);
     timer_.reset(s);
     sd_event_source_set_enabled(s, SD_EVENT_ON);
+    sd_event_source* d = nullptr;
+    if (int r = sd_event_add_defer(event_, &d, on_deferred, this); r < 0)
+        return "sd_event_add_defer: " + errno_name(-r);
+    deferred_.reset(d);
+    // Ahead of everything else the loop has ready: it is a kill waiting.
+    sd_event_source_set_priority(d, SD_EVENT_PRIORITY_IMPORTANT);
+    sd_event_source_set_enabled(d, SD_EVENT_OFF);
+    started_ = true;
     // What already holds (a fitted Teensy absent at start) kills now, not at the first reading.
-    conditions_changed();
+    decide({}, monotonic_ns(), false);
     return {};
 }
 
@@ -34,6 +40,30 @@ int FailsafeMonitor::on_timer(sd_event_source* s, uint64_t usec, void* userdata)
     sd_event_source_set_time(s, usec + self->period_us_);
     self->poll(monotonic_ns());
     return 0;
+}
+
+int FailsafeMonitor::on_deferred(sd_event_source*, void* userdata) {
+    static_cast<FailsafeMonitor*>(userdata)->decide({}, monotonic_ns(), false);
+    return 0;
+}
+
+void FailsafeMonitor::push(FailsafeCondition c, bool holds, std::string_view reason) {
+    if (holds)
+        reasons_[static_cast<std::size_t>(c)] = reason;
+    pushed_.push_back({c, holds});
+    if (!started_)
+        return; // decided at start
+    // Inside a decision, whose kill is under way (the kill output lost as it was asserted, the
+    // pilots forgotten by the kill), or inside another of the Vehicle's sequences (a ClearKill's
+    // or a D-Bus Kill's line write failed): never halfway through it, but as soon as it returns
+    // to the loop; a condition that cleared during a decision (the pilots its kill forgot) at the
+    // next reading, as the thruster conditions do, so that the raised failsafe is announced first.
+    if (deciding_ || vehicle_.acting()) {
+        if ((holds || !deciding_) && deferred_)
+            sd_event_source_set_enabled(deferred_.get(), SD_EVENT_ONESHOT);
+        return;
+    }
+    decide({}, monotonic_ns(), false);
 }
 
 void FailsafeMonitor::poll(uint64_t now) {
@@ -48,21 +78,17 @@ void FailsafeMonitor::poll(uint64_t now) {
         FailsafeTransitions t = policy_.observe(i, r->fault_bits, r->temperature_c, now);
         ts.insert(ts.end(), t.begin(), t.end());
     }
-    FailsafeTransitions own = look_at_conditions(now);
-    ts.insert(ts.end(), own.begin(), own.end());
-    report_.tell(ts);
-    carry_out(ts, now);
-    ascent_.keep(now);
+    decide(std::move(ts), now, true);
 }
 
-FailsafeTransitions FailsafeMonitor::look_at_conditions(uint64_t now) {
-    FailsafeTransitions ts;
-    const auto holding = conditions_();
-    for (std::size_t c = 0; c < kFailsafeConditionCount; ++c)
-        if (condition_is_fixed(static_cast<FailsafeCondition>(c))) {
-            FailsafeTransitions t = policy_.set_condition(static_cast<FailsafeCondition>(c), holding[c], now);
-            ts.insert(ts.end(), t.begin(), t.end());
-        }
+void FailsafeMonitor::decide(FailsafeTransitions ts, uint64_t now, bool keep_ascent) {
+    if (deciding_)
+        return;
+    deciding_ = true;
+    for (const Pushed& p : std::exchange(pushed_, {})) {
+        FailsafeTransitions t = policy_.set_condition(p.condition, p.holds, now);
+        ts.insert(ts.end(), t.begin(), t.end());
+    }
     FailsafeTransitions due = policy_.tick(now);
     ts.insert(ts.end(), due.begin(), due.end());
     const uint64_t kill_at = policy_.pending_deadline(FailsafeCondition::PilotLost);
@@ -70,14 +96,11 @@ FailsafeTransitions FailsafeMonitor::look_at_conditions(uint64_t now) {
         pilot_lost_kill_at_ = at; // PilotLostKillAt: on its change only, not at every reading
         events_.changed(kChangeFailsafes);
     }
-    return ts;
-}
-
-void FailsafeMonitor::conditions_changed() {
-    const uint64_t now = monotonic_ns();
-    const FailsafeTransitions ts = look_at_conditions(now);
     report_.tell(ts);
     carry_out(ts, now);
+    if (keep_ascent)
+        ascent_.keep(now);
+    deciding_ = false;
 }
 
 void FailsafeMonitor::carry_out(const FailsafeTransitions& ts, uint64_t now) {
@@ -93,57 +116,16 @@ void FailsafeMonitor::carry_out(const FailsafeTransitions& ts, uint64_t now) {
             continue;
         const FailsafeAction a = t.failsafe.effective();
         if (a == FailsafeAction::Kill) {
-            vehicle_.kill(KillSource::Failsafe, FailsafeReport::describe(t.failsafe));
+            // Read as the source's own kill where the row names one ("bus", "device", "switch"),
+            // with the reason it pushed; else as the failsafe's.
+            const KillSource source = failsafe_row(t.failsafe.condition).kill_source;
+            const std::string& pushed = reasons_[static_cast<std::size_t>(t.failsafe.condition)];
+            vehicle_.kill(source, source == KillSource::Failsafe || pushed.empty() ? FailsafeReport::describe(t.failsafe)
+                                                                                    : pushed);
         } else if (a == FailsafeAction::Surface && !ascent_.active()) {
             ascent_.begin(FailsafeReport::describe(t.failsafe), now);
         }
     }
-}
-
-Result FailsafeMonitor::clear_kill_refusal() const {
-    // Bus lost, an unreachable thruster and the kill switch are refused where they arise, by
-    // name (BusLost, ThrusterUnreachable, KillSwitchSet), and at once when they end, not at
-    // this object's next reading; pilot lost ended with its kill (nothing is left to lose). The
-    // Teensy link is refused here, by the failsafe that holds: no other error names it.
-    std::vector<ActiveFailsafe> b = policy_.blocking();
-    std::erase_if(b, [this](const ActiveFailsafe& f) {
-        return (condition_is_fixed(f.condition) && f.condition != FailsafeCondition::TeensyLinkLost) ||
-               (overriding_ && f.condition == *overriding_);
-    });
-    if (b.empty())
-        return {};
-    std::string m = "a failsafe holds: ";
-    for (std::size_t i = 0; i < b.size(); ++i)
-        m += (i ? ", " : "") + FailsafeReport::describe(b[i]);
-    const auto fixed =
-        std::find_if(b.begin(), b.end(), [](const ActiveFailsafe& f) { return condition_is_fixed(f.condition); });
-    if (fixed != b.end())
-        m += "; " + std::string(condition_name(fixed->condition)) + " is fixed at kill: ClearKill works once it clears";
-    else
-        m += "; ClearKillOverride(\"" + std::string(condition_name(b.front().condition)) +
-             "\") clears the kill anyway";
-    return {Status::FailsafeActive, m};
-}
-
-Result FailsafeMonitor::clear_kill_override(std::string_view condition, std::string_view caller) {
-    const auto c = condition_from_name(condition);
-    if (!c)
-        return {Status::InvalidValue, "no failsafe condition \"" + std::string(condition) + "\""};
-    if (condition_is_fixed(*c))
-        return {Status::FailsafeActive, std::string(condition) + " is fixed at kill: it cannot be overridden"};
-    // ClearKill with the named condition's failsafes set aside (another that holds still
-    // refuses); they are overridden only when it clears the kill: a refused call changes nothing.
-    overriding_ = *c;
-    Result r = vehicle_.clear_kill();
-    overriding_.reset();
-    if (!r.ok())
-        return r;
-    if (policy_.override_condition(*c)) {
-        log_warning("FAILSAFE OVERRIDE: %s named %s in ClearKillOverride; it only warns until it clears",
-                    std::string(caller).c_str(), std::string(condition).c_str());
-        events_.changed(kChangeFailsafes);
-    }
-    return r;
 }
 
 std::string FailsafeMonitor::summary() const {

@@ -17,10 +17,6 @@ public:
     // A command that moves something, from `client`: accepted only when ready, it restarts the
     // command timeout and makes `client` the commanding client, as SetThrust does.
     virtual Result accept_command(std::string_view client) = 0;
-    // A device that moves something went away under the daemon: the vehicle is killed.
-    virtual void device_lost(std::string_view why) = 0;
-    // The Teensy's link went away or came back: the failsafes decide (teensy-link-lost kills).
-    virtual void link_changed() = 0;
 };
 
 } // namespace caracara

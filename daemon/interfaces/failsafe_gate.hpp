@@ -1,9 +1,12 @@
-// What the Vehicle asks of the failsafes, without knowing them (daemon/failsafe_monitor
-// implements it): whether a kill may be cleared, and to look now when a condition of the
-// vehicle's own changed.
+// The failsafes as the objects below them see them (daemon/failsafe/failsafe_monitor implements
+// it): every source of a fixed condition (core/failsafe.hpp, kFailsafeTable) pushes it here,
+// and the Vehicle asks whether a kill may be cleared.
 #pragma once
 
+#include "core/failsafe.hpp"
 #include "core/status.hpp"
+
+#include <string_view>
 
 namespace caracara {
 
@@ -12,10 +15,10 @@ public:
     virtual ~FailsafeGate() = default;
     // Ok, or FailsafeActive while a failsafe that kills (or surfaces) still holds.
     virtual Result clear_kill_refusal() const = 0;
-    // A fixed condition may have changed (the last pilot left, the Teensy link went or came
-    // back): decided now, not at the next reading, so that a kill is at once and a
-    // persistence time counts from the event.
-    virtual void conditions_changed() = 0;
+    // Condition `c` holds now, or has cleared; `reason` says what happened (the kill's reason
+    // where the row's kill source is not "failsafe"). Decided at once, not at the next reading:
+    // a kill is immediate and a persistence time counts from the event.
+    virtual void push(FailsafeCondition c, bool holds, std::string_view reason) = 0;
 };
 
 } // namespace caracara

@@ -2,6 +2,8 @@
 
 #include "core/clock.hpp"
 
+#include <utility>
+
 namespace caracara {
 
 void BusLoss::watch() {
@@ -21,6 +23,8 @@ void BusLoss::watch() {
 void BusLoss::recovered() {
     if (timer_)
         sd_event_source_set_enabled(timer_.get(), SD_EVENT_OFF);
+    if (std::exchange(pushed_, false))
+        failsafes_.push(FailsafeCondition::BusLost, false, "the I2C bus is back");
 }
 
 int BusLoss::on_timer(sd_event_source*, uint64_t, void* userdata) {
@@ -37,7 +41,8 @@ void BusLoss::declare(const std::string& why) {
         return;
     tm.state = BusState::Lost;
     tm.last_recovery_error = why;
-    vehicle_.kill(KillSource::Bus, "I2C bus lost: " + why);
+    pushed_ = true;
+    failsafes_.push(FailsafeCondition::BusLost, true, "I2C bus lost: " + why);
     events_.changed(kChangeState | kChangeBus);
 }
 

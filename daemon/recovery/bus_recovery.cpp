@@ -13,14 +13,14 @@ constexpr uint64_t kReopenNs = 1'000'000'000;
 } // namespace
 
 BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio,
-                         ThrusterBus& bus, ControlLoop& loop, Vehicle& vehicle, VehicleEvents& events)
+                         ThrusterBus& bus, ControlLoop& loop, FailsafeGate& failsafes, VehicleEvents& events)
     : event_(event),
       config_(config),
       bus_(bus),
       steps_(config, io, gpio, bus),
       loop_(loop),
       events_(events),
-      loss_(event, config.control, bus, vehicle, events),
+      loss_(event, config.control, bus, failsafes, events),
       policy_(config.recovery.attempts, config.recovery.backoff_ms) {}
 
 void BusRecovery::bus_locked_up(const std::string& reason) {

@@ -11,7 +11,7 @@
 #include "daemon/recovery/bus_recovery_steps.hpp"
 #include "daemon/bus/thruster_bus.hpp"
 #include "daemon/control/control_loop.hpp"
-#include "daemon/vehicle/vehicle.hpp"
+#include "daemon/interfaces/failsafe_gate.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
 #include "drivers/platform/device_io.hpp"
 #include "drivers/platform/event_loop.hpp"
@@ -25,9 +25,10 @@ namespace caracara {
 class BusRecovery final : public BusMonitor::Listener {
 public:
     BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& io, GpioBackend& gpio, ThrusterBus& bus,
-                ControlLoop& loop, Vehicle& vehicle, VehicleEvents& events);
+                ControlLoop& loop, FailsafeGate& failsafes, VehicleEvents& events);
 
     void bus_locked_up(const std::string& reason) override;
+    void bus_back() override { loss_.recovered(); }
     // The other holder of the I2C node (the emergency stop's connection), let go of while the
     // driver is unbound and taken again once it is back. Null: none.
     void set_node_holder(I2cNodeHolder* holder) { steps_.set_node_holder(holder); }

@@ -68,6 +68,7 @@ void SafetyLines::check_outputs() {
 void SafetyLines::switch_lost() {
     if (listener_)
         listener_->kill_switch_read(true);
+    failsafes_.push(FailsafeCondition::KillSwitchUnreadable, true, "the kill switch cannot be read");
     schedule_reopen();
 }
 
@@ -105,10 +106,13 @@ int SafetyLines::on_reopen(sd_event_source*, uint64_t, void* userdata) {
     };
     reopen_output(self->kill_out_, g.kill_output, self->kill_asserted_ ? 1 : 0, "kill output");
     reopen_output(self->power_off_, g.power_off_output, 0, "power-off output");
+    if (!self->output_missing())
+        self->failsafes_.push(FailsafeCondition::SafetyLineLost, false, "every output line is back");
     if (self->kill_switch_.unreadable()) {
         if (std::string e = self->kill_switch_.open(); e.empty()) {
             log_notice("kill switch %s is back; its level decides", line_spec(*g.kill_switch).describe().c_str());
-            self->poll();
+            self->poll(); // its level first: a switch still set keeps the kill
+            self->failsafes_.push(FailsafeCondition::KillSwitchUnreadable, false, "the kill switch reads again");
         } else {
             missing = true;
         }
@@ -125,8 +129,7 @@ void SafetyLines::output_lost(std::unique_ptr<GpioLine>& line, const char* what,
     log_error("%s cannot be written (%s): vehicle killed; asking for it again once a second", what,
               errno_name(-err).c_str());
     schedule_reopen();
-    if (listener_)
-        listener_->device_lost(std::string(what) + " went away");
+    failsafes_.push(FailsafeCondition::SafetyLineLost, true, std::string(what) + " went away");
 }
 
 void SafetyLines::set_kill_output(bool asserted) {

@@ -1,10 +1,12 @@
 // The vehicle's safety lines: the kill switch (its KillSwitch, whose edges wake the loop above
 // D-Bus and the bus work), the kill output and the power-off output. It reads and drives
 // lines; what a switch change means is the Vehicle's business. A switch that cannot be read is
-// a pressed one until it can be again; a line that went away is asked for again once a second.
+// a pressed one until it can be again; it and an output that cannot be written are pushed to
+// the failsafes (kill-switch-unreadable, safety-line-lost); a line gone is asked for once a second.
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/interfaces/failsafe_gate.hpp"
 #include "daemon/safety/kill_switch.hpp"
 #include "drivers/devices/kill_output_watcher.hpp"
 #include "drivers/platform/event_loop.hpp"
@@ -24,12 +26,10 @@ public:
         virtual ~Listener() = default;
         // The switch's current reading (set = kill), on every edge and every backstop poll.
         virtual void kill_switch_read(bool set) = 0;
-        // An output line could not be written (its chip or the simulator went away).
-        virtual void device_lost(std::string_view why) = 0;
     };
 
-    SafetyLines(sd_event* event, GpioBackend& gpio, const GpioSettings& settings)
-        : event_(event), gpio_(gpio), settings_(settings),
+    SafetyLines(sd_event* event, GpioBackend& gpio, const GpioSettings& settings, FailsafeGate& failsafes)
+        : event_(event), gpio_(gpio), settings_(settings), failsafes_(failsafes),
           kill_switch_(event, gpio, settings.kill_switch, [this] { poll(); }, [this](const std::string&) { switch_lost(); }) {}
 
     // Requests the configured lines (the kill output starting at `kill_asserted`) and watches
@@ -44,6 +44,8 @@ public:
     bool has_power_off() const { return power_off_ != nullptr; }
     // A kill output is configured but its line went away (asked for again once a second).
     bool kill_output_missing() const { return settings_.kill_output && !kill_out_; }
+    // A configured output (kill, power-off) went away and is not back yet.
+    bool output_missing() const { return kill_output_missing() || (settings_.power_off_output && !power_off_); }
     void assert_power_off();
     // Told the kill output line whenever it changes (null before it goes): the fatal-signal
     // emergency stop writes it first.
@@ -68,19 +70,20 @@ public:
 
 private:
     static int on_reopen(sd_event_source*, uint64_t usec, void* userdata);
-    // An output (kill, power-off) could not be written: dropped, the vehicle killed, and asked
-    // for again with the reopen timer (the kill output then starts asserted).
+    // An output (kill, power-off) could not be written: dropped, safety-line-lost pushed, and
+    // asked for again with the reopen timer (the kill output then starts asserted).
     void output_lost(std::unique_ptr<GpioLine>& line, const char* what, int err);
     void schedule_reopen();
     // Every kOutputCheckUs: an output that cannot be read back went away (output_lost).
     void check_outputs();
     // The switch cannot be read (its chip or the simulator went away): it counts as set (a
-    // kill), and it is asked for again once a second.
+    // kill), kill-switch-unreadable is pushed, and it is asked for again once a second.
     void switch_lost();
 
     sd_event* event_;
     GpioBackend& gpio_;
     const GpioSettings& settings_;
+    FailsafeGate& failsafes_;
     Listener* listener_ = nullptr;
     KillSwitch kill_switch_;
     std::unique_ptr<GpioLine> kill_out_;

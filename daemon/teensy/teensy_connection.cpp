@@ -9,15 +9,15 @@
 
 namespace caracara {
 
-TeensyConnection::TeensyConnection(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate)
-    : event_(event), gate_(gate), spi_(io, settings.device, settings.spi), link_(spi_, settings.teensy), worker_(link_),
+TeensyConnection::TeensyConnection(sd_event* event, DeviceIo& io, const SpiSettings& settings, FailsafeGate& failsafes)
+    : event_(event), failsafes_(failsafes), spi_(io, settings.device, settings.spi), link_(spi_, settings.teensy), worker_(link_),
       watch_(
           settings, [this] { worker_.collect(); }, [this] { return open_; },
           [this](uint64_t ms) {
               // Silent: asked for this long and no valid frame.
               log_error("Teensy on SPI %s answered no valid frame for %llu ms: failsafe teensy-link-lost",
                         spi_.path().c_str(), static_cast<unsigned long long>(ms));
-              lose(TeensyLoss::Silent);
+              lose(TeensyLoss::Silent, "the Teensy answered no valid frame for " + std::to_string(ms) + " ms");
           }),
       poll_(
           worker_, link_, tm_, [this](teensy::TeensyError e) { return io_errno(e); },
@@ -31,9 +31,10 @@ int TeensyConnection::open() {
     const int r = spi_.open();
     open_ = tm_.online = r >= 0;
     if (r < 0) {
-        // Fitted: the vehicle stays killed (the failsafes look at the conditions as they start).
+        // Fitted: the vehicle stays killed (the failsafes decide what was pushed as they start).
         if (watch_.fitted()) {
-            watch_.lose(TeensyLoss::Absent);
+            if (watch_.lose(TeensyLoss::Absent))
+                failsafes_.push(FailsafeCondition::TeensyLinkLost, true, "the Teensy is fitted but absent at start");
             log_error("Teensy is fitted ([spi] fitted) but SPI %s is absent at start (%s): failsafe "
                       "teensy-link-lost; asking for it again once a second",
                       spi_.path().c_str(), errno_name(-r).c_str());
@@ -69,17 +70,17 @@ void TeensyConnection::lose_link() {
     open_ = false;
     worker_.submit([this] { spi_.close(); }, nullptr);
     watch_.gone(); // gone, whatever it was before
-    lose(TeensyLoss::Gone);
+    lose(TeensyLoss::Gone, "the Teensy's SPI device went away");
     reopen_.schedule();
 }
 
-void TeensyConnection::lose(TeensyLoss why) {
+void TeensyConnection::lose(TeensyLoss why, std::string_view what) {
     tm_.online = false;
     if (!watch_.lose(why))
         return;
     if (on_lost_)
         on_lost_();
-    gate_.link_changed(); // the kill, at once
+    failsafes_.push(FailsafeCondition::TeensyLinkLost, true, what); // the kill, at once
 }
 
 void TeensyConnection::heard(uint64_t now) {
@@ -94,7 +95,7 @@ void TeensyConnection::heard(uint64_t now) {
     // Whatever the wheels were doing before, they stop now: the kill's Stop may not have got through.
     if (on_back_)
         on_back_();
-    gate_.link_changed(); // teensy-link-lost clears
+    failsafes_.push(FailsafeCondition::TeensyLinkLost, false, "the Teensy answers again");
 }
 
 std::string TeensyConnection::start(int64_t priority) {

@@ -1,7 +1,7 @@
 // The connection to the Teensy over SPI: the node, the link and the TeensyWorker whose thread
 // carries every frame, so a slow or hung Teensy never holds the loop. Its TeensyPoll asks one
 // frame a cycle; a command's frame is handed over and its Result given back later. The link is
-// lost (told to its CommandGate: the failsafes kill, as teensy-link-lost) when the device goes
+// lost (teensy-link-lost pushed to the failsafes, which kill) when the device goes
 // away (ENODEV: its TeensyReopen asks for it again once a second), when a fitted Teensy is absent
 // at start, or when no valid frame came back for [spi] silence_ms of asking (busy for ever, no
 // answer, garbage); it is back at the next valid frame. The commands themselves are TeensyPort's,
@@ -16,7 +16,7 @@
 #include "daemon/teensy/teensy_reopen.hpp"
 #include "daemon/teensy/teensy_telemetry.hpp"
 #include "daemon/teensy/teensy_worker.hpp"
-#include "daemon/interfaces/command_gate.hpp"
+#include "daemon/interfaces/failsafe_gate.hpp"
 #include "drivers/devices/teensy_link.hpp"
 #include "drivers/platform/device_io.hpp"
 #include "drivers/platform/event_loop.hpp"
@@ -26,12 +26,13 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
 
 namespace caracara {
 
 class TeensyConnection {
 public:
-    TeensyConnection(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate);
+    TeensyConnection(sd_event* event, DeviceIo& io, const SpiSettings& settings, FailsafeGate& failsafes);
 
     // `lost`: the device went away; `back`: it is open again (the wheels are to be stopped).
     void set_handlers(std::function<void()> lost, std::function<void()> back) {
@@ -61,11 +62,11 @@ public:
 
 private:
     void polled(TeensyPoll::Outcome outcome);
-    // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, told to the
-    // gate (the wheels cannot be stopped: the failsafes kill), and asked for again once a second.
+    // The SPI device went away (ENODEV: unbound, a restarted simulator): closed, teensy-link-lost
+    // pushed (the wheels cannot be stopped: the failsafes kill), and asked for again once a second.
     void lose_link();
-    // The link lost for `why` (the kill, at once), unless it already is.
-    void lose(TeensyLoss why);
+    // The link lost for `why` (teensy-link-lost pushed: the kill, at once), unless it already is.
+    void lose(TeensyLoss why, std::string_view what);
     int io_errno(teensy::TeensyError e) const; // the worker's: the failed transfer's errno, or 0
     // A valid frame came back (`now`): a lost link is back.
     void heard(uint64_t now);
@@ -73,7 +74,7 @@ private:
     void reopened();
 
     sd_event* event_;
-    CommandGate& gate_;
+    FailsafeGate& failsafes_;
     SpiDev spi_;      // the worker's while it runs
     TeensyLink link_; // the worker's while it runs
     TeensyWorker worker_;

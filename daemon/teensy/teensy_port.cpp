@@ -8,8 +8,8 @@
 namespace caracara {
 
 TeensyPort::TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate,
-                       VehicleEvents& events)
-    : gate_(gate), events_(events), connection_(event, io, settings, gate), turn_(event, connection_, gate) {
+                       FailsafeGate& failsafes, VehicleEvents& events)
+    : gate_(gate), events_(events), connection_(event, io, settings, failsafes), turn_(event, connection_, gate) {
     connection_.set_handlers([this] { wheels_moving_ = false; }, [this] { stop_motion(); });
 }
 

@@ -10,6 +10,7 @@
 #include "daemon/teensy/teensy_connection.hpp"
 #include "daemon/teensy/teensy_turn.hpp"
 #include "daemon/interfaces/command_gate.hpp"
+#include "daemon/interfaces/failsafe_gate.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
 #include "drivers/platform/device_io.hpp"
 #include "drivers/platform/event_loop.hpp"
@@ -25,7 +26,10 @@ namespace caracara {
 
 class TeensyPort {
 public:
-    TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate, VehicleEvents& events);
+    // `gate`: whether the vehicle takes a wheel or turn command; `failsafes`: where the link's
+    // loss is pushed (teensy-link-lost).
+    TeensyPort(sd_event* event, DeviceIo& io, const SpiSettings& settings, CommandGate& gate, FailsafeGate& failsafes,
+               VehicleEvents& events);
     ~TeensyPort() { close(); }
 
     int open() { return connection_.open(); } // 0 or -errno (before start); a missing Teensy is not fatal

@@ -18,7 +18,16 @@ Result PilotWatch::accept_command(std::string_view client) {
     deadline_.arm(safety_.next_deadline());
     if (previous != safety_.commanding_client())
         events_.changed(kChangeController);
+    tell_failsafes(); // a pilot again: pilot-lost ends
     return {};
+}
+
+void PilotWatch::tell_failsafes() {
+    if (safety_.pilot_lost() == told_lost_)
+        return;
+    told_lost_ = safety_.pilot_lost();
+    failsafes_.push(FailsafeCondition::PilotLost, told_lost_,
+                    told_lost_ ? "the last pilot left the bus" : "a pilot commands, or the pilots were forgotten");
 }
 
 void PilotWatch::client_left(std::string_view unique_name) {
@@ -35,9 +44,8 @@ void PilotWatch::client_left(std::string_view unique_name) {
     if (safety_.pilot_lost() && !was_lost) {
         log_warning("the last pilot (%s) left the bus: killed in %u ms (failsafe pilot-lost) unless a pilot commands",
                     std::string(unique_name).c_str(), failsafe_.rule(FailsafeCondition::PilotLost).persistence_ms);
-        if (failsafes_)
-            failsafes_->conditions_changed();
     }
+    tell_failsafes();
 }
 
 } // namespace caracara

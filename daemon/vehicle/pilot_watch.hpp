@@ -1,7 +1,7 @@
 // Who pilots the vehicle, as clients come and go: a command's client taken as the commanding
 // client (SetThrust, SetMotion, a packet, a wheel or a turn), and a client that leaves the bus:
 // its zeros when it was commanding, and, when it was the last pilot, the pilot-lost failsafe's
-// condition told to the failsafes at once. The roster itself is the safety machine's
+// condition pushed to the failsafes at once (and its end, when a pilot commands again). The roster itself is the safety machine's
 // (core/pilot_roster); what the safety machine decides is carried out by the Vehicle (`handle`).
 // Owned by the Vehicle.
 #pragma once
@@ -24,10 +24,10 @@ class PilotWatch final {
 public:
     using Handle = std::function<void(const SafetyAction&)>;
     PilotWatch(const FailsafeSettings& failsafe, SafetyMachine& safety, const MotorCommands& motors,
-               const VehicleCondition& condition, DeadlineTimer& deadline, VehicleEvents& events, Handle handle)
+               const VehicleCondition& condition, DeadlineTimer& deadline, VehicleEvents& events,
+               FailsafeGate& failsafes, Handle handle)
         : failsafe_(failsafe), safety_(safety), motors_(motors), condition_(condition), deadline_(deadline),
-          events_(events), handle_(std::move(handle)) {}
-    void set_failsafe_gate(FailsafeGate* gate) { failsafes_ = gate; }
+          events_(events), failsafes_(failsafes), handle_(std::move(handle)) {}
 
     // The one place a command is accepted (CommandGate::accept_command: SetThrust, SetMotion, a
     // packet's motors, the wheels, a turn, the failsafe's ascent): refused while a failsafe
@@ -35,6 +35,9 @@ public:
     // the command timeout restarts, and a new controller is announced.
     Result accept_command(std::string_view client);
     void client_left(std::string_view unique_name);
+    // Pushes pilot-lost to the failsafes when it began or ended (a pilot left or commands again;
+    // a kill, a clear or a power-off forgets the pilots): after each of the Vehicle's actions.
+    void tell_failsafes();
 
 private:
     const FailsafeSettings& failsafe_;
@@ -43,8 +46,9 @@ private:
     const VehicleCondition& condition_;
     DeadlineTimer& deadline_;
     VehicleEvents& events_;
+    FailsafeGate& failsafes_;
     Handle handle_;
-    FailsafeGate* failsafes_ = nullptr;
+    bool told_lost_ = false; // pilot-lost as last pushed
 };
 
 } // namespace caracara

@@ -9,7 +9,7 @@ namespace caracara {
 static_assert(DeadlineTimer::kNever == SafetyMachine::kNoDeadline);
 
 Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
-                 VehicleEvents& events)
+                 VehicleEvents& events, FailsafeGate& failsafes)
     : config_(config),
       lines_(lines),
       teensy_(teensy),
@@ -18,8 +18,9 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       safety_(safety_config(config), false, monotonic_ns()),
       deadline_([this] { tick(monotonic_ns()); }),
       motors_(config, safety_, *this, actuator_, events),
-      condition_(safety_, bus, lines),
-      pilots_(config.failsafe, safety_, motors_, condition_, deadline_, events, [this](const SafetyAction& a) { handle(a); }) {}
+      condition_(safety_, bus, lines, failsafes),
+      pilots_(config.failsafe, safety_, motors_, condition_, deadline_, events, failsafes,
+              [this](const SafetyAction& a) { handle(a); }) {}
 
 void Vehicle::handle(const SafetyAction& a, const Result* kill) {
     uint32_t changes = 0;
@@ -29,7 +30,11 @@ void Vehicle::handle(const SafetyAction& a, const Result* kill) {
     }
     if (safety_.kill_output_asserted())
         motors_.end_surfacing(); // a kill ends an ascent at once
-    losses_.during([&] { actuator_.carry_out(a, safety_.kill_output_asserted(), kill); });
+    // Not re-entered halfway: a line lost inside it is decided by the failsafes after it.
+    const bool outer = !acting_;
+    acting_ = true;
+    actuator_.carry_out(a, safety_.kill_output_asserted(), kill);
+    acting_ = !outer;
     if (a.state_changed)
         changes |= kChangeState;
     if (a.command_stale)
@@ -37,13 +42,7 @@ void Vehicle::handle(const SafetyAction& a, const Result* kill) {
                  static_cast<unsigned long long>(config_.control.command_timeout_ms));
     events_.changed(changes);
     arm_deadline();
-    if (const std::string why = losses_.take(); !why.empty())
-        device_lost(why);
-}
-
-void Vehicle::device_lost(std::string_view why) {
-    if (!losses_.defer(why))
-        kill(KillSource::Device, why);
+    pilots_.tell_failsafes();
 }
 
 std::string Vehicle::start(sd_event* event) {
@@ -90,15 +89,6 @@ Result Vehicle::power_off(std::string_view confirmation) {
     actuator_.power_off(); // thrusters first, whatever handle() decided; then the line
     log_warning("POWER-OFF confirmed: thrusters to zero%s", lines_.has_power_off() ? ", then the power-off line" : "");
     return {};
-}
-
-void Vehicle::link_changed() {
-    // The kill is the failsafes' (teensy-link-lost, at once); a Vehicle without them (none in
-    // the daemon: the FailsafeMonitor is its gate from its construction) still kills.
-    if (failsafes_)
-        failsafes_->conditions_changed();
-    else if (teensy_.link_lost())
-        kill(KillSource::Device, "the Teensy's SPI device went away");
 }
 
 void Vehicle::kill_switch_read(bool set) {

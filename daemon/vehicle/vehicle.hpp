@@ -21,7 +21,6 @@
 #include "daemon/teensy/teensy_port.hpp"
 #include "daemon/interfaces/command_gate.hpp"
 #include "daemon/interfaces/demand_listener.hpp"
-#include "daemon/vehicle/device_loss_deferral.hpp"
 #include "daemon/vehicle/motor_commands.hpp"
 #include "daemon/vehicle/pilot_watch.hpp"
 #include "daemon/vehicle/vehicle_condition.hpp"
@@ -38,8 +37,9 @@ namespace caracara {
 
 class Vehicle final : public CommandGate, public SafetyLines::Listener {
 public:
+    // `failsafes`: where the pilot watch pushes pilot-lost, and what a ClearKill asks last.
     Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& lines, TeensyPort& teensy,
-            VehicleEvents& events);
+            VehicleEvents& events, FailsafeGate& failsafes);
     // Where the motor values go down to the thrusters (the control loop).
     void set_demand_listener(DemandListener* orders) { actuator_.set_demand_listener(orders); }
     // Makes the deadline timer (end of arming, command timeout). "" or why it could not.
@@ -77,11 +77,9 @@ public:
     Result state_error() const override { return condition_.state_error(); }
     bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
     Result accept_command(std::string_view client) override { return pilots_.accept_command(client); }
-    // A line or a thruster went away under the daemon (SafetyLines, ThrusterHealth): killed,
-    // source device.
-    void device_lost(std::string_view why) override;
-    // The Teensy link (TeensyConnection): the failsafes kill, as teensy-link-lost.
-    void link_changed() override;
+    // Inside a safety sequence being carried out (SafetyActuator::carry_out): the failsafes
+    // decide a condition pushed meanwhile once it is done, not halfway through it.
+    bool acting() const { return acting_; }
 
     // What thruster i is to be ordered now: its applied value while the vehicle may drive.
     int32_t order_value(size_t i) const { return motors_.order_value(i); }
@@ -101,11 +99,6 @@ public:
 
     // Failsafes (daemon/failsafe_monitor decides, the Vehicle carries out).
     static constexpr std::string_view kFailsafeClient = MotorCommands::kFailsafeClient;
-    void set_failsafe_gate(FailsafeGate* gate) {
-        failsafes_ = gate;
-        condition_.set_failsafe_gate(gate);
-        pilots_.set_failsafe_gate(gate);
-    }
     void exclude(const std::array<bool, kMotorCount>& excluded) { motors_.exclude(excluded); }
     Result surface(const AxisDemand& ascent) { return motors_.surface(ascent); }
     bool surfacing() const { return motors_.surfacing(); }
@@ -127,8 +120,7 @@ private:
     MotorCommands motors_;
     VehicleCondition condition_;
     PilotWatch pilots_;
-    FailsafeGate* failsafes_ = nullptr;
-    DeviceLossDeferral losses_;
+    bool acting_ = false;
 };
 
 } // namespace caracara

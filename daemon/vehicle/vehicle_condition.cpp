@@ -32,8 +32,8 @@ Result VehicleCondition::clear_kill_refusal() const {
                     std::string(io_error_name(bus_.thruster(*i).last_error())) + "); the kill stays"};
     if (lines_.kill_output_missing() && safety_.state() == SafetyState::Killed)
         return {Status::Hardware, "the kill output line is gone (asked for again once a second); the kill stays"};
-    if (failsafe_gate_ && safety_.state() == SafetyState::Killed)
-        return failsafe_gate_->clear_kill_refusal();
+    if (safety_.state() == SafetyState::Killed)
+        return failsafes_.clear_kill_refusal();
     return {};
 }
 

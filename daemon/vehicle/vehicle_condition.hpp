@@ -16,9 +16,9 @@ namespace caracara {
 
 class VehicleCondition final {
 public:
-    VehicleCondition(const SafetyMachine& safety, const ThrusterBus& bus, const SafetyLines& lines)
-        : safety_(safety), bus_(bus), lines_(lines) {}
-    void set_failsafe_gate(const FailsafeGate* gate) { failsafe_gate_ = gate; }
+    VehicleCondition(const SafetyMachine& safety, const ThrusterBus& bus, const SafetyLines& lines,
+                     const FailsafeGate& failsafes)
+        : safety_(safety), bus_(bus), lines_(lines), failsafes_(failsafes) {}
 
     // Ok when the vehicle is ready to move; else the error a caller gets (Killed, Arming, ...).
     Result state_error() const;
@@ -36,7 +36,7 @@ private:
     const SafetyMachine& safety_;
     const ThrusterBus& bus_;
     const SafetyLines& lines_;
-    const FailsafeGate* failsafe_gate_ = nullptr;
+    const FailsafeGate& failsafes_;
 };
 
 } // namespace caracara

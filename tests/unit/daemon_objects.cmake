@@ -7,3 +7,4 @@ caracara_unit_test(test_control_loop SOURCES unit/test_control_loop.cpp LIBS dae
 caracara_unit_test(test_thruster_bus SOURCES unit/test_thruster_bus.cpp LIBS daemon_fakes)
 caracara_unit_test(test_teensy_worker SOURCES unit/test_teensy_worker.cpp LIBS daemon_fakes)
 caracara_unit_test(test_preflight SOURCES unit/test_preflight.cpp LIBS daemon_fakes)
+caracara_unit_test(test_failsafe_table SOURCES unit/test_failsafe_table.cpp LIBS daemon_fakes)

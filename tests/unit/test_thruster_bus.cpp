@@ -21,19 +21,23 @@ using Kind = WireEvent::Kind;
 
 namespace {
 
-class Gate final : public CommandGate {
+// The failsafes as ThrusterHealth sees them: thruster-unreachable pushed (holds, with its
+// reason) and cleared.
+class Gate final : public FailsafeGate {
 public:
-    Result state_error() const override { return {}; }
-    bool powered_off() const override { return false; }
-    Result accept_command(std::string_view) override { return {}; }
-    void device_lost(std::string_view why) override { lost.emplace_back(why); }
-    void link_changed() override {}
+    Result clear_kill_refusal() const override { return {}; }
+    void push(FailsafeCondition c, bool holds, std::string_view why) override {
+        REQUIRE(c == FailsafeCondition::ThrusterUnreachable);
+        (holds ? lost : cleared).emplace_back(why);
+    }
     std::vector<std::string> lost;
+    std::vector<std::string> cleared;
 };
 
 class Lockups final : public BusMonitor::Listener {
 public:
     void bus_locked_up(const std::string& reason) override { reasons.push_back(reason); }
+    void bus_back() override {}
     std::vector<std::string> reasons;
 };
 
@@ -165,10 +169,10 @@ TEST_CASE("when_idle runs once the transfers handed over are on the wire, at onc
     CHECK(*seen == 2);
 }
 
-TEST_CASE("a thruster failing three transfers in a row is unreachable; the gate hears it once; it answers again") {
+TEST_CASE("a thruster failing three transfers in a row is unreachable; the failsafes hear it once; it answers again") {
     BusRig r;
     Gate gate;
-    r.bus.health().set_gate(&gate);
+    r.bus.health().set_failsafes(&gate);
     r.wire.fail(3, ENXIO);
     for (int n = 0; n < 5; ++n) {
         r.bus.send_order(3, 0);
@@ -183,13 +187,14 @@ TEST_CASE("a thruster failing three transfers in a row is unreachable; the gate 
     r.bus.send_order(3, 0);
     REQUIRE(r.run_until([&] { return r.bus.idle(); }));
     CHECK_FALSE(r.bus.health().first_unreachable());
+    CHECK(gate.cleared.size() == 1); // thruster-unreachable ends with the last one answering
     Gate late;
     r.wire.fail(6, ENXIO);
     for (int n = 0; n < 3; ++n) {
         r.bus.send_order(6, 0);
         REQUIRE(r.run_until([&] { return r.bus.idle(); }));
     }
-    r.bus.health().set_gate(&late); // told at once of the one already unreachable
+    r.bus.health().set_failsafes(&late); // told at once of the one already unreachable
     CHECK(late.lost.size() == 1);
 }
 

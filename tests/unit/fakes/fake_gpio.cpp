@@ -12,8 +12,14 @@ public:
     Line(FakeGpio& gpio, std::string name, int value) : gpio_(gpio), name_(std::move(name)), value_(value) {
         record();
     }
-    int get() override { return name_ == kKillSwitch ? gpio_.switch_set_ : value_; }
+    int get() override {
+        if (name_ == kKillSwitch)
+            return gpio_.switch_set_;
+        return gpio_.outputs_gone_ ? -ENODEV : value_;
+    }
     int set(int value) override {
+        if (gpio_.outputs_gone_)
+            return -ENODEV;
         value_ = value;
         record();
         return 0;
@@ -52,6 +58,10 @@ FakeGpio::~FakeGpio() {
 std::unique_ptr<GpioLine> FakeGpio::request(const GpioLineSpec& spec, GpioMode, int initial, std::string& error) {
     if (spec.name != kKillSwitch && spec.name != kKillOutput && spec.name != kPowerOff) {
         error = "no line " + spec.describe();
+        return nullptr;
+    }
+    if (spec.name != kKillSwitch && outputs_gone_) {
+        error = "gpiochip0 is gone";
         return nullptr;
     }
     return std::make_unique<Line>(*this, spec.name, initial);

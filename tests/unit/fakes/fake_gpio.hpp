@@ -27,12 +27,16 @@ public:
                                       std::string& error) override;
     // Moves the kill switch (set = kill) and makes an edge.
     void set_kill_switch(bool set);
+    // The output lines' chip goes away (their reads and writes fail ENODEV, a request is
+    // refused) or comes back.
+    void set_outputs_gone(bool gone) { outputs_gone_ = gone; }
 
 private:
     class Line;
     FakeWire& wire_;
     int switch_fd_ = -1;
     bool switch_set_ = false;
+    bool outputs_gone_ = false;
 };
 
 } // namespace caracara::test
