@@ -30,7 +30,8 @@ sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
 
 import harness  # noqa: E402
 from harness import missing, npm_ci  # noqa: E402
-from bounds import CLIENT_LOSS_ZERO_MS_MAX  # noqa: E402
+from bounds import CLIENT_LOSS_ZERO_MS_MAX, ROS_READING_STAMP_AGE_MS_MAX, ROS_SENSOR_RATE_MAX_FRACTION  # noqa: E402
+from bounds import ROS_SENSOR_RATE_MIN_FRACTION, ROS_SENSOR_RATE_WINDOW_S  # noqa: E402
 from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, angle_diff, poll, speed_byte  # noqa: E402
 from test_failsafes import kill_edges, orders  # noqa: E402
 from vehicle_motion import START_HEADING_RAD, judge, place  # noqa: E402
@@ -48,6 +49,9 @@ PUBLISHED = {"rt/caracara/imu": "sensor_msgs/Imu", "rt/caracara/joint_states": "
 DISCOVERY_INFO = {"ros_discovery_info": "rmw_dds_common/ParticipantEntitiesInfo"}
 GID_BYTES = {"humble": 24, "jazzy": 16}  # rmw_dds_common's Gid: char[24] in Humble, char[16] since Iron
 MOTOR_MAX = 8850
+DAEMON_TELEMETRY_HZ = 5.0  # daemon/control/control_loop.cpp's kTelemetryPeriodNs: [ros] sensor_rate_hz's default
+STEADY_TOPICS = {"rt/caracara/imu": "sensor_msgs/Imu", "rt/tf": "tf2_msgs/TFMessage",
+                 "rt/caracara/joint_states": "sensor_msgs/JointState"}
 
 
 def build_peer(distro):
@@ -194,6 +198,12 @@ def expected_axes(attitude, convention):
     if convention == "enu":
         return (forward[1], forward[0], forward[2]), (-right[1], -right[0], -right[2])
     return (forward[0], forward[1], -forward[2]), (right[0], right[1], -right[2])
+
+
+def stamp_of(topic, m):
+    """A message's header stamp in ns (CLOCK_REALTIME); /tf's of its one transform."""
+    head = m["transforms"][0]["header"] if topic == "rt/tf" else m["header"]
+    return head["stamp"]["sec"] * 10 ** 9 + head["stamp"]["nanosec"]
 
 
 def unwrap(angles):
@@ -354,16 +364,22 @@ class RosTestCase(VehicleTestCase):
         self.assertIn("rt/caracara/imu", samples, "no Imu received")
         self.assertEqual("rt/tf" in samples, publish_tf)
         self.assertGreater(len(attitude), 10)
+        unjudged = {}
         for topic, msgs in samples.items():
             for _, m in msgs:
                 if topic == "rt/tf":
                     tf = m["transforms"][0]
                     self.assertEqual((tf["header"]["frame_id"], tf["child_frame_id"]), (world, body))
-                    head, q = tf["header"], tf["transform"]["rotation"]
+                    q = tf["transform"]["rotation"]
                 else:
                     self.assertEqual(m["header"]["frame_id"], body)
-                    head, q = m["header"], m["orientation"]
-                stamp = head["stamp"]["sec"] * 10 ** 9 + head["stamp"]["nanosec"]
+                    q = m["orientation"]
+                stamp = stamp_of(topic, m)
+                if stamp + 50e6 < attitude[0][0]:
+                    # A reading from before the record began (the first message of a steady
+                    # stream may carry the reading of up to a second ago): nothing to judge it by.
+                    unjudged[topic] = unjudged.get(topic, 0) + 1
+                    continue
                 near = [a for t, a in attitude if -200e6 <= t - stamp <= 50e6] or \
                     [min(attitude, key=lambda a: abs(a[0] - stamp))[1]]
                 got = rotate(q, (1, 0, 0)), rotate(q, (0, 1, 0))
@@ -374,6 +390,8 @@ class RosTestCase(VehicleTestCase):
                 att = min(near, key=error)
                 self.assertLessEqual(error(att), delta, "%s: body axes x, y in %s: got %s, the simulator's %s gives %s"
                                      % (topic, world, got, att, expected_axes(att, convention)))
+        for topic, n in unjudged.items():
+            self.assertLessEqual(n, 2, "%s: %d of %d messages stamped before the record began" % (topic, n, len(samples[topic])))
 
     def hold_motion(self, seconds, **axes):
         """SetMotion(axes) over D-Bus, renewed within the command timeout, for `seconds`."""
@@ -381,6 +399,44 @@ class RosTestCase(VehicleTestCase):
         while time.monotonic() < end:
             self.rig.motion(**axes)
             time.sleep(0.1)
+
+    def check_steady_rates(self, rate_hz, topics=STEADY_TOPICS):
+        """A late subscriber on a still vehicle (placed at rest, no thrust: nothing changes, so
+        caracarad announces only its counters, once a second) gets each of `topics` at `rate_hz`,
+        each message stamped with the time of the reading it carries: at or before its arrival and
+        at most ROS_READING_STAMP_AGE_MS_MAX older, never going back, and the same reading sent
+        again carries the same stamp (so fewer stamps than messages: not the time of sending)."""
+        rig = self.rig
+        rig.reset()
+        time.sleep(1.0)  # an earlier test's thrust fully died away: placed, the vehicle stays
+        self.place_and_wait(0.4)
+        time.sleep(1.5)  # this subscriber joins long after the values last changed
+        realtime_minus_monotonic = time.time_ns() - time.monotonic_ns()
+        # Counted from a second after the first message: the peer's readers matched first, and
+        # Cyclone's writers match them a little later (a gap of up to 800 ms before that).
+        samples, _, _, _ = self.listen(ROS_SENSOR_RATE_WINDOW_S + 2, topics)
+        expected = rate_hz * ROS_SENSOR_RATE_WINDOW_S
+        for topic in topics:
+            with self.subTest(topic=topic):
+                got = samples.get(topic, [])
+                self.assertTrue(got, "nothing on " + topic)
+                start = got[0][0] + 10 ** 9
+                got = [(t, m) for t, m in got if start <= t < start + ROS_SENSOR_RATE_WINDOW_S * 10 ** 9]
+                stamps = []
+                for t_ns, m in got:
+                    stamp = stamp_of(topic, m)
+                    age_ms = (t_ns + realtime_minus_monotonic - stamp) / 1e6
+                    self.assertGreaterEqual(age_ms, -5, "%s stamped after it arrived" % topic)
+                    self.assertLessEqual(age_ms, ROS_READING_STAMP_AGE_MS_MAX, "%s: a stamp %.0f ms old" % (topic, age_ms))
+                    stamps.append(stamp)
+                print("%s: %d messages in %.1f s on a still vehicle (%.1f Hz configured), %d distinct stamps"
+                      % (topic, len(got), ROS_SENSOR_RATE_WINDOW_S, rate_hz, len(set(stamps))), file=sys.stderr)
+                self.assertGreaterEqual(len(got), ROS_SENSOR_RATE_MIN_FRACTION * expected)
+                self.assertLessEqual(len(got), ROS_SENSOR_RATE_MAX_FRACTION * expected)
+                self.assertEqual(stamps, sorted(stamps), "stamps went back")
+                self.assertLess(len(set(stamps)), len(stamps), "every message stamped anew: the time of sending")
+        # The vehicle was still: the counts are the rate's, not the changes'.
+        self.assertLess(abs(angle_diff(float(rig.sim_teensy("Orientation")[0]), 0.4)), 0.002, "the vehicle turned")
 
     def place_and_wait(self, heading):
         """The simulated vehicle placed (vehicle_motion.place), and caracarad's Teensy reading it:
@@ -415,6 +471,9 @@ class RosTestCase(VehicleTestCase):
         # A clockwise turn (the seed's yaw, + clockwise seen from above).
         rig.reset()
         self.place_and_wait(0.3)
+        # A whole poll round (yaw, pitch, roll, a distance: one a cycle) and a telemetry tick: the
+        # reading now held is all of the placed vehicle, not the heading alone.
+        time.sleep(0.3)
         attitude.clear()
         try:
             samples, _, _, _ = self.listen(2.5, ORIENTATION_TOPICS, during=lambda: during(yaw=0.5))
@@ -426,8 +485,9 @@ class RosTestCase(VehicleTestCase):
         self.check_orientation(samples, attitude, convention, world, body, delta=0.05)
         sign = -1 if convention == "enu" else 1
         for topic in ORIENTATION_TOPICS:
+            # The turn's readings: not one from before the record began (check_orientation).
             qs = [m["orientation"] if topic == "rt/caracara/imu" else m["transforms"][0]["transform"]["rotation"]
-                  for _, m in samples[topic]]
+                  for _, m in samples[topic] if stamp_of(topic, m) + 50e6 >= attitude[0][0]]
             yaws = unwrap([quaternion_yaw(q) for q in qs])
             with self.subTest(topic=topic):
                 self.assertGreater(sign * (yaws[-1] - yaws[0]), 0.4,
@@ -582,10 +642,14 @@ class PublishedTest(RosTestCase):
         for n in ["caracara: thruster_%d" % i for i in range(MOTORS)] + ["caracara: i2c bus", "caracara: teensy",
                                                                          "caracara: failsafes", "caracara: vehicle"]:
             self.assertIn(n, names)
-        # Rates follow the daemon's announcements: joint_states comes with the thrusters' telemetry
-        # (at most 5 Hz, one message a batch, and only when a reading changed: 10 in the 3 s on a
-        # loaded CI machine), not only with changes of state.
+        # joint_states comes at the steady sensor rate (5 Hz: test_steady_rates_on_a_still_vehicle
+        # counts it), not only with changes of state.
         self.assertGreaterEqual(len(samples["rt/caracara/joint_states"]), 5)
+
+    def test_steady_rates_on_a_still_vehicle(self):
+        """imu, /tf and joint_states at the daemon's telemetry rate (the default) to a late subscriber,
+        though nothing changes."""
+        self.check_steady_rates(DAEMON_TELEMETRY_HZ)
 
     def test_orientation_in_enu_flu(self):
         """REP 103 / 145: base_link (x forward, y left, z up) in odom (x east, y north, z up), the
@@ -641,10 +705,14 @@ class JazzyRangeTest(RosTestCase):
 class NedFrdTest(RosTestCase):
     """frame_convention = "ned": base_link_frd (x forward, y right, z down) in odom_ned (x north,
     y east, z down); a clockwise turn reads as yaw increasing."""
-    ROS_CONFIG = 'frame_convention = "ned"\n'
+    ROS_CONFIG = 'frame_convention = "ned"\nsensor_rate_hz = 10\n'
 
     def test_orientation_in_ned_frd(self):
         self.check_attitude_and_turn("ned", "odom_ned", "base_link_frd")
+
+    def test_configured_sensor_rate(self):
+        """[ros] sensor_rate_hz = 10: imu, /tf and joint_states at 10 Hz on a still vehicle."""
+        self.check_steady_rates(10.0)
 
 
 class NoOdomTfTest(RosTestCase):
@@ -673,7 +741,7 @@ class NoOdomTfTest(RosTestCase):
 
 
 class ConfigTest(unittest.TestCase):
-    """The [ros] keys of the frames: a bad value is refused at start, by name, before any DDS."""
+    """The [ros] keys of the frames and rates: a bad value is refused at start, by name, before any DDS."""
 
     def test_bad_frame_options_refused_by_name(self):
         exe = os.path.join(BUILD_DIR, "tools", "ros", "caracara-ros")
@@ -681,7 +749,10 @@ class ConfigTest(unittest.TestCase):
                  ('frame_convention = 1', 'ros.frame_convention must be "enu" or "ned"'),
                  ('publish_odom_tf = "no"', "ros.publish_odom_tf must be true or false"),
                  ('commands = "true"', "ros.commands must be true or false"),
-                 ('odom_tf = false', "unknown key ros.odom_tf")]
+                 ('odom_tf = false', "unknown key ros.odom_tf"),
+                 ('sensor_rate_hz = 0', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50"),
+                 ('sensor_rate_hz = 51.5', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50"),
+                 ('sensor_rate_hz = "5"', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50")]
         with tempfile.TemporaryDirectory() as d:
             conf = os.path.join(d, "ros.toml")
             for line, message in cases:

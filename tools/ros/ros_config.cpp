@@ -1,5 +1,6 @@
 #include "tools/ros/ros_config.hpp"
 
+#include <cmath>
 #include <toml++/toml.h>
 
 namespace caracara::ros {
@@ -34,7 +35,7 @@ std::string load_config(const std::string& path, RosConfig& c) {
     for (const auto& [key, _] : ros.as_table() ? *ros.as_table() : toml::table{}) {
         static const char* const known[] = {"namespace", "domain_id", "range_layout", "commands", "world_frame",
                                             "base_frame", "frame_convention", "publish_odom_tf", "range_min_m",
-                                            "range_max_m", "range_fov_rad"};
+                                            "range_max_m", "range_fov_rad", "sensor_rate_hz"};
         bool ok = false;
         for (const char* k : known)
             ok = ok || key.str() == k;
@@ -80,6 +81,13 @@ std::string load_config(const std::string& path, RosConfig& c) {
         c.range_max_m = static_cast<float>(*v);
     if (auto v = ros["range_fov_rad"].value<double>())
         c.range_fov_rad = static_cast<float>(*v);
+    if (const toml::node* n = ros["sensor_rate_hz"].node()) {
+        const auto v = n->value<double>(); // an integer is taken too
+        if (!v || !std::isfinite(*v) || *v <= 0 || *v > kMaxSensorRateHz)
+            return path + ": ros.sensor_rate_hz must be a number of Hz above 0 and at most " +
+                   std::to_string(static_cast<int>(kMaxSensorRateHz));
+        c.sensor_rate_hz = *v;
+    }
     if (auto v = t["network"]["interface"].value<std::string>())
         c.interface = *v;
     return "";

@@ -30,6 +30,9 @@ struct RosConfig {
     // transform make tf2 jump between them.
     bool publish_odom_tf = true;
     float range_min_m = 0.0f, range_max_m = 65.535f, range_fov_rad = 0.0f;
+    // imu, /tf and joint_states go out at this rate whether their values change or not, as a ROS
+    // driver's do (tf2 and robot_localization wait for a steady stream).
+    double sensor_rate_hz = kDaemonTelemetryRateHz;
     caracara::dbus::BusChoice bus;
 };
 

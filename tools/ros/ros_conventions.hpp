@@ -14,6 +14,13 @@ namespace caracara::ros {
 
 inline constexpr unsigned kThrusterJoints = 8;
 
+// caracarad announces its telemetry (the Teensy's attitude, the thrusters' readings) at 5 Hz
+// (daemon/control/control_loop.cpp, kTelemetryPeriodNs): the sensor topics' default rate.
+inline constexpr double kDaemonTelemetryRateHz = 5.0;
+// The highest sensor rate the config takes: beyond the daemon's loop (50 Hz by default) the
+// same reading would only be sent again.
+inline constexpr double kMaxSensorRateHz = 50.0;
+
 // The frame names of the defaults (REP 105): the world frame and the vehicle's body.
 inline const std::string kDefaultWorldFrame = "odom";
 inline const std::string kDefaultBaseFrame = "base_link";

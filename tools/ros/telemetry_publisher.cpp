@@ -29,11 +29,16 @@ const Value& get(const Props& p, const char* name) {
 }
 char* c_str(const std::string& s) { return const_cast<char*>(s.c_str()); }
 
-// The header's frame_id points into `frame`, which must outlive the message's write.
-std_msgs_msg_dds__Header_ header(const std::string& frame) {
+timespec realtime_now() {
     timespec t{};
     clock_gettime(CLOCK_REALTIME, &t);
-    return {{static_cast<int32_t>(t.tv_sec), static_cast<uint32_t>(t.tv_nsec)}, c_str(frame)};
+    return t;
+}
+
+// The header's frame_id points into `frame`, which must outlive the message's write. `at`: the
+// time of the reading the message carries (now for what has no reading: diagnostics, state).
+std_msgs_msg_dds__Header_ header(const std::string& frame, const timespec& at = realtime_now()) {
+    return {{static_cast<int32_t>(at.tv_sec), static_cast<uint32_t>(at.tv_nsec)}, c_str(frame)};
 }
 
 int thruster_of(const std::string& path) {
@@ -55,6 +60,7 @@ TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, con
     : event_(event), dds_(dds), config_(config),
       world_frame_(world_frame_id(config.world_frame, config.frame_convention)),
       body_frame_(body_frame_id(config.base_frame, config.frame_convention)),
+      sensor_period_us_(static_cast<uint64_t>(1e6 / config.sensor_rate_hz)),
       mirror_([this](const std::string& path, const std::string&, const Props& changes,
                      const Props&) { changed(path, changes); },
               [this] { reload(); }),
@@ -73,6 +79,15 @@ TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, con
     if (sd_event_add_defer(event_, &s, on_flush, this) >= 0) {
         flush_.reset(s);
         sd_event_source_set_enabled(s, SD_EVENT_OFF);
+    }
+    // The sensor topics' steady rate: a timer of its own, accurate to 1 ms (sd-event's default
+    // accuracy, 250 ms, would bunch the messages).
+    uint64_t now = 0;
+    sd_event_now(event_, CLOCK_MONOTONIC, &now);
+    s = nullptr;
+    if (sd_event_add_time(event_, &s, CLOCK_MONOTONIC, now + sensor_period_us_, 1000, on_sensor_tick, this) >= 0) {
+        sensor_timer_.reset(s);
+        sd_event_source_set_enabled(s, SD_EVENT_ON);
     }
 }
 
@@ -110,7 +125,8 @@ bool TelemetryPublisher::connect() {
         client_.reset();
         return false;
     }
-    mark(kImu | kJoints | kRanges | kDiagnostics | kState);
+    teensy_read_at_ = thrusters_read_at_ = realtime_now();
+    mark(kRanges | kDiagnostics | kState);
     return true;
 }
 
@@ -123,7 +139,8 @@ void TelemetryPublisher::reload() {
         std::fprintf(stderr, "caracara-ros: reloading caracarad's objects failed (%s)\n", f.message.c_str());
         return;
     }
-    mark(kImu | kJoints | kRanges | kDiagnostics | kState);
+    teensy_read_at_ = thrusters_read_at_ = realtime_now();
+    mark(kRanges | kDiagnostics | kState);
 }
 
 void TelemetryPublisher::changed(const std::string& path, const Props& changes) {
@@ -132,10 +149,9 @@ void TelemetryPublisher::changed(const std::string& path, const Props& changes) 
         if (changes.contains("State") || changes.contains("KillSource"))
             d |= kState;
     } else if (thruster_of(path) >= 0) {
-        d |= kJoints;
+        thrusters_read_at_ = realtime_now();
     } else if (path == caracara::dbus::kTeensyPath) {
-        if (changes.contains("Orientation"))
-            d |= kImu;
+        teensy_read_at_ = realtime_now();
         // A reading per Teensy poll (each announces its Frames count), changed or not: a range
         // sensor's subscribers expect a steady stream, not only the changes.
         if (changes.contains("Distances") || changes.contains("Frames"))
@@ -157,10 +173,6 @@ int TelemetryPublisher::on_flush(sd_event_source*, void* userdata) {
     self->dirty_ = 0;
     if (d & kState)
         self->write_state();
-    if (d & kImu)
-        self->write_imu_and_tf();
-    if (d & kJoints)
-        self->write_joints();
     if (d & kRanges)
         self->write_ranges();
     if (d & kDiagnostics) {
@@ -189,6 +201,21 @@ int TelemetryPublisher::on_diagnostics_due(sd_event_source*, uint64_t usec, void
     return 0;
 }
 
+int TelemetryPublisher::on_sensor_tick(sd_event_source* s, uint64_t usec, void* userdata) {
+    auto* self = static_cast<TelemetryPublisher*>(userdata);
+    // From the due time, not from now: a late tick does not slow the rate down.
+    sd_event_source_set_time(s, usec + self->sensor_period_us_);
+    sd_event_source_set_enabled(s, SD_EVENT_ON);
+    if (!self->client_ || !self->teensy_read_at_.tv_sec)
+        return 0; // nothing read yet
+    // An offline Teensy's last attitude is no reading: the Imu and /tf stop, as a driver's do
+    // when its sensor goes quiet (the diagnostics say why).
+    if (get(self->props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Online").boolean())
+        self->write_imu_and_tf();
+    self->write_joints();
+    return 0;
+}
+
 void TelemetryPublisher::write_state() {
     const Props& p = props(kRoot, caracara::dbus::kVehicleIface);
     const std::string state = get(p, "State").s, source = get(p, "KillSource").s;
@@ -214,7 +241,7 @@ void TelemetryPublisher::write_imu_and_tf() {
                                                      config_.frame_convention);
     const geometry_msgs_msg_dds__Quaternion_ q{r.x, r.y, r.z, r.w};
     sensor_msgs_msg_dds__Imu_ imu{};
-    imu.header = header(body_frame_);
+    imu.header = header(body_frame_, teensy_read_at_);
     imu.orientation = q;
     // REP 145: the orientation's covariance is unknown (all zeros); the Teensy gives no angular
     // velocity or linear acceleration, marked by -1 in the first element of their covariances.
@@ -224,7 +251,7 @@ void TelemetryPublisher::write_imu_and_tf() {
     if (!config_.publish_odom_tf)
         return;
     geometry_msgs_msg_dds__TransformStamped_ t{};
-    t.header = header(world_frame_);
+    t.header = header(world_frame_, teensy_read_at_);
     t.child_frame_id = c_str(body_frame_);
     t.transform.rotation = q;
     tf2_msgs_msg_dds__TFMessage_ tf{};
@@ -248,10 +275,10 @@ void TelemetryPublisher::write_joints() {
     std::vector<double> none;
     const auto n = static_cast<uint32_t>(names.size());
     // velocity: the reported speed as a fraction of full thrust; effort: the current in A.
-    sensor_msgs_msg_dds__JointState_ js{header(config_.base_frame), {n, n, name_ptrs.data(), false}, {0, 0, nullptr, false},
+    sensor_msgs_msg_dds__JointState_ js{header(config_.base_frame, thrusters_read_at_), {n, n, name_ptrs.data(), false}, {0, 0, nullptr, false},
                                         {n, n, actual.data(), false}, {n, n, current.data(), false}};
     dds_write(joints_, &js);
-    sensor_msgs_msg_dds__JointState_ os{header(config_.base_frame), {n, n, name_ptrs.data(), false}, {0, 0, nullptr, false},
+    sensor_msgs_msg_dds__JointState_ os{header(config_.base_frame, thrusters_read_at_), {n, n, name_ptrs.data(), false}, {0, 0, nullptr, false},
                                         {n, n, ordered.data(), false}, {0, 0, nullptr, false}};
     dds_write(ordered_, &os);
 }
@@ -266,11 +293,11 @@ void TelemetryPublisher::write_ranges() {
         const float metres = range_metres(static_cast<uint32_t>(d.items[i].unsigned_integer()));
         // radiation_type ULTRASOUND (0): the Teensy does not say which kind of sensor it reads.
         if (config_.range_layout == RangeLayout::Jazzy) {
-            jazzy_sensor_msgs_msg_dds__Range_ r{header(frame), 0, config_.range_fov_rad, config_.range_min_m,
+            jazzy_sensor_msgs_msg_dds__Range_ r{header(frame, teensy_read_at_), 0, config_.range_fov_rad, config_.range_min_m,
                                                 config_.range_max_m, metres, 0.0f};
             dds_write(ranges_[i], &r);
         } else {
-            sensor_msgs_msg_dds__Range_ r{header(frame), 0, config_.range_fov_rad, config_.range_min_m,
+            sensor_msgs_msg_dds__Range_ r{header(frame, teensy_read_at_), 0, config_.range_fov_rad, config_.range_min_m,
                                           config_.range_max_m, metres};
             dds_write(ranges_[i], &r);
         }

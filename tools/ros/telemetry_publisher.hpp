@@ -1,7 +1,8 @@
 // caracara-ros's reading connection to caracarad and the topics it publishes: the vehicle's
-// objects (GetManagedObjects) kept current by PropertiesChanged, each change written to the
-// topics it touches once per batch of signals, so the rates are the daemon's announcement
-// rates; nothing is polled. The topics (docs/ros2.md): imu, joint_states, thrusters/ordered,
+// objects (GetManagedObjects) kept current by PropertiesChanged; nothing is polled. imu, /tf,
+// joint_states and thrusters/ordered go out at the config's sensor rate whether values change
+// or not, each stamped with the time of the reading it carries; the others when caracarad
+// announces a change, once per batch of signals. The topics (docs/ros2.md): imu, joint_states, thrusters/ordered,
 // range/N, /diagnostics (at most 1 Hz, at once when a level changes), killed, state and
 // kill_source (transient-local), /tf (unless the config leaves odom -> base_link to the
 // vehicle's localization).
@@ -12,6 +13,7 @@
 #include "tools/ros/dds_participant.hpp"
 
 #include <array>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -30,10 +32,11 @@ public:
     sd_bus* bus() const { return client_ ? client_->bus() : nullptr; }
 
 private:
-    enum Dirty : unsigned { kImu = 1, kJoints = 2, kRanges = 4, kDiagnostics = 8, kState = 16 };
+    enum Dirty : unsigned { kRanges = 4, kDiagnostics = 8, kState = 16 };
     static int on_flush(sd_event_source* s, void* userdata);
     static int on_retry(sd_event_source* s, uint64_t usec, void* userdata);
     static int on_diagnostics_due(sd_event_source* s, uint64_t usec, void* userdata);
+    static int on_sensor_tick(sd_event_source* s, uint64_t usec, void* userdata);
     bool connect();
     void retry();
     void reload();
@@ -54,7 +57,13 @@ private:
     // The Imu's and /tf's frame names in the config's convention (headers point into them).
     const std::string world_frame_, body_frame_;
     std::unique_ptr<client::Client> client_;
-    caracara::SourcePtr flush_, retry_, diagnostics_timer_;
+    const uint64_t sensor_period_us_;
+    caracara::SourcePtr flush_, retry_, diagnostics_timer_, sensor_timer_;
+    // When the readings the mirror holds were taken, as far as caracara-ros can tell: the arrival
+    // (CLOCK_REALTIME) of the object's latest PropertiesChanged. caracarad announces a changed
+    // value at its next telemetry tick, so any later announcement of the object (its counters,
+    // once a second) says the value it holds was read again unchanged. Zero: nothing read yet.
+    timespec teensy_read_at_{}, thrusters_read_at_{};
     client::ObjectMirror mirror_;
     unsigned dirty_ = 0;
     uint64_t diagnostics_last_us_ = 0;
