@@ -288,7 +288,7 @@ int main(int argc, char** argv) {
 #endif
             // Volatile writers match a transient-local reader? No: request volatile for them.
             const bool latched = a.find("/state=") != std::string::npos || a.find("/killed=") != std::string::npos ||
-                                 a.find("/kill_source=") != std::string::npos ||
+                                 a.find("/kill_source=") != std::string::npos || a.rfind("rt/tf_static=", 0) == 0 ||
                                  a.rfind("ros_discovery_info=", 0) == 0;
             if (!latched)
                 rq.durability().kind = VOLATILE_DURABILITY_QOS;

@@ -45,7 +45,8 @@ PUBLISHED = {"rt/caracara/imu": "sensor_msgs/Imu", "rt/caracara/joint_states": "
              "rt/caracara/thrusters/ordered": "sensor_msgs/JointState", "rt/caracara/range/0": "sensor_msgs/Range",
              "rt/diagnostics": "diagnostic_msgs/DiagnosticArray", "rt/caracara/killed": "std_msgs/Bool",
              "rt/caracara/state": "std_msgs/String", "rt/caracara/kill_source": "std_msgs/String",
-             "rt/tf": "tf2_msgs/TFMessage"}
+             "rt/tf": "tf2_msgs/TFMessage", "rt/tf_static": "tf2_msgs/TFMessage"}
+LATCHED = ("killed", "state", "kill_source", "tf_static")  # transient-local, as ROS latches them
 DISCOVERY_INFO = {"ros_discovery_info": "rmw_dds_common/ParticipantEntitiesInfo"}
 GID_BYTES = {"humble": 24, "jazzy": 16}  # rmw_dds_common's Gid: char[24] in Humble, char[16] since Iron
 MOTOR_MAX = 8850
@@ -597,7 +598,7 @@ class PublishedTest(RosTestCase):
                 self.assertEqual(w["type"], "%s::msg::dds_::%s_" % (pkg, name))
                 self.assertTrue(w["reliable"])
                 self.assertTrue(w["xcdr1"])
-                self.assertEqual(w["transient_local"], topic.split("/")[-1] in ("killed", "state", "kill_source"))
+                self.assertEqual(w["transient_local"], topic.split("/")[-1] in LATCHED)
 
     def test_discovery_info_lists_the_node(self):
         """`ros2 node list` / `ros2 node info` see caracara_ros with its topics (Humble's 24-byte gid)."""
@@ -740,6 +741,59 @@ class NoOdomTfTest(RosTestCase):
         self.check_orientation(samples, attitude, "enu", "odom", "base_link", publish_tf=False, delta=0.05)
 
 
+def quaternion_from_rpy(roll, pitch, yaw):
+    """URDF's rpy (fixed axes x, y, z) as a quaternion, the test's own: q = qz(yaw) qy(pitch) qx(roll)."""
+    def mul(a, b):
+        ax, ay, az, aw = a
+        bx, by, bz, bw = b
+        return (aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz)
+    qx = (math.sin(roll / 2), 0, 0, math.cos(roll / 2))
+    qy = (0, math.sin(pitch / 2), 0, math.cos(pitch / 2))
+    qz = (0, 0, math.sin(yaw / 2), math.cos(yaw / 2))
+    x, y, z, w = mul(qz, mul(qy, qx))
+    return {"x": x, "y": y, "z": z, "w": w}
+
+
+class StaticFramesTest(RosTestCase):
+    """/tf_static as tf2's static broadcaster sends it (transient-local, one TFMessage holding every
+    static transform): the IMU's and each distance sensor's mount from the config, in base_link
+    (REP 103 body FLU); each Range in its own frame."""
+    MOUNTS = {"imu_link": ((0.12, -0.05, 0.03), (0.0, 0.0, math.pi / 2)),
+              "sonar_front": ((0.45, 0.0, -0.1), (0.0, 0.2, 0.0))}
+    ROS_CONFIG = ('[ros.imu]\nframe = "imu_link"\nxyz = [0.12, -0.05, 0.03]\nrpy = [0.0, 0.0, %r]\n'
+                  '[[ros.range]]\nframe = "sonar_front"\nxyz = [0.45, 0.0, -0.1]\nrpy = [0.0, 0.2, 0.0]\n' % (math.pi / 2))
+
+    def test_late_subscriber_gets_the_mounts(self):
+        time.sleep(1.0)  # joins late: caracara-ros sent /tf_static long before
+        samples, _, writers, _ = self.listen(2, {"rt/tf_static": "tf2_msgs/TFMessage",
+                                                 "rt/caracara/range/0": "sensor_msgs/Range"})
+        w = writers["rt/tf_static"]
+        self.assertTrue(w["reliable"] and w["transient_local"], w)
+        # Keep-last 1: the one (last) message, holding every static transform.
+        self.assertEqual(len(samples.get("rt/tf_static", [])), 1, samples.get("rt/tf_static"))
+        transforms = {t["child_frame_id"]: t for t in samples["rt/tf_static"][0][1]["transforms"]}
+        distances = len(self.rig.sim_teensy("Distances"))
+        # The config's two, and range_N for each distance sensor beyond the config's one.
+        self.assertEqual(set(transforms), set(self.MOUNTS) | {"range_%d" % i for i in range(1, distances)})
+        for frame, t in transforms.items():
+            with self.subTest(frame=frame):
+                xyz, rpy = self.MOUNTS.get(frame, ((0, 0, 0), (0, 0, 0)))
+                self.assertEqual(t["header"]["frame_id"], "base_link")
+                tr, q = t["transform"]["translation"], t["transform"]["rotation"]
+                for k, axis in enumerate("xyz"):
+                    self.assertAlmostEqual(tr[axis], xyz[k], places=9)
+                want = quaternion_from_rpy(*rpy)
+                for c in "xyzw":
+                    self.assertAlmostEqual(q[c], want[c], places=9)
+        # The IMU turned a quarter left (yaw pi/2): its x axis is base_link's left (+y).
+        imu_x = rotate(transforms["imu_link"]["transform"]["rotation"], (1, 0, 0))
+        for got, want in zip(imu_x, (0, 1, 0)):
+            self.assertAlmostEqual(got, want, places=6)
+        # The Range is in its sensor's own frame.
+        self.assertEqual(samples["rt/caracara/range/0"][-1][1]["header"]["frame_id"], "sonar_front")
+
+
 class ConfigTest(unittest.TestCase):
     """The [ros] keys of the frames and rates: a bad value is refused at start, by name, before any DDS."""
 
@@ -752,7 +806,17 @@ class ConfigTest(unittest.TestCase):
                  ('odom_tf = false', "unknown key ros.odom_tf"),
                  ('sensor_rate_hz = 0', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50"),
                  ('sensor_rate_hz = 51.5', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50"),
-                 ('sensor_rate_hz = "5"', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50")]
+                 ('sensor_rate_hz = "5"', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50"),
+                 ('[ros.imu]\nxyz = [0.1, 0.2]', "ros.imu.xyz must be 3 numbers, metres from the base frame "
+                  "(x forward, y left, z up), each within 10"),
+                 ('[ros.imu]\nxyz = [0.1, 0.2, 120]', "ros.imu.xyz must be 3 numbers"),
+                 ('[ros.imu]\nrpy = [0, 0, 90]', "ros.imu.rpy must be 3 numbers, radians (roll, pitch, yaw about "
+                  "x, y, z), each within 2 pi"),
+                 ('[ros.imu]\nframe = "/imu"', 'ros.imu.frame must be a frame name (letters, digits, _) ("/imu")'),
+                 ('[ros.imu]\nplace = [0, 0, 0]', "unknown key ros.imu.place"),
+                 ('[[ros.range]]\nxyz = [0, 0, 0]\n[[ros.range]]\nrpy = ["a", 0, 0]', "ros.range[1].rpy must be 3 numbers"),
+                 ('[[ros.range]]\nframe = "base_link"', 'sensor frame "base_link" is the vehicle\'s own'),
+                 ('[[ros.range]]\nframe = "imu_link"', 'sensor frame "imu_link" is named twice')]
         with tempfile.TemporaryDirectory() as d:
             conf = os.path.join(d, "ros.toml")
             for line, message in cases:

@@ -9,10 +9,19 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace caracara::ros {
 
 enum class RangeLayout { Humble, Jazzy };
+
+// Where a sensor sits on the vehicle, for /tf_static: its frame's name, its position in metres
+// and its orientation in radians (URDF's rpy: roll about x, pitch about y, yaw about z, fixed
+// axes) in the base frame, REP 103's body FLU (x forward, y left, z up).
+struct SensorMount {
+    std::string frame;
+    frames::Vec3 xyz, rpy;
+};
 
 struct RosConfig {
     std::string ros_namespace = "/caracara";
@@ -33,11 +42,18 @@ struct RosConfig {
     // imu, /tf and joint_states go out at this rate whether their values change or not, as a ROS
     // driver's do (tf2 and robot_localization wait for a steady stream).
     double sensor_rate_hz = kDaemonTelemetryRateHz;
+    // [ros.imu] and [[ros.range]] (one per distance sensor, in the Teensy's order): by default at
+    // the base frame's origin, facing forward; a sensor the config does not list gets that too.
+    SensorMount imu{kDefaultImuFrame, {}, {}};
+    std::vector<SensorMount> ranges;
     caracara::dbus::BusChoice bus;
 };
 
 // Reads `path` into `config`; returns "" or what is wrong with the file (named key and value).
 std::string load_config(const std::string& path, RosConfig& config);
+
+// Distance sensor i's mount: the config's, else range_i at the origin facing forward.
+SensorMount range_mount(const RosConfig& config, std::size_t i);
 
 // The ROS topic name under the namespace ("state" -> "/caracara/state"; "/diagnostics" stays).
 std::string ros_topic(const RosConfig& config, const std::string& name);

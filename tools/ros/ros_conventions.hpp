@@ -24,6 +24,8 @@ inline constexpr double kMaxSensorRateHz = 50.0;
 // The frame names of the defaults (REP 105): the world frame and the vehicle's body.
 inline const std::string kDefaultWorldFrame = "odom";
 inline const std::string kDefaultBaseFrame = "base_link";
+// The IMU's frame on the vehicle (/tf_static), as ROS drivers name it.
+inline const std::string kDefaultImuFrame = "imu_link";
 
 // A frame's name in a convention (core/frames.hpp): NED / FRD frames carry _ned / _frd, as MAVROS
 // names them, so a tool never takes them for REP 103's ENU / FLU ones.

@@ -69,6 +69,9 @@ TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, con
     imu_ = dds_.writer(&sensor_msgs_msg_dds__Imu__desc, topic("imu"), Profile::Default);
     if (config_.publish_odom_tf) // else no writer at all: ros2 topic info /tf names only the localization's
         tf_ = dds_.writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf", Profile::Default);
+    // As tf2's static broadcaster: reliable, transient-local, keep-last 1, one TFMessage holding
+    // every static transform (a late subscriber gets them all at once).
+    tf_static_ = dds_.writer(&tf2_msgs_msg_dds__TFMessage__desc, "/tf_static", Profile::Latched);
     joints_ = dds_.writer(&sensor_msgs_msg_dds__JointState__desc, topic("joint_states"), Profile::Default);
     ordered_ = dds_.writer(&sensor_msgs_msg_dds__JointState__desc, topic("thrusters/ordered"), Profile::Default);
     diagnostics_ = dds_.writer(&diagnostic_msgs_msg_dds__DiagnosticArray__desc, "/diagnostics", Profile::Default);
@@ -94,6 +97,8 @@ TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, con
 TelemetryPublisher::~TelemetryPublisher() { mirror_.clear(); }
 
 void TelemetryPublisher::start() {
+    if (!sent_static_frames_) // the config's sensors at once; the Teensy's others when it reports them
+        write_static_frames();
     if (!connect())
         retry();
 }
@@ -285,11 +290,14 @@ void TelemetryPublisher::write_joints() {
 
 void TelemetryPublisher::write_ranges() {
     const Value& d = get(props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Distances");
+    const bool more = d.items.size() > ranges_.size();
     for (std::size_t i = ranges_.size(); i < d.items.size(); ++i)
         ranges_.push_back(dds_.writer(config_.range_layout == RangeLayout::Jazzy ? &jazzy_range_ : &sensor_msgs_msg_dds__Range__desc,
                                       ros_topic(config_, "range/" + std::to_string(i)), Profile::Default));
+    if (more && d.items.size() > config_.ranges.size())
+        write_static_frames(); // a sensor the config does not list: its frame, at the origin
     for (std::size_t i = 0; i < d.items.size(); ++i) {
-        const std::string frame = range_frame(i);
+        const std::string frame = range_mount(config_, i).frame;
         const float metres = range_metres(static_cast<uint32_t>(d.items[i].unsigned_integer()));
         // radiation_type ULTRASOUND (0): the Teensy does not say which kind of sensor it reads.
         if (config_.range_layout == RangeLayout::Jazzy) {
@@ -302,6 +310,31 @@ void TelemetryPublisher::write_ranges() {
             dds_write(ranges_[i], &r);
         }
     }
+}
+
+void TelemetryPublisher::write_static_frames() {
+    // The IMU and every distance sensor, the config's and the Teensy's (the more of the two).
+    std::vector<SensorMount> mounts{config_.imu};
+    for (std::size_t i = 0; i < std::max(config_.ranges.size(), ranges_.size()); ++i)
+        mounts.push_back(range_mount(config_, i));
+    std::vector<geometry_msgs_msg_dds__TransformStamped_> ts;
+    const timespec now = realtime_now();
+    for (const SensorMount& m : mounts) {
+        // URDF's rpy (fixed axes x, y, z) is the Z-Y-X Euler rotation yaw, pitch, roll.
+        const frames::Quaternion q = frames::from_euler_zyx(m.rpy.z, m.rpy.y, m.rpy.x);
+        geometry_msgs_msg_dds__TransformStamped_ t{};
+        // In REP 103's body FLU, under the base frame itself (not its _frd twin in NED).
+        t.header = header(config_.base_frame, now);
+        t.child_frame_id = c_str(m.frame);
+        t.transform.translation = {m.xyz.x, m.xyz.y, m.xyz.z};
+        t.transform.rotation = {q.x, q.y, q.z, q.w};
+        ts.push_back(t);
+    }
+    // The headers and child frames point into `mounts`, alive until the write returns.
+    tf2_msgs_msg_dds__TFMessage_ tf{};
+    tf.transforms = {static_cast<uint32_t>(ts.size()), static_cast<uint32_t>(ts.size()), ts.data(), false};
+    dds_write(tf_static_, &tf);
+    sent_static_frames_ = true;
 }
 
 // OK 0, WARN 1, ERROR 2 for: each thruster, the bus, the Teensy, the failsafes, the vehicle.

@@ -5,7 +5,7 @@
 // announces a change, once per batch of signals. The topics (docs/ros2.md): imu, joint_states, thrusters/ordered,
 // range/N, /diagnostics (at most 1 Hz, at once when a level changes), killed, state and
 // kill_source (transient-local), /tf (unless the config leaves odom -> base_link to the
-// vehicle's localization).
+// vehicle's localization), /tf_static (the IMU's and each distance sensor's mount).
 #pragma once
 
 #include "tools/client/client.hpp"
@@ -47,6 +47,7 @@ private:
     void write_imu_and_tf();
     void write_joints();
     void write_ranges();
+    void write_static_frames();
     void write_state();
     void write_diagnostics();
     std::vector<uint8_t> levels() const;
@@ -70,8 +71,9 @@ private:
     std::vector<uint8_t> last_levels_;
     std::string last_state_, last_source_;
     bool state_written_ = false;
+    bool sent_static_frames_ = false;
 
-    dds_entity_t imu_, tf_ = 0, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
+    dds_entity_t imu_, tf_ = 0, tf_static_, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
     std::vector<dds_entity_t> ranges_;
     dds_topic_descriptor_t jazzy_range_;
 };
