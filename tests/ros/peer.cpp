@@ -11,7 +11,8 @@
 //   peer publish TOPIC TYPE HEX[,HEX...] COUNT HZ [hold|stdin]   publishes once matched, the samples in
 //                                       turn, one JSON line each {"sent","t_ns"}; hold: then sleeps;
 //                                       stdin: then goes on at HZ with the last sample, each hex line
-//                                       read from stdin the sample from then on, until stdin closes
+//                                       read from stdin the sample from then on, until stdin closes;
+//                                       a line "stop" stops the writes (the writer stays) until the next
 //   peer roundtrip TYPE HEX             Fast CDR's bytes for the sample the hex decodes to
 // t_ns is CLOCK_MONOTONIC, the clock of the simulator's wire log.
 // TYPE is "pkg/Name"; TOPIC the DDS topic ("rt/caracara/imu"). Participant lease 100 ms, so a
@@ -368,12 +369,17 @@ int main(int argc, char** argv) {
                 closed = true;
             });
             void* current = samples.back();
+            bool stopped = false;
             for (int i = count;; ++i) {
                 {
                     std::lock_guard l(m);
                     if (closed)
                         break;
-                    if (!next.empty()) {
+                    if (next == "stop") { // a pilot's stack that stops sending, its writer still there
+                        stopped = true;
+                        next.clear();
+                    } else if (!next.empty()) {
+                        stopped = false;
                         SerializedPayload_t p = unhex(next);
                         next.clear();
                         samples.push_back(current = type.create_data());
@@ -383,9 +389,11 @@ int main(int argc, char** argv) {
                         }
                     }
                 }
-                w->write(current);
-                std::printf("{\"sent\":%d,\"t_ns\":%lld}\n", i, static_cast<long long>(now_ns()));
-                std::fflush(stdout);
+                if (!stopped) {
+                    w->write(current);
+                    std::printf("{\"sent\":%d,\"t_ns\":%lld}\n", i, static_cast<long long>(now_ns()));
+                    std::fflush(stdout);
+                }
                 std::this_thread::sleep_for(period);
             }
             in.join();

@@ -338,14 +338,14 @@ class RosTestCase(VehicleTestCase):
     @contextlib.contextmanager
     def steering(self, topic, type_, msg, hz=50):
         """The peer publishing `msg` at `hz` until the block ends, as a pilot's stack would;
-        send(m) makes it publish m from then on (one writer throughout). At the end it leaves in
-        good order."""
+        send(m) makes it publish m from then on (one writer throughout); send("stop") stops it
+        sending, its writer still there. At the end it leaves in good order."""
         p = subprocess.Popen([self.peer, "publish", topic, type_, self.codec.encode(type_, msg, self.DISTRO), "1",
                               str(hz), "stdin"], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL, text=True)
 
-        def send(m):
-            p.stdin.write(self.codec.encode(type_, m, self.DISTRO) + "\n")
+        def send(m):  # "stop": the writer stops sending and stays
+            p.stdin.write((m if m == "stop" else self.codec.encode(type_, m, self.DISTRO)) + "\n")
             p.stdin.flush()
         try:
             yield send
@@ -755,6 +755,95 @@ def quaternion_from_rpy(roll, pitch, yaw):
     return {"x": x, "y": y, "z": z, "w": w}
 
 
+def ros_gid(guid_hex, distro):
+    """A 16-byte DDS GUID (32 hex digits) as `ros2 topic info -v` prints the GID (rclpy: each byte
+    as two hex digits, dotted), zero-padded to the distro's Gid size."""
+    data = bytes.fromhex(guid_hex) + bytes(GID_BYTES[distro] - 16)
+    return ".".join("%02x" % b for b in data)
+
+
+def commands_status(samples):
+    """The last /diagnostics' "caracara: ros commands" status, its values as a dict."""
+    msgs = samples.get("rt/diagnostics")  # once a second: a listen of 2.5 s or more gets one
+    assert msgs, "no /diagnostics received"
+    return commands_status_of(msgs[-1][1])
+
+
+def commands_status_of(msg):
+    st = [s for s in msg["status"] if s["name"] == "caracara: ros commands"]
+    assert len(st) == 1, [s["name"] for s in msg["status"]]
+    return {**st[0], "values": {kv["key"]: kv["value"] for kv in st[0]["values"]}}
+
+
+class OneWriterTest(RosTestCase):
+    """One commanding writer: the first writer of cmd_wrench / cmd_thrust that commands holds the
+    vehicle until it stops for the command timeout (the vehicle's, 500 ms here) or leaves; a second
+    writer's samples are refused by name, move nothing (the simulator's wire log), are logged with
+    its GID as `ros2 topic info -v` prints it and counted on /diagnostics, which name the holder."""
+    COMMANDS = True
+    CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 500}
+    DIAGNOSTICS = {"rt/diagnostics": "diagnostic_msgs/DiagnosticArray"}
+
+    def test_second_writer_refused_until_the_first_stops(self):
+        rig = self.rig
+        rig.rearm()
+        timeout_s = int(rig.vget("CommandTimeoutMs")) / 1000
+        thrust = lambda d: {"layout": {"dim": [], "data_offset": 0}, "data": d}  # noqa: E731
+        first, second = [0.3, 0.3] + [0] * 6, [0] * 6 + [0.4, 0.4]  # different thrusters each
+        speeds = lambda d: [speed_byte(round(v * MOTOR_MAX)) for v in d]  # noqa: E731
+        with self.steering("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray", thrust(first)) as send_first:
+            rig.wait_sim_speeds(speeds(first))
+            # The first writer's GUID as the peer discovered it: the one cmd_thrust writer so far.
+            samples, _, writers, _ = self.listen(2.5, self.DIAGNOSTICS)
+            first_guid = writers["rt/caracara/cmd_thrust"]["guid"]
+            first_gid = ros_gid(first_guid, self.DISTRO)
+            status = commands_status(samples)
+            self.assertEqual(status["values"]["holder"], first_gid)
+            self.assertEqual(status["message"], "held by writer " + first_gid)
+            since = rig.wire_next()
+            log_start = len(rig.log("caracara-ros"))
+            with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray", thrust(second)):
+                poll(lambda: "(not-holder)" in rig.log("caracara-ros")[log_start:], 20,
+                     message="the second writer was never refused")
+                samples, _, _, endpoints = self.listen(3.5, self.DIAGNOSTICS)
+                # Nothing of the second writer's moved: the wire carried the first's orders only.
+                log = rig.wire_log(since)[1]
+                self.assertEqual([(i, sp) for e, i, sp in orders(log) if i >= 2 and sp != ZERO], [])
+                self.assertEqual({sp for e, i, sp in orders(log) if i < 2}, set(speeds(first)[:2]))
+                self.assertEqual(rig.motor_values(), [round(v * MOTOR_MAX) for v in first])
+                second_guids = {o["guid"] for o in endpoints if o.get("writer") == "rt/caracara/cmd_thrust"} - {first_guid}
+                self.assertEqual(len(second_guids), 1, endpoints)
+                second_gid = ros_gid(second_guids.pop(), self.DISTRO)
+                # Refused by name, logged with its GID, the holder named.
+                self.assertIn("cmd_thrust from writer %s refused (not-holder): the vehicle is held by writer %s"
+                              % (second_gid, first_gid), rig.log("caracara-ros"))
+                # On /diagnostics: the holder, the refusals counted and growing, message by message
+                # (a refusal is there within a second: the diagnostics come at 1 Hz), the last named.
+                counts = []
+                for t_ns, m in samples["rt/diagnostics"]:
+                    st = commands_status_of(m)
+                    self.assertEqual(st["values"]["holder"], first_gid)
+                    self.assertEqual(st["level"], 1, "a recent refusal is a WARN")
+                    counts.append((t_ns, int(st["values"]["refused not-holder"])))
+                self.assertGreaterEqual(len(counts), 2, counts)
+                for (t0, c0), (t1, c1) in zip(counts, counts[1:]):
+                    self.assertLessEqual(t1 - t0, 1.5e9, "diagnostics more than a second apart")
+                    self.assertGreater(c1, c0, "refusals not counted on /diagnostics as they came: %s" % counts)
+                self.assertIn("not-holder from writer " + second_gid, st["values"]["last refusal"])
+                # The first stops (its writer stays): past the command timeout the second takes over.
+                send_first("stop")
+                stopped = time.monotonic()
+                rig.wait_sim_speeds(speeds(second), 20)
+                took_s = time.monotonic() - stopped
+                print("first writer stopped -> second writer's thrust on the thrusters: %.2f s (command timeout %.1f s)"
+                      % (took_s, timeout_s), file=sys.stderr)
+                self.assertGreaterEqual(took_s, timeout_s)
+                self.assertIn("writer %s holds the vehicle" % second_gid, rig.log("caracara-ros"))
+                status = commands_status(self.listen(2.5, self.DIAGNOSTICS)[0])
+                self.assertEqual(status["values"]["holder"], second_gid)
+        rig.wait_sim_zero()
+
+
 class StaticFramesTest(RosTestCase):
     """/tf_static as tf2's static broadcaster sends it (transient-local, one TFMessage holding every
     static transform): the IMU's and each distance sensor's mount from the config, in base_link
@@ -902,6 +991,10 @@ class CommandsTest(RosTestCase):
                       "between -1 and 1, got 2", rig.log("caracara-ros"))
         self.assertEqual(nonzero_orders(rig.wire_log(since)[1]), [])
         self.assertEqual(rig.motor_values(), [0] * MOTORS)
+        # Every refusal is on /diagnostics too, counted by kind (the 5 cases, each once at least).
+        status = commands_status(self.listen(2.5, {"rt/diagnostics": "diagnostic_msgs/DiagnosticArray"})[0])
+        self.assertGreaterEqual(int(status["values"]["refused bad-value"]), 5, status)
+        self.assertIn("bad-value from writer ", status["values"]["last refusal"])
 
     def test_peer_killed_zeros_within_the_client_loss_bound(self):
         rig = self.rig

@@ -110,8 +110,10 @@ int main(int argc, char** argv) {
     sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
     try {
         caracara::ros::DdsParticipant dds(config);
-        caracara::ros::TelemetryPublisher telemetry(event.get(), dds, config);
-        caracara::ros::CommandSubscriber commands(event.get(), dds, config, [&] { kill_over(telemetry.bus(), config.bus); });
+        caracara::ros::CommandRecord record; // the writers' holder and refusals, on /diagnostics
+        caracara::ros::TelemetryPublisher telemetry(event.get(), dds, config, record);
+        caracara::ros::CommandSubscriber commands(event.get(), dds, config, record,
+                                                  [&] { kill_over(telemetry.bus(), config.bus); });
         telemetry.start();
         std::fprintf(stderr, "caracara-ros: domain %u, namespace %s, commands %s\n", config.domain_id,
                      config.ros_namespace.empty() ? "/" : config.ros_namespace.c_str(), config.commands ? "on" : "off");

@@ -1,5 +1,6 @@
 #include "tools/ros/telemetry_publisher.hpp"
 
+#include "core/clock.hpp"
 #include "core/frames.hpp"
 #include "drivers/protocol/seabotix.hpp"
 #include "tools/ros/ros_conventions.hpp"
@@ -20,7 +21,8 @@ namespace {
 const std::string kRoot = caracara::dbus::kRootPath;
 const std::string kThrusterPrefix = kRoot + "/thruster/";
 constexpr unsigned kThrusters = kThrusterJoints;
-constexpr uint64_t kDiagnosticsPeriodUs = 1'000'000; // rqt_robot_monitor's expectation: about 1 Hz
+constexpr uint64_t kDiagnosticsPeriodUs = 1'000'000; // a diagnostics monitor's expectation: about 1 Hz
+constexpr uint64_t kRefusalWarnNs = 10'000'000'000;   // how long a refused command keeps "ros commands" at WARN
 
 const Value kNone;
 const Value& get(const Props& p, const char* name) {
@@ -56,8 +58,9 @@ double actual_fraction(const Props& p) {
 
 } // namespace
 
-TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config)
-    : event_(event), dds_(dds), config_(config),
+TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config,
+                                       CommandRecord& commands)
+    : event_(event), dds_(dds), config_(config), commands_(commands),
       world_frame_(world_frame_id(config.world_frame, config.frame_convention)),
       body_frame_(body_frame_id(config.base_frame, config.frame_convention)),
       sensor_period_us_(static_cast<uint64_t>(1e6 / config.sensor_rate_hz)),
@@ -65,6 +68,7 @@ TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, con
                      const Props&) { changed(path, changes); },
               [this] { reload(); }),
       jazzy_range_(under_type_name(jazzy_sensor_msgs_msg_dds__Range__desc, "sensor_msgs::msg::dds_::Range_")) {
+    commands_.on_change([this] { mark(kDiagnostics); }); // a refusal on /diagnostics within a second
     const auto topic = [&](const char* name) { return ros_topic(config_, name); };
     imu_ = dds_.writer(&sensor_msgs_msg_dds__Imu__desc, topic("imu"), Profile::Default);
     if (config_.publish_odom_tf) // else no writer at all: ros2 topic info /tf names only the localization's
@@ -131,6 +135,7 @@ bool TelemetryPublisher::connect() {
         return false;
     }
     teensy_read_at_ = thrusters_read_at_ = realtime_now();
+    commands_.set_timeout_ms(get(props(kRoot, caracara::dbus::kVehicleIface), "CommandTimeoutMs").unsigned_integer());
     mark(kRanges | kDiagnostics | kState);
     return true;
 }
@@ -145,6 +150,7 @@ void TelemetryPublisher::reload() {
         return;
     }
     teensy_read_at_ = thrusters_read_at_ = realtime_now();
+    commands_.set_timeout_ms(get(props(kRoot, caracara::dbus::kVehicleIface), "CommandTimeoutMs").unsigned_integer());
     mark(kRanges | kDiagnostics | kState);
 }
 
@@ -351,6 +357,9 @@ std::vector<uint8_t> TelemetryPublisher::levels() const {
     out.push_back(get(v, "Failsafes").items.empty() ? 0 : 1);
     const std::string state = get(v, "State").s;
     out.push_back(state == "fault" ? 2 : state == "ready" || state == "arming" ? 0 : 1);
+    // The ROS commands: WARN while a refusal is recent, so a monitor shows it, then OK again.
+    const uint64_t last = commands_.last_refusal_ns();
+    out.push_back(last && monotonic_ns() < last + kRefusalWarnNs ? 1 : 0);
     return out;
 }
 
@@ -404,6 +413,17 @@ void TelemetryPublisher::write_diagnostics() {
     st.push_back({lv[kThrusters + 3], "caracara: vehicle", get(v, "State").s, "caracarad",
                   {{"kill source", get(v, "KillSource").s}, {"profile", get(v, "Profile").s},
                    {"controller", get(v, "Controller").s}, {"budget limit", std::to_string(get(v, "BudgetLimit").integer())}}});
+    const uint64_t now = monotonic_ns();
+    const std::string holder = commands_.holder(now);
+    Status cs{lv[kThrusters + 4], "caracara: ros commands",
+              !config_.commands ? "off (kill only)" : holder.empty() ? "no writer holds the vehicle" : "held by writer " + holder,
+              "caracara-ros",
+              {{"holder", holder}, {"command timeout ms", std::to_string(commands_.timeout_ms())},
+               {"refused", std::to_string(commands_.refusals())}}};
+    for (const auto& n : EnumNames<CommandRefusal>::table)
+        cs.values.push_back({"refused " + std::string(n.name), std::to_string(commands_.refusals(n.value))});
+    cs.values.push_back({"last refusal", commands_.last_refusal()});
+    st.push_back(std::move(cs));
     std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> kvs(st.size());
     std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_> out;
     for (std::size_t i = 0; i < st.size(); ++i) {

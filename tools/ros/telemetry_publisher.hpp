@@ -10,6 +10,7 @@
 
 #include "tools/client/client.hpp"
 #include "tools/client/object_mirror.hpp"
+#include "tools/ros/command_record.hpp"
 #include "tools/ros/dds_participant.hpp"
 
 #include <array>
@@ -21,7 +22,9 @@ namespace caracara::ros {
 
 class TelemetryPublisher {
 public:
-    TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config);
+    // `commands`: the ROS writers' holder and refusals, a status of /diagnostics; its command
+    // timeout is set from the daemon's CommandTimeoutMs.
+    TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config, CommandRecord& commands);
     ~TelemetryPublisher();
     TelemetryPublisher(const TelemetryPublisher&) = delete;
     TelemetryPublisher& operator=(const TelemetryPublisher&) = delete;
@@ -55,6 +58,7 @@ private:
     sd_event* event_;
     DdsParticipant& dds_;
     const RosConfig& config_;
+    CommandRecord& commands_;
     // The Imu's and /tf's frame names in the config's convention (headers point into them).
     const std::string world_frame_, body_frame_;
     std::unique_ptr<client::Client> client_;
