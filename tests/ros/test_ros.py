@@ -413,15 +413,17 @@ class RosTestCase(VehicleTestCase):
         self.place_and_wait(0.4)
         time.sleep(1.5)  # this subscriber joins long after the values last changed
         realtime_minus_monotonic = time.time_ns() - time.monotonic_ns()
-        # Counted from a second after the first message: the peer's readers matched first, and
-        # Cyclone's writers match them a little later (a gap of up to 800 ms before that).
-        samples, _, _, _ = self.listen(ROS_SENSOR_RATE_WINDOW_S + 2, topics)
+        # Counted from 2.5 s after the first message: the first one or two come as the peer's
+        # readers match, then nothing until Cyclone's writers have matched them too (0.8-1 s alone,
+        # about 2.4 s once in a whole e2e_ros run on the loaded machine); from then on the rate.
+        samples, _, _, _ = self.listen(ROS_SENSOR_RATE_WINDOW_S + 3.5, topics)
         expected = rate_hz * ROS_SENSOR_RATE_WINDOW_S
         for topic in topics:
             with self.subTest(topic=topic):
                 got = samples.get(topic, [])
                 self.assertTrue(got, "nothing on " + topic)
-                start = got[0][0] + 10 ** 9
+                start = got[0][0] + 2.5e9
+                startup_gap_ms = max((b[0] - a[0]) / 1e6 for a, b in zip(got, got[1:]) if a[0] < start)
                 got = [(t, m) for t, m in got if start <= t < start + ROS_SENSOR_RATE_WINDOW_S * 10 ** 9]
                 stamps = []
                 for t_ns, m in got:
@@ -430,8 +432,9 @@ class RosTestCase(VehicleTestCase):
                     self.assertGreaterEqual(age_ms, -5, "%s stamped after it arrived" % topic)
                     self.assertLessEqual(age_ms, ROS_READING_STAMP_AGE_MS_MAX, "%s: a stamp %.0f ms old" % (topic, age_ms))
                     stamps.append(stamp)
-                print("%s: %d messages in %.1f s on a still vehicle (%.1f Hz configured), %d distinct stamps"
-                      % (topic, len(got), ROS_SENSOR_RATE_WINDOW_S, rate_hz, len(set(stamps))), file=sys.stderr)
+                print("%s: %d messages in %.1f s on a still vehicle (%.1f Hz configured), %d distinct stamps; "
+                      "before the window the longest gap %.0f ms" % (topic, len(got), ROS_SENSOR_RATE_WINDOW_S, rate_hz,
+                                                                    len(set(stamps)), startup_gap_ms), file=sys.stderr)
                 self.assertGreaterEqual(len(got), ROS_SENSOR_RATE_MIN_FRACTION * expected)
                 self.assertLessEqual(len(got), ROS_SENSOR_RATE_MAX_FRACTION * expected)
                 self.assertEqual(stamps, sorted(stamps), "stamps went back")
