@@ -214,8 +214,12 @@ int TelemetryPublisher::on_diagnostics_due(sd_event_source*, uint64_t usec, void
 
 int TelemetryPublisher::on_sensor_tick(sd_event_source* s, uint64_t usec, void* userdata) {
     auto* self = static_cast<TelemetryPublisher*>(userdata);
-    // From the due time, not from now: a late tick does not slow the rate down.
-    sd_event_source_set_time(s, usec + self->sensor_period_us_);
+    // From the due time, not from now: a late tick does not slow the rate down. After a stall of
+    // more than a period the missed ticks are skipped, not sent in a burst of the same reading.
+    uint64_t now = 0;
+    sd_event_now(self->event_, CLOCK_MONOTONIC, &now);
+    const uint64_t next = usec + self->sensor_period_us_;
+    sd_event_source_set_time(s, next > now ? next : now + self->sensor_period_us_);
     sd_event_source_set_enabled(s, SD_EVENT_ON);
     if (!self->client_ || !self->teensy_read_at_.tv_sec)
         return 0; // nothing read yet
