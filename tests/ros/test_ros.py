@@ -414,8 +414,8 @@ class RosTestCase(VehicleTestCase):
         time.sleep(1.5)  # this subscriber joins long after the values last changed
         realtime_minus_monotonic = time.time_ns() - time.monotonic_ns()
         # Counted from 2.5 s after the first message: the first one or two come as the peer's
-        # readers match, then nothing until Cyclone's writers have matched them too (0.8-1 s alone,
-        # about 2.4 s once in a whole e2e_ros run on the loaded machine); from then on the rate.
+        # readers match, then there may be a gap before the stream runs (1 s at 5 Hz and 2.4 s once
+        # with the listening peer's old 100 ms lease; 0.2 s with its 2 s one); from then on the rate.
         samples, _, _, _ = self.listen(ROS_SENSOR_RATE_WINDOW_S + 3.5, topics)
         expected = rate_hz * ROS_SENSOR_RATE_WINDOW_S
         for topic in topics:
