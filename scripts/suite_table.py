@@ -237,6 +237,11 @@ def table(results):
         if name in ("e2e_bridge", "e2e_cockpit"):
             add(by["bridge Debian 12" if name == "e2e_bridge" else "cockpit Debian 12"], t)
             continue
+        if name == "npm_bridge":
+            # The setup test that installs the bridge's and the cockpit's npm packages
+            # (FIXTURES_SETUP, label bridge): the bridge row's; npm_ros is e2e_ros's, in e2e.
+            add(by["bridge Debian 12"], t)
+            continue
         if name in ("system_debs", "system_nspawn"):
             suite = by["system Debian 12"]
         elif "kernel" in ls:
@@ -249,7 +254,8 @@ def table(results):
             suite = by["soak"]
         elif "release" in ls:
             suite = by["release (version)"]
-        elif name == "layers":
+        elif name in ("layers", "bounds_lint", "bounds_lint_test"):
+            # The lints on the sources: the layering rules, and the bounds file (tests/bounds_lint.py).
             suite = by["layers"]
         elif name == "readme_suites":
             suite = by["README CI table"]

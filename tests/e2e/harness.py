@@ -26,6 +26,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
@@ -35,8 +36,10 @@ import dbus
 import dbus.mainloop.glib
 from gi.repository import GLib
 
-# The npm packages the Node tests pin (tests/bridge, tests/ros), cached between runs.
-NPM_CACHE = "/var/cache/caracara-npm"
+# The npm packages the Node tests pin (tests/bridge, tests/ros): tests/npm_packages.py.
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import npm_packages  # noqa: E402
+
 CI_RUN = os.environ.get("CI") == "true"
 
 
@@ -48,18 +51,19 @@ def missing(what):
 
 
 def npm_ci(here):
-    """node_modules in `here` as its package-lock.json pins them (once per lock). npm is needed only
-    to install them (the Debian 13 root has node and the packages the host installed)."""
+    """Checks that node_modules in `here` are what its package-lock.json pins. Never installs: a test
+    may run in a namespace without network (e2e_ros: unshare --net); CTest's setup tests npm_bridge
+    and npm_ros install them beforehand (tests/npm_packages.py, FIXTURES_REQUIRED)."""
     if not shutil.which("node"):
         missing("node is needed (scripts/deps.sh)")
-    stamp = os.path.join(here, "node_modules", ".package-lock.json")
-    lock = os.path.join(here, "package-lock.json")
-    if os.path.exists(stamp) and os.path.getmtime(stamp) >= os.path.getmtime(lock):
+    why = npm_packages.stale(here)
+    if why is None:
         return
     if not shutil.which("npm"):
         missing("npm is needed to install %s's packages (scripts/deps.sh)" % here)
-    subprocess.run(["npm", "ci", "--cache", NPM_CACHE, "--no-audit", "--no-fund", "--prefer-offline"], cwd=here,
-                   check=True, stdout=subprocess.DEVNULL)
+    raise AssertionError("%s: the CTest setup test %s installs them (tests/npm_packages.py %s), outside any "
+                         "network namespace; this test does not fetch" % (why, npm_packages.fixture(here), here))
+
 
 # --- where things are -----------------------------------------------------------------------
 

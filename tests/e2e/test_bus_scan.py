@@ -11,7 +11,7 @@ import subprocess
 import time
 import unittest
 
-from bounds import SCAN_KILL_REPLY_MS_MAX
+from bounds import KILL_REPLY_MS_MAX
 from harness import (DEFAULT_MT, ERR, MOTORS, SIM, ZERO, Rig, VehicleTestCase, command, error_name, poll,
                      toml_value)
 
@@ -202,7 +202,7 @@ class KillDuringScanTest(ScanCase):
         out, err = scan.communicate(timeout=30)
         late_ms = (t_reply - t_kill) / 1e6
         print("\nKill() during a scan: replied (its zeros on the wire) after %.2f ms" % late_ms)
-        self.assertLess(late_ms, SCAN_KILL_REPLY_MS_MAX)
+        self.assertLess(late_ms, KILL_REPLY_MS_MAX)
         self.assertEqual(scan.returncode, 1, "the scan was not ended by the kill: %s" % out)
         self.assertIn("Killed", err)
         self.assertEqual(busy, ERR + "Busy")

@@ -5,7 +5,7 @@ import statistics
 import time
 import unittest
 
-from bounds import (COMMAND_TIMEOUT_LATENESS_MS_MAX)
+from bounds import COMMAND_TIMEOUT_EARLY_MS_MAX, COMMAND_TIMEOUT_LATENESS_MS_MAX
 from harness import (ZERO, DEFAULT_MT, VehicleTestCase, poll, speed_byte)
 
 
@@ -33,7 +33,7 @@ class CommandTimeoutTimerTest(VehicleTestCase):
               % (", ".join("%.2f" % v for v in lateness), median))
         # Before, the zero waited for the next 50 Hz tick: 13-19 ms late.
         self.assertLess(median, COMMAND_TIMEOUT_LATENESS_MS_MAX)
-        self.assertGreater(median, -2.0, "zeroed before the timeout")
+        self.assertGreater(median, -COMMAND_TIMEOUT_EARLY_MS_MAX, "zeroed before the timeout")
 
 
 if __name__ == "__main__":

@@ -18,7 +18,7 @@ import dbus
 
 from harness import (DEFAULT_MT, ERR, MOTORS, ROOT, SEED_AXIS_MOTORS, VEHICLE, ZERO, Rig, budget_limit, command,
                      error_name, poll, pump_main_loop, speed_byte)
-from bounds import FAILSAFE_LATENESS_MS_MAX
+from bounds import FAILSAFE_LATENESS_MS_MAX, KILL_REPLY_MS_MAX, SURFACE_ASCENT_EARLY_MS_MAX
 from vehicle_checks import KILL_OUT
 
 THRUSTER_CONDITIONS = ["water-detect", "ground-fault", "overtemp", "stall", "hall"]
@@ -386,13 +386,15 @@ class SurfaceTest(FailsafeCase):
             self.assertTrue(all(s == ascent[i] for i, s in between), "an order that is not the ascent: %r" %
                             [(i, hex(s)) for i, s in between if s != ascent[i]][:5])
             took = (edge.time_ns - first.time_ns) / 1e6
-            print("\nascent on the wire for %.0f ms (configured 1500)" % took)
-            self.assertGreaterEqual(took, 1500 - 25)  # from its first order, within a loop period
-            self.assertLess(took, 1500 + 500)
+            duration_ms = self.SURFACE["duration_ms"]
+            print("\nascent on the wire for %.0f ms (configured %d)" % (took, duration_ms))
+            # From its first order, within a loop period; its end is the FailsafeMonitor's.
+            self.assertGreaterEqual(took, duration_ms - SURFACE_ASCENT_EARLY_MS_MAX)
+            self.assertLessEqual(took, duration_ms + FAILSAFE_LATENESS_MS_MAX)
             self.assertFalse(nonzero_after_kill(log, edge))
             # The ascent ran to the end SurfacingUntil said: its kill then, its orders up to it.
             until_ns = assert_deadline_kept(self, until, edge, "SurfacingUntil")
-            self.assertLessEqual(until_ns - first.time_ns, 1500e6, "SurfacingUntil later than its duration")
+            self.assertLessEqual(until_ns - first.time_ns, duration_ms * 1e6, "SurfacingUntil later than its duration")
             self.assertEqual(int(rig.vget("SurfacingUntil")), 0)
             self.assertEqual(error_name(rig.vcall, "ClearKill"), ERR + "FailsafeActive")
         finally:
@@ -412,7 +414,7 @@ class SurfaceTest(FailsafeCase):
             since = rig.wire_next()
             t0 = time.monotonic()
             rig.vcall("Kill")
-            self.assertLess(time.monotonic() - t0, 1.0)
+            self.assertLess((time.monotonic() - t0) * 1000, KILL_REPLY_MS_MAX)
             self.assertEqual(rig.state(), "killed")
             self.assertEqual(rig.vget("KillSource"), "dbus")
             rig.wait_sim_zero()

@@ -10,7 +10,7 @@ import re
 import time
 import unittest
 
-from bounds import TEENSY_SILENCE_LATENESS_MS_MAX
+from bounds import TEENSY_SILENCE_EARLY_MS_MAX, TEENSY_SILENCE_LATENESS_MS_MAX
 from harness import ERR, MOTORS, TEENSY_IFACE, TEENSY_PATH, ZERO, Rig, error_name, poll, speed_byte
 from test_failsafes import kill_edges, nonzero_after_kill, orders
 
@@ -62,7 +62,7 @@ class TeensySilenceTest(unittest.TestCase):
         print("\n%s: kill output %.1f ms, last thruster zero %.1f ms after the Teensy fell silent (silence_ms %d)"
               % (self._testMethodName, late_ms, max(zeros.values()) if zeros else -1, SILENCE_MS))
         # Not before the silence: the last valid frame was at most one poll (20 ms) before.
-        self.assertGreaterEqual(late_ms, SILENCE_MS - 40)
+        self.assertGreaterEqual(late_ms, SILENCE_MS - TEENSY_SILENCE_EARLY_MS_MAX)
         self.assertLess(late_ms, SILENCE_MS + TEENSY_SILENCE_LATENESS_MS_MAX)
         self.assertEqual(sorted(zeros), list(range(MOTORS)), "not every thruster got a zero after the kill output")
         self.assertLess(max(zeros.values()), SILENCE_MS + TEENSY_SILENCE_LATENESS_MS_MAX)

@@ -9,3 +9,9 @@ if(NOT CARACARA_SANITIZE AND NOT CMAKE_CROSSCOMPILING)
   add_test(NAME kernel COMMAND ${CMAKE_CURRENT_LIST_DIR}/run.sh ${CMAKE_BINARY_DIR}/kernel)
   set_tests_properties(kernel PROPERTIES LABELS kernel TIMEOUT 1500 SKIP_RETURN_CODE 77)
 endif()
+
+# The doc check run.sh ends with (tests/kernel/write_doc.py --check), on a section and run outputs
+# made by the test itself: no QEMU, no root; in every build (the Debian 13 root's ctest too).
+add_test(NAME kernel_doc_check COMMAND /usr/bin/python3 -m unittest -v test_write_doc
+         WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR})
+set_tests_properties(kernel_doc_check PROPERTIES ENVIRONMENT "PYTHONDONTWRITEBYTECODE=1")

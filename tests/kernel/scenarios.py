@@ -1087,12 +1087,20 @@ def nodes_from_udev():
     driver_line = next(line for line in rules.splitlines() if 'KERNEL=="i2c-bcm2835"' in line)
     with open("/run/udev/rules.d/60-caracara.rules", "w") as f:
         f.write(rules + "\n" + driver_line.replace("i2c-bcm2835", DRIVER_ID) + "\n")
-    udevd = subprocess.Popen(["/lib/systemd/systemd-udevd"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    # The guest runs chrooted into the host's root: systemd's tools refuse to act there unless told.
+    env = dict(os.environ, SYSTEMD_IGNORE_CHROOT="1")
+    udevd = subprocess.Popen(["/lib/systemd/systemd-udevd", "--debug"], stdout=subprocess.DEVNULL,
+                             stderr=open("/run/udevd.log", "w"), env=env)
+    # A trigger before udevd listens is lost: wait until it answers (its control socket comes first).
+    poll(lambda: subprocess.run(["udevadm", "control", "--ping", "--timeout=5"], env=env,
+                                stderr=subprocess.DEVNULL).returncode == 0, 30, interval=0.2,
+         message="systemd-udevd never answered")
     subprocess.run(["udevadm", "trigger", "--action=add", "--subsystem-match=i2c-dev", "--subsystem-match=spidev",
-                    "--subsystem-match=gpio"], check=True)
-    subprocess.run(["udevadm", "trigger", "--action=add", "--subsystem-match=drivers", "--sysname-match=" + DRIVER_ID],
-                   check=True)
-    subprocess.run(["udevadm", "settle", "--timeout=30"], check=True)
+                    "--subsystem-match=gpio"], check=True, env=env)
+    subprocess.run(["udevadm", "trigger", "--type=subsystems", "--action=add", "--subsystem-match=drivers",
+                    "--sysname-match=" + DRIVER_ID],
+                   check=True, env=env)
+    subprocess.run(["udevadm", "settle", "--timeout=30"], check=True, env=env)
     return udevd
 
 
@@ -1147,6 +1155,10 @@ def sc_device_access(rig):
     finally:
         udevd.terminate()
         udevd.wait(10)
+        with open("/run/udevd.log") as f:
+            log = f.read()
+        print("--- systemd-udevd on the nodes:\n" + "\n".join(
+            line for line in log.splitlines() if re.search(r"i2c-\d|spidev|gpiochip|caracara-i2c", line))[-4000:])
         # The next scenarios' daemon runs as root again, as every other scenario's.
         if not rig._died("caracarad"):
             rig.stop_daemon()

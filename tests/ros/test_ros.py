@@ -30,8 +30,9 @@ sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
 
 import harness  # noqa: E402
 from harness import missing, npm_ci  # noqa: E402
-from bounds import CLIENT_LOSS_ZERO_MS_MAX, ROS_READING_STAMP_AGE_MS_MAX, ROS_SENSOR_RATE_MAX_FRACTION  # noqa: E402
-from bounds import ROS_SENSOR_RATE_MIN_FRACTION, ROS_SENSOR_RATE_WINDOW_S  # noqa: E402
+from bounds import CLIENT_LOSS_ZERO_MS_MAX, ORIENTATION_TO_JUDGE_MIN_RAD, ROS_READING_STAMP_AGE_MS_MAX  # noqa: E402
+from bounds import ROS_SENSOR_RATE_MAX_FRACTION, ROS_SENSOR_RATE_MIN_FRACTION, ROS_SENSOR_RATE_WINDOW_S  # noqa: E402
+from bounds import ROS_TAKEOVER_EARLY_MS_MAX  # noqa: E402
 from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, angle_diff, poll, speed_byte  # noqa: E402
 from test_failsafes import kill_edges, orders  # noqa: E402
 from vehicle_motion import START_HEADING_RAD, judge, place  # noqa: E402
@@ -429,7 +430,7 @@ class RosTestCase(VehicleTestCase):
                 for t_ns, m in got:
                     stamp = stamp_of(topic, m)
                     age_ms = (t_ns + realtime_minus_monotonic - stamp) / 1e6
-                    self.assertGreaterEqual(age_ms, -5, "%s stamped after it arrived" % topic)
+                    self.assertGreaterEqual(age_ms, 0, "%s stamped after it arrived" % topic)
                     self.assertLessEqual(age_ms, ROS_READING_STAMP_AGE_MS_MAX, "%s: a stamp %.0f ms old" % (topic, age_ms))
                     stamps.append(stamp)
                 print("%s: %d messages in %.1f s on a still vehicle (%.1f Hz configured), %d distinct stamps; "
@@ -469,8 +470,8 @@ class RosTestCase(VehicleTestCase):
             samples, _, _, _ = self.listen(2, ORIENTATION_TOPICS, during=lambda: during(pitch=0.5, roll=0.5))
         finally:
             rig.motion()
-        self.assertGreater(min(a[1][1] for a in attitude), 0.15, "not nose up enough to judge")
-        self.assertGreater(min(a[1][2] for a in attitude), 0.15, "not rolled right enough to judge")
+        self.assertGreater(min(a[1][1] for a in attitude), ORIENTATION_TO_JUDGE_MIN_RAD, "not nose up enough to judge")
+        self.assertGreater(min(a[1][2] for a in attitude), ORIENTATION_TO_JUDGE_MIN_RAD, "not rolled right enough to judge")
         self.check_orientation(samples, attitude, convention, world, body)
         # A clockwise turn (the seed's yaw, + clockwise seen from above).
         rig.reset()
@@ -842,7 +843,7 @@ class OneWriterTest(RosTestCase):
                       % (took_s, timeout_s), file=sys.stderr)
                 # Not before the timeout ran out from the first writer's last sample, which went out
                 # up to one of its 50 Hz periods before "stop" reached it (0.49 s once, in a whole run).
-                self.assertGreaterEqual(took_s, timeout_s - 2 / 50)
+                self.assertGreaterEqual(took_s * 1000, timeout_s * 1000 - ROS_TAKEOVER_EARLY_MS_MAX)
                 self.assertIn("writer %s holds the vehicle" % second_gid, rig.log("caracara-ros"))
                 status = commands_status(self.listen(2.5, self.DIAGNOSTICS)[0])
                 self.assertEqual(status["values"]["holder"], second_gid)

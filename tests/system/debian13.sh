@@ -181,14 +181,10 @@ chmod 0755 "$root/usr/local/bin/caracara-build-and-test"
 debs=$build-debs
 mkdir -p "$debs"
 # The ros tests' npm packages (tests/ros/package-lock.json): the root has no network and sees the
-# source read-only, so they are installed here, as the host's own e2e_ros does (tests/e2e/harness.py
-# npm_ci); the root's node runs them (plain JavaScript).
-ros_npm=$src/tests/ros
-if [ ! "$ros_npm/node_modules/.package-lock.json" -nt "$ros_npm/package-lock.json" ]; then
-  command -v npm >/dev/null || die "npm is needed for the ros tests' packages (scripts/deps.sh)"
-  (cd "$ros_npm" && npm ci --cache /var/cache/caracara-npm --no-audit --no-fund --prefer-offline >/dev/null) ||
-    die "npm ci in $ros_npm failed"
-fi
+# source read-only, so they are installed here, on the host, by the script CTest's setup test
+# npm_ros runs (tests/npm_packages.py); in the root npm_ros finds them up to date and e2e_ros only
+# checks them (tests/e2e/harness.py npm_ci). The root's node runs them (plain JavaScript).
+/usr/bin/python3 "$src/tests/npm_packages.py" "$src/tests/ros" || die "the ros tests' npm packages could not be installed"
 # The root's own ccache (GCC 14, not the host's compiler), kept between runs: CI builds mostly
 # the same sources each time, from a clone at a new path (scripts/ccache.sh sets the base dir).
 ccache_dir=$cache_dir/ccache-$suite-$arch

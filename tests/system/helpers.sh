@@ -43,10 +43,11 @@ state_is() { [ "$(state)" = "$1" ]; }
 wire_next() { vbus call $S $SP $S GetWireLog t 9223372036854775808 | awk '{print $2}'; }
 # pilot_lost_kill T0_US: the last pilot left the bus just after T0_US (CLOCK_MONOTONIC us): the
 # pilot-lost failsafe kills (KillSource failsafe), seen no sooner than the default persistence
+# (PILOT_LOST_PERSISTENCE_MS, tests/bounds.json: core/failsafe.hpp's, checked by tests/bounds_lint.py)
 # after T0 and at most PILOT_LOST_KILL_LATENESS_MS_MAX later (the packaged configuration has no kill output line to time on
 # the wire, so the kill is timed by polling State). Without T0_US (the pilot left at a time
 # unknown): the kill alone.
-PILOT_LOST_MS=5000
+PILOT_LOST_MS=$PILOT_LOST_PERSISTENCE_MS
 pilot_lost_kill() {
   local seen
   wait_until $((PILOT_LOST_MS / 1000 + 5)) state_is killed || { info "not killed: State $(state)"; return 1; }
