@@ -157,6 +157,14 @@ def fixed_sample(type_, distro="humble"):
     }[type_]
 
 
+def peer_exited(p, err):
+    """A publishing peer that exited by itself before the test was done with it (no reader matched
+    it in time, say): that, with what it said, is the failure."""
+    if p.poll() is not None:
+        err.seek(0)
+        raise AssertionError("the publishing peer exited with %s: %s" % (p.returncode, err.read().strip()))
+
+
 def nonzero_orders(log):
     """The thruster orders of the log that are not zero."""
     return [e for e, _, speed in orders(log) if speed != ZERO]
@@ -200,6 +208,15 @@ def expected_axes(attitude, convention):
     if convention == "enu":
         return (forward[1], forward[0], forward[2]), (-right[1], -right[0], -right[2])
     return (forward[0], forward[1], -forward[2]), (right[0], right[1], -right[2])
+
+
+def sim_attitude(rig):
+    """(CLOCK_REALTIME ns, [yaw, pitch, roll]): the simulator's attitude, timed at the middle of
+    the call that read it (timed before it, a slow reply on the loaded machine made the simulator
+    seem ahead of what it was at that time)."""
+    before = time.time_ns()
+    att = [float(x) for x in rig.sim_teensy("Orientation")]
+    return ((before + time.time_ns()) // 2, att)
 
 
 def stamp_of(topic, m):
@@ -324,32 +341,43 @@ class RosTestCase(VehicleTestCase):
         return r
 
     @contextlib.contextmanager
-    def driving(self, topic, type_, msg, hz=50):
+    def driving(self, topic, type_, msg, hz=50, short_lease=False):
         """The peer publishing `msg` at `hz` (50: as a pilot's stack would) until the block ends,
-        then SIGKILLed: a writer that goes away without a word."""
+        then SIGKILLed: a writer that goes away without a word. short_lease: its participant's
+        lease 100 ms (peer.cpp), for a test that times how soon its death is noticed."""
         hex_ = self.codec.encode(type_, msg, self.DISTRO)
-        p = subprocess.Popen([self.peer, "publish", topic, type_, hex_, "1000000", str(hz), "hold"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        try:
-            yield p
-        finally:
-            p.send_signal(signal.SIGKILL)
-            p.wait(10)
+        env = dict(os.environ, PEER_SHORT_LEASE="1" if short_lease else "0")
+        with tempfile.TemporaryFile("w+") as err:
+            p = subprocess.Popen([self.peer, "publish", topic, type_, hex_, "1000000", str(hz), "hold"],
+                                 stdout=subprocess.DEVNULL, stderr=err, text=True, env=env)
+            try:
+                yield p
+            except Exception:
+                peer_exited(p, err)
+                raise
+            finally:
+                p.send_signal(signal.SIGKILL)
+                p.wait(10)
 
     @contextlib.contextmanager
     def steering(self, topic, type_, msg, hz=50):
         """The peer publishing `msg` at `hz` until the block ends, as a pilot's stack would;
         send(m) makes it publish m from then on (one writer throughout); send("stop") stops it
         sending, its writer still there. At the end it leaves in good order."""
+        err = tempfile.TemporaryFile("w+")
+        self.addCleanup(err.close)
         p = subprocess.Popen([self.peer, "publish", topic, type_, self.codec.encode(type_, msg, self.DISTRO), "1",
                               str(hz), "stdin"], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL, text=True)
+                             stderr=err, text=True)
 
         def send(m):  # "stop": the writer stops sending and stays
             p.stdin.write((m if m == "stop" else self.codec.encode(type_, m, self.DISTRO)) + "\n")
             p.stdin.flush()
         try:
             yield send
+        except Exception:
+            peer_exited(p, err)
+            raise
         finally:
             p.stdin.close()
             try:
@@ -390,8 +418,12 @@ class RosTestCase(VehicleTestCase):
                     want = expected_axes(att, convention)
                     return max(abs(got[axis][k] - want[axis][k]) for axis in range(2) for k in range(3))
                 att = min(near, key=error)
-                self.assertLessEqual(error(att), delta, "%s: body axes x, y in %s: got %s, the simulator's %s gives %s"
-                                     % (topic, world, got, att, expected_axes(att, convention)))
+                if error(att) > delta:
+                    best_t, best = min(attitude, key=lambda a: error(a[1]))
+                    self.fail("%s: body axes x, y in %s: got %s, the simulator's %s gives %s (error %.3f); the best "
+                              "match of the whole record, %s (error %.3f), was %.0f ms from the stamp"
+                              % (topic, world, got, att, expected_axes(att, convention), error(att), best,
+                                 error(best), (best_t - stamp) / 1e6))
         for topic, n in unjudged.items():
             self.assertLessEqual(n, 2, "%s: %d of %d messages stamped before the record began" % (topic, n, len(samples[topic])))
 
@@ -465,7 +497,7 @@ class RosTestCase(VehicleTestCase):
             if time.monotonic() - last[0] > 0.1:
                 rig.motion(**axes)
                 last[0] = time.monotonic()
-            attitude.append((time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")]))
+            attitude.append(sim_attitude(rig))
         try:
             samples, _, _, _ = self.listen(2, ORIENTATION_TOPICS, during=lambda: during(pitch=0.5, roll=0.5))
         finally:
@@ -617,8 +649,7 @@ class PublishedTest(RosTestCase):
         # The simulator's attitude through the window (the body turns under this thrust), to
         # compare each Imu sample with the simulator's attitude at its stamp.
         attitude = []
-        samples, _, _, _ = self.listen(3, during=lambda: attitude.append(
-            (time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")])))
+        samples, _, _, _ = self.listen(3, during=lambda: attitude.append(sim_attitude(rig)))
         for topic in PUBLISHED:
             self.assertIn(topic, samples, "nothing received on " + topic)
         last = {t: s[-1][1] for t, s in samples.items()}
@@ -734,7 +765,7 @@ class NoOdomTfTest(RosTestCase):
             if time.monotonic() - last[0] > 0.1:
                 rig.motion(yaw=0.3)
                 last[0] = time.monotonic()
-            attitude.append((time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")]))
+            attitude.append(sim_attitude(rig))
         try:
             samples, _, writers, _ = self.listen(2, {"rt/caracara/imu": "sensor_msgs/Imu"}, during=turning)
         finally:
@@ -807,8 +838,11 @@ class OneWriterTest(RosTestCase):
             since = rig.wire_next()
             log_start = len(rig.log("caracara-ros"))
             with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray", thrust(second)):
-                poll(lambda: "(not-holder)" in rig.log("caracara-ros")[log_start:], 20,
-                     message="the second writer was never refused")
+                try:
+                    poll(lambda: "(not-holder)" in rig.log("caracara-ros")[log_start:], 20)
+                except harness.Timeout:
+                    self.fail("the second writer was never refused; caracara-ros's log since it began:\n" +
+                              rig.log("caracara-ros")[log_start:])
                 samples, _, _, endpoints = self.listen(3.5, self.DIAGNOSTICS)
                 # Nothing of the second writer's moved: the wire carried the first's orders only.
                 log = rig.wire_log(since)[1]
@@ -1006,7 +1040,7 @@ class CommandsTest(RosTestCase):
         rig = self.rig
         data = [0.3] * 2 + [0] * 6
         with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
-                          {"layout": {"dim": [], "data_offset": 0}, "data": data}):
+                          {"layout": {"dim": [], "data_offset": 0}, "data": data}, short_lease=True):
             rig.wait_sim_speeds([speed_byte(round(v * MOTOR_MAX)) for v in data])
             since = rig.wire_next()
             killed_at = time.monotonic_ns()  # the block's end SIGKILLs the peer

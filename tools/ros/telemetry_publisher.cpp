@@ -134,7 +134,7 @@ bool TelemetryPublisher::connect() {
         client_.reset();
         return false;
     }
-    teensy_read_at_ = thrusters_read_at_ = realtime_now();
+    orientation_read_at_ = teensy_read_at_ = thrusters_read_at_ = realtime_now();
     commands_.set_timeout_ms(get(props(kRoot, caracara::dbus::kVehicleIface), "CommandTimeoutMs").unsigned_integer());
     mark(kRanges | kDiagnostics | kState);
     return true;
@@ -149,7 +149,7 @@ void TelemetryPublisher::reload() {
         std::fprintf(stderr, "caracara-ros: reloading caracarad's objects failed (%s)\n", f.message.c_str());
         return;
     }
-    teensy_read_at_ = thrusters_read_at_ = realtime_now();
+    orientation_read_at_ = teensy_read_at_ = thrusters_read_at_ = realtime_now();
     commands_.set_timeout_ms(get(props(kRoot, caracara::dbus::kVehicleIface), "CommandTimeoutMs").unsigned_integer());
     mark(kRanges | kDiagnostics | kState);
 }
@@ -162,13 +162,38 @@ void TelemetryPublisher::changed(const std::string& path, const Props& changes) 
     } else if (thruster_of(path) >= 0) {
         thrusters_read_at_ = realtime_now();
     } else if (path == caracara::dbus::kTeensyPath) {
-        teensy_read_at_ = realtime_now();
+        teensy_changed(changes);
         // A reading per Teensy poll (each announces its Frames count), changed or not: a range
         // sensor's subscribers expect a steady stream, not only the changes.
         if (changes.contains("Distances") || changes.contains("Frames"))
             d |= kRanges;
     }
     mark(d);
+}
+
+void TelemetryPublisher::teensy_changed(const Props& changes) {
+    // Its link counters and state (BusyRetries, LinkErrors, Online, Task...) are no reading: a
+    // stalled poll's retries say nothing of when the orientation was read.
+    const bool reading = changes.contains("Orientation") || changes.contains("Distances") || changes.contains("Frames");
+    if (!reading)
+        return;
+    const timespec now = realtime_now();
+    teensy_read_at_ = now;
+    timespec at = now; // an unchanged value confirmed: as of this announcement
+    // Announced with the Orientation it dates (0 from a caracarad that does not give it).
+    const uint64_t read_ns = get(changes, "OrientationReadNs").unsigned_integer();
+    const uint64_t mono = monotonic_ns();
+    if (changes.contains("Orientation") && read_ns && read_ns <= mono) {
+        // The reading's CLOCK_MONOTONIC time (caracarad's, on this machine) as CLOCK_REALTIME.
+        const uint64_t ns = static_cast<uint64_t>(now.tv_sec) * 1'000'000'000ull + static_cast<uint64_t>(now.tv_nsec) -
+                            (mono - read_ns);
+        at = {static_cast<time_t>(ns / 1'000'000'000ull), static_cast<long>(ns % 1'000'000'000ull)};
+    }
+    // Never back in time (tf2 drops a transform older than the last): a confirmation's arrival
+    // may be later than the next change's reading.
+    if (at.tv_sec > orientation_read_at_.tv_sec ||
+        (at.tv_sec == orientation_read_at_.tv_sec && at.tv_nsec > orientation_read_at_.tv_nsec))
+        orientation_read_at_ = at;
 }
 
 void TelemetryPublisher::mark(unsigned dirty) {
@@ -221,7 +246,7 @@ int TelemetryPublisher::on_sensor_tick(sd_event_source* s, uint64_t usec, void* 
     const uint64_t next = usec + self->sensor_period_us_;
     sd_event_source_set_time(s, next > now ? next : now + self->sensor_period_us_);
     sd_event_source_set_enabled(s, SD_EVENT_ON);
-    if (!self->client_ || !self->teensy_read_at_.tv_sec)
+    if (!self->client_ || !self->orientation_read_at_.tv_sec)
         return 0; // nothing read yet
     // An offline Teensy's last attitude is no reading: the Imu and /tf stop, as a driver's do
     // when its sensor goes quiet (the diagnostics say why).
@@ -256,7 +281,7 @@ void TelemetryPublisher::write_imu_and_tf() {
                                                      config_.frame_convention);
     const geometry_msgs_msg_dds__Quaternion_ q{r.x, r.y, r.z, r.w};
     sensor_msgs_msg_dds__Imu_ imu{};
-    imu.header = header(body_frame_, teensy_read_at_);
+    imu.header = header(body_frame_, orientation_read_at_);
     imu.orientation = q;
     // REP 145: the orientation's covariance is unknown (all zeros); the Teensy gives no angular
     // velocity or linear acceleration, marked by -1 in the first element of their covariances.
@@ -266,7 +291,7 @@ void TelemetryPublisher::write_imu_and_tf() {
     if (!config_.publish_odom_tf)
         return;
     geometry_msgs_msg_dds__TransformStamped_ t{};
-    t.header = header(world_frame_, teensy_read_at_);
+    t.header = header(world_frame_, orientation_read_at_);
     t.child_frame_id = c_str(body_frame_);
     t.transform.rotation = q;
     tf2_msgs_msg_dds__TFMessage_ tf{};

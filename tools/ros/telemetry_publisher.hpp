@@ -45,6 +45,7 @@ private:
     void reload();
     void mark(unsigned dirty);
     void changed(const std::string& path, const client::Props& changes);
+    void teensy_changed(const client::Props& changes);
     const client::Props& props(const std::string& path, const char* iface) const { return mirror_.props(path, iface); }
 
     void write_imu_and_tf();
@@ -64,11 +65,14 @@ private:
     std::unique_ptr<client::Client> client_;
     const uint64_t sensor_period_us_;
     caracara::SourcePtr flush_, retry_, diagnostics_timer_, sensor_timer_;
-    // When the readings the mirror holds were taken, as far as caracara-ros can tell: the arrival
-    // (CLOCK_REALTIME) of the object's latest PropertiesChanged. caracarad announces a changed
-    // value at its next telemetry tick, so any later announcement of the object (its counters,
-    // once a second) says the value it holds was read again unchanged. Zero: nothing read yet.
-    timespec teensy_read_at_{}, thrusters_read_at_{};
+    // When the readings the mirror holds were taken (CLOCK_REALTIME). The orientation: the time
+    // caracarad gives with a changed value (OrientationReadNs), not its announcement's arrival,
+    // which comes up to a telemetry period later, more on a loaded machine (a turning vehicle's
+    // Imu would be that far behind its stamp). Otherwise the arrival of the object's latest
+    // announcement of a reading: caracarad announces a changed value at its next telemetry tick,
+    // so a later announcement of the Teensy's Frames or a thruster's counters (once a second)
+    // says the value held was read again unchanged. Zero: nothing read yet.
+    timespec orientation_read_at_{}, teensy_read_at_{}, thrusters_read_at_{};
     client::ObjectMirror mirror_;
     unsigned dirty_ = 0;
     uint64_t diagnostics_last_us_ = 0;
