@@ -43,6 +43,8 @@ case $limit in
 esac
 
 build_fuzzers >/dev/null
+# The JavaScript harnesses' npm packages (fuzz/node), from its lock file.
+/usr/bin/python3 "$top/tests/npm_packages.py" "$top/fuzz/node"
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}

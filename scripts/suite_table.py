@@ -176,7 +176,7 @@ def table(results):
     systemable = ROOT and AMD64
     suites = [Suite("unit", "normal"), Suite("integration", "normal"), Suite("e2e", "normal"),
               Suite("bridge Debian 12", "normal"), Suite("cockpit Debian 12", "normal"),
-              Suite("soak", "normal"), Suite("layers", "normal"), Suite("README CI table", "normal"),
+              Suite("soak", "normal"), Suite("layers", "normal"), Suite("docs from records", "normal"),
               Suite("release (version)", "normal"),
               Suite("system Debian 12", "normal", systemable, need_root),
               Suite("kernel Debian 12", "normal", systemable, need_root),
@@ -257,8 +257,9 @@ def table(results):
         elif name in ("layers", "bounds_lint", "bounds_lint_test"):
             # The lints on the sources: the layering rules, and the bounds file (tests/bounds_lint.py).
             suite = by["layers"]
-        elif name == "readme_suites":
-            suite = by["README CI table"]
+        elif name in ("readme_suites", "doc_figures", "bench_report"):
+            # README's CI table, the quoted figures and the benchmark tables against their records.
+            suite = by["docs from records"]
         else:
             suite = by["unit"]
         add(suite, t)
@@ -325,10 +326,28 @@ def print_table(rows, steps, failed, ci):
         print("suites: every selected suite ran and held")
 
 
+def run_summary(rec):
+    """What a record keeps of a whole run for the runs beside it: when, what, how long."""
+    return {k: rec.get(k) for k in ("finished", "commit", "ci", "machine", "caches", "seconds", "failed")} | \
+        {"steps": {n: v["seconds"] for n, v in (rec.get("steps") or {}).items() if v.get("selected")}}
+
+
 def record(rows, steps, failed, record_path):
-    """The run as a record: what README's CI table is written from (--readme)."""
+    """The run as a record: what README's CI table is written from (--readme). It keeps the last
+    run with warm caches and the last with cold ones (scripts/test.sh says which this one was:
+    CARACARA_SUITE_CACHES) under "runs", so that both times stay in view."""
     commit = git("rev-parse", "HEAD")
-    return {
+    caches = os.environ.get("CARACARA_SUITE_CACHES", "warm")
+    seconds = int(os.environ.get("CARACARA_SUITE_SECONDS", "0")) or sum(v[2] for v in steps.values())
+    runs = {}
+    if os.path.exists(record_path):
+        try:
+            with open(record_path) as f:
+                old = json.load(f)
+            runs = old.get("runs") or {old.get("caches", "warm"): run_summary(old)}
+        except (OSError, ValueError):
+            runs = {}
+    rec = {
         "written_by": "scripts/suite_table.py --record (scripts/test.sh)",
         "finished": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%MZ"),
         "commit": commit,
@@ -341,10 +360,30 @@ def record(rows, steps, failed, record_path):
         "steps": {n: {"selected": v[0], "exit": v[1], "seconds": v[2]} for n, v in steps.items()},
         "suites": [{"suite": r[0], "result": r[1], "counts": r[2], "time": r[3], "failed": r[4]} for r in rows],
         "failed": failed,
+        "caches": caches,
+        "seconds": seconds,
     }
+    if all(v[0] for v in steps.values()):
+        runs[caches] = run_summary(rec)
+    rec["runs"] = runs
+    return rec
 
 
 BEGIN, END = "<!-- suite-table begin -->", "<!-- suite-table end -->"
+
+
+def runs_line(rec):
+    """The whole runs' times, warm caches and cold (every cache of the suite emptied first)."""
+    def one(kind, r):
+        if not r:
+            return "%s caches: none recorded yet" % kind
+        steps = ", ".join("%s %d min" % (n, round(s / 60)) for n, s in r["steps"].items())
+        return "%s caches: **%d min %d s** (%s, commit %s%s; %s)" % (
+            kind, r["seconds"] // 60, r["seconds"] % 60, r["finished"], (r["commit"] or "?")[:12],
+            ", failed" if r["failed"] else "", steps)
+    runs = rec.get("runs") or {}
+    return "Whole runs of `scripts/test.sh` (CI's command), the last with each kind of cache: " + \
+        "; ".join(one(k, runs.get(k)) for k in ("warm", "cold")) + "."
 
 
 def readme_section(rec):
@@ -365,6 +404,8 @@ def readme_section(rec):
                     "" if everything else " (not a full run)",
                     "Every selected suite ran and held." if not rec["failed"] else
                     "**It failed** (the rows marked failed)."),
+                "",
+                runs_line(rec),
                 "",
                 "| suite | result | counts | time |",
                 "| --- | --- | --- | --- |"]

@@ -15,6 +15,17 @@
 # a full run (scripts/test.sh alone), build-results/suites.json otherwise. Every step runs even after one failed, so the table is whole.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
+# Warm or cold: a run that finds none of the suite's caches (ccache, the debootstrapped roots,
+# the kernel packages, the npm packages) is a cold one, as on a fresh machine; the record keeps
+# the last of each (scripts/suite_table.py). CARACARA_SUITE_CACHES=warm|cold says it instead.
+if [ -z "${CARACARA_SUITE_CACHES:-}" ]; then
+  CARACARA_SUITE_CACHES=cold
+  for c in /var/cache/ccache /var/cache/caracara-systest /var/cache/caracara-kernel /var/cache/caracara-npm; do
+    [ -n "$(ls -A "$c" 2>/dev/null)" ] && CARACARA_SUITE_CACHES=warm
+  done
+fi
+export CARACARA_SUITE_CACHES
+echo "== caches: $CARACARA_SUITE_CACHES"
 "$top/scripts/deps.sh"
 which=${1:-all}
 jobs=$(nproc)
@@ -74,6 +85,10 @@ sanitize_suite() {
 }
 
 step normal run_suite normal "$top/build"
+# The figures the normal step's tests printed, as the record the docs quote (bench/figures.json;
+# scripts/doc_figures.py --write then rewrites README.md and docs/ from it, CTest doc_figures
+# checks them).
+[ ! -f "$results/normal.xml" ] || /usr/bin/python3 "$top/scripts/doc_figures.py" --record "$results/normal.xml" || failed=1
 step cross cross_suite
 step arm64-packages arm64_packages
 step sanitize sanitize_suite
@@ -84,6 +99,6 @@ step fuzz fuzz_suite
 record=$results/suites.json
 [ "$which" != all ] || record=$top/bench/suite-results.json
 table=0
-/usr/bin/python3 "$top/scripts/suite_table.py" "$results" --record "$record" || table=$?
+CARACARA_SUITE_SECONDS=$SECONDS /usr/bin/python3 "$top/scripts/suite_table.py" "$results" --record "$record" || table=$?
 stamp "all"
 [ "$failed" -eq 0 ] && [ "$table" -eq 0 ]

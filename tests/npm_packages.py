@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The npm packages of a Node test directory (tests/bridge, tests/ros), installed before any test
+"""The npm packages of a Node test directory (tests/bridge, tests/ros, fuzz/node), installed before any test
 isolates itself: CTest's setup tests npm_bridge and npm_ros (FIXTURES_SETUP, tests/CMakeLists.txt)
 and tests/system/debian13.sh run this, outside any network namespace; the tests themselves only
 check (tests/e2e/harness.py npm_ci), and never reach for the network.
@@ -21,7 +21,7 @@ import sys
 
 NPM_CACHE = "/var/cache/caracara-npm"
 # Which CTest setup test installs which directory's packages.
-FIXTURE = {"bridge": "npm_bridge", "ros": "npm_ros"}
+FIXTURE = {"bridge": "npm_bridge", "ros": "npm_ros", "node": "npm_fuzz"}
 
 
 def fixture(here):

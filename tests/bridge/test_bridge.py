@@ -14,6 +14,7 @@ test starts; the test only checks them. Under CI (CI=true) a missing node, npm o
 import json
 import math
 import os
+import re
 import select
 import shutil
 import socket
@@ -182,10 +183,13 @@ class BridgeRig:
             os.chmod(cls.sockdir, 0o755)
             cls.socket = os.path.join(cls.sockdir, "bridge.sock")
             cls.bridge_log = open(os.path.join(cls.rig.dir, "caracara-bridge.log"), "ab")
+            # One more origin than the bridge's own may connect (issue 46): a page the tests serve there.
+            cls.allowed_port = free_port()
             cls.bridge = subprocess.Popen(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge"),
                                            "--listen", "unix:" + cls.socket, "--bus-address", cls.rig.address,
                                            "--cockpit-dir", os.path.join(SOURCE, "tools", "cockpit"),
-                                           "--dives-dir", cls.rig.dives_dir],
+                                           "--dives-dir", cls.rig.dives_dir,
+                                           "--allow-origin", "http://localhost:%d" % cls.allowed_port],
                                           stdout=cls.bridge_log, stderr=subprocess.STDOUT)
             cls.procs.append(cls.bridge)
             poll(lambda: os.path.exists(cls.socket) or cls.bridge.poll() is not None, 10, message="the bridge's socket")
@@ -224,6 +228,42 @@ class BridgeRig:
     def listening(port):
         return port_listens(port)
 
+    def ssh_config(self):
+        """An ssh config naming the private sshd "vehicle", as a pilot's ~/.ssh/config would."""
+        cfg = os.path.join(self.sshd.dir, "ssh_config")
+        if not os.path.exists(cfg):
+            with open(cfg, "w") as f:
+                f.write(f"Host vehicle\n  HostName 127.0.0.1\n  Port {self.sshd.port}\n  User root\n"
+                        f"  IdentityFile {self.sshd.dir}/client_key\n  IdentitiesOnly yes\n  UserKnownHostsFile /dev/null\n"
+                        "  StrictHostKeyChecking no\n  BatchMode yes\n  LogLevel ERROR\n")
+        return cfg
+
+    def caracaractl_bridge(self, port):
+        """`caracaractl -H vehicle bridge --port PORT` held until the test's end (its stderr in the
+        rig's directory; $XDG_RUNTIME_DIR a directory of the test's, to find its private one):
+        (process, ws:// address, http:// address, key, stderr path, runtime directory)."""
+        runtime = tempfile.mkdtemp(prefix="caracaractl-runtime-")
+        os.chmod(runtime, 0o755)  # open to all, as /tmp: only the private directory's mode decides
+        self.addCleanup(shutil.rmtree, runtime, True)
+        err_path = os.path.join(self.rig.dir, "caracaractl-bridge-%d.log" % port)
+        err = open(err_path, "w")
+        p = subprocess.Popen(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "caracaractl"), "-H", "vehicle",
+                              "bridge", "--port", str(port), "--socket", self.socket, "--ssh-config", self.ssh_config()],
+                             stdout=subprocess.PIPE, stderr=err, text=True, env={**os.environ, "XDG_RUNTIME_DIR": runtime})
+
+        def stop():
+            if p.poll() is None:
+                p.send_signal(2)
+                self.assertEqual(p.wait(15), 0, "caracaractl bridge on ^C")
+            p.stdout.close()
+            err.close()
+        self.addCleanup(stop)
+        ws_url, http_url = p.stdout.readline().strip(), p.stdout.readline().strip()
+        m = re.fullmatch(r"ws://localhost:%d/\?key=([0-9a-f]{64})" % port, ws_url)
+        self.assertTrue(m, "caracaractl bridge printed %r" % ws_url)
+        self.assertEqual(http_url, "http://localhost:%d/?key=%s" % (port, m.group(1)))
+        return p, ws_url, http_url, m.group(1), err_path, runtime
+
     def check_bridge_stops_cleanly(self):
         # SIGTERM: exit status 0, its socket removed (under ASan: no leak, which would make it non-zero).
         self.bridge.terminate()
@@ -254,33 +294,71 @@ class BridgeTest(BridgeRig, unittest.TestCase):
         self.assertIsNone(self.bridge.poll(), "the bridge survived every test")
 
     def test_2_caracaractl_bridge_forwards_and_prints_the_address(self):
-        cfg = os.path.join(self.sshd.dir, "ssh_config")
-        with open(cfg, "w") as f:
-            f.write(f"Host vehicle\n  HostName 127.0.0.1\n  Port {self.sshd.port}\n  User root\n"
-                    f"  IdentityFile {self.sshd.dir}/client_key\n  IdentitiesOnly yes\n  UserKnownHostsFile /dev/null\n"
-                    "  StrictHostKeyChecking no\n  BatchMode yes\n  LogLevel ERROR\n")
         port = free_port()
-        p = subprocess.Popen(harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "caracaractl"), "-H", "vehicle",
-                              "bridge", "--port", str(port), "--socket", self.socket, "--ssh-config", cfg],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        try:
-            self.assertEqual(p.stdout.readline().strip(), "ws://localhost:%d" % port)
-            self.assertEqual(p.stdout.readline().strip(), "http://localhost:%d/" % port)
-            # A WebSocket upgrade with the Foxglove subprotocol through the forward.
+        p, ws_url, http_url, key, err_path, runtime = self.caracaractl_bridge(port)
+        upgrade = (b"GET %s HTTP/1.1\r\nHost: localhost:%d\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                   b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+                   b"Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n%s\r\n")
+
+        def ask(request):
             with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
-                s.sendall(b"GET / HTTP/1.1\r\nHost: localhost\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                          b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
-                          b"Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n\r\n")
-                head = s.recv(4096).decode(errors="replace")
-            self.assertIn("101", head.splitlines()[0])
-            self.assertIn("sec-websocket-protocol: foxglove.websocket.v1", head.lower())
-        finally:
-            p.send_signal(2)
-            code = p.wait(15)
-            err = p.stderr.read()
-            p.stdout.close()
-            p.stderr.close()
-            self.assertEqual(code, 0, err)
+                s.sendall(request)
+                got = b""
+                while chunk := s.recv(65536):
+                    got += chunk
+                    if b"\r\n\r\n" in got and b" 101 " in got.split(b"\r\n")[0]:
+                        break  # an open WebSocket: its head is enough
+                return got.decode(errors="replace")
+        # The forward without its key, with a wrong one, or with another port's cookie: 403, the
+        # reason in the body, the refusal on caracaractl's stderr; nothing reaches the bridge.
+        for target, extra, why in ((b"/", b"", "needs the key of its session"),
+                                   (b"/?key=" + b"0" * 64, b"", "wrong key"),
+                                   (b"/", b"Cookie: caracara_key_%d=%s\r\n" % (port + 1, key.encode()),
+                                    "needs the key of its session")):
+            answer = ask(upgrade % (target, port, extra))
+            self.assertIn("403", answer.splitlines()[0], answer)
+            self.assertIn(why, answer)
+        for target in (b"/", b"/dives/"):
+            answer = ask(b"GET %s HTTP/1.1\r\nHost: localhost:%d\r\n\r\n" % (target, port))
+            self.assertIn("403", answer.splitlines()[0], answer)
+        # With it: a WebSocket upgrade with the Foxglove subprotocol (the key in the query, as
+        # Foxglove's URL carries it); a page load is redirected without the key, setting the cookie
+        # that then lets the page and its requests through.
+        answer = ask(upgrade % (b"/?key=" + key.encode(), port, b""))
+        self.assertIn("101", answer.splitlines()[0])
+        self.assertIn("sec-websocket-protocol: foxglove.websocket.v1", answer.lower())
+        answer = ask(b"GET /?key=%s HTTP/1.1\r\nHost: localhost:%d\r\n\r\n" % (key.encode(), port))
+        self.assertIn("303", answer.splitlines()[0], answer)
+        self.assertIn("\r\nLocation: /\r\n", answer)
+        self.assertIn("\r\nSet-Cookie: caracara_key_%d=%s; Path=/; HttpOnly; SameSite=Strict\r\n" % (port, key), answer)
+        cookie = b"Cookie: caracara_key_%d=%s\r\n" % (port, key.encode())
+        answer = ask(b"GET / HTTP/1.1\r\nHost: localhost:%d\r\n%s\r\n" % (port, cookie))
+        self.assertIn("200", answer.splitlines()[0])
+        self.assertIn("<title>Caracara cockpit</title>", answer)
+        self.assertIn("101", ask(upgrade % (b"/", port, cookie)).splitlines()[0])
+        with open(err_path) as f:
+            said = f.read()
+        self.assertIn("caracaractl: refused a connection to localhost:%d without the key" % port, said)
+        self.assertIn("caracaractl: refused a connection to localhost:%d with a wrong key" % port, said)
+        # The reference client, which sends no Origin (as Foxglove desktop), through the forward
+        # with the printed address.
+        script = ("import { connect } from './lib.mjs';"
+                  "const c = await connect(process.env.CARACARA_WS_URL); c.subscribeAll();"
+                  "const s = await c.waitFor('/vehicle/state'); await c.close(); console.log(s.state);")
+        r = subprocess.run(["node", "--input-type=module", "-e", script], cwd=HERE, capture_output=True, text=True,
+                           timeout=60, env={**os.environ, "CARACARA_WS_URL": ws_url})
+        self.assertEqual(r.returncode, 0, r.stderr)
+        # ssh's end is a socket in a directory of the pilot's alone: another local user cannot
+        # go round the key.
+        (private,) = [d for d in os.listdir(runtime) if d.startswith("caracaractl-bridge.")]
+        private = os.path.join(runtime, private)
+        self.assertEqual(os.stat(private).st_mode & 0o777, 0o700)
+        self.assertEqual(connect_as(os.path.join(private, "bridge.sock"), "--reuid=nobody", "--regid=nogroup",
+                                    "--clear-groups"), "EACCES")
+        p.send_signal(2)
+        self.assertEqual(p.wait(15), 0)
+        self.assertFalse(os.path.exists(private), "the private directory outlived the forward")
+        cfg = self.ssh_config()
         # SSH refuses the login (no key of nobody's is authorized): 4, as the help says; the
         # host not reached (nothing listens on the port): 3.
         with open(cfg, "a") as f:
@@ -297,6 +375,54 @@ class BridgeTest(BridgeRig, unittest.TestCase):
             harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "caracaractl"), "-H", "refused", "bridge", "--port",
                                 str(free_port()), "--socket", self.socket, "--ssh-config", cfg],
             capture_output=True, text=True, timeout=60).stderr)
+
+    def test_2_pages_of_other_origins_are_refused(self):
+        # What a browser sends (issue 46): a page's WebSocket and fetch carry its Origin; the
+        # bridge's own page is http://<Host>. Through the rig's plain ssh -L forward.
+        def ask(origin, host="127.0.0.1:%d" % self.port, target=b"/", upgrade=True):
+            head = b"GET %s HTTP/1.1\r\nHost: %s\r\n" % (target, host.encode())
+            if upgrade:
+                head += (b"Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                         b"Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: foxglove.websocket.v1\r\n")
+            if origin is not None:
+                head += b"Origin: %s\r\n" % origin.encode()
+            with socket.create_connection(("127.0.0.1", self.port), timeout=10) as s:
+                s.sendall(head + b"\r\n")
+                got = s.recv(65536).decode(errors="replace")
+            return got.split("\r\n")[0], got.split("\r\n\r\n", 1)[-1]
+        own = "http://127.0.0.1:%d" % self.port
+        self.assertIn("101", ask(None)[0])                       # no Origin: not a browser page
+        self.assertIn("101", ask(own)[0])                        # the cockpit the bridge serves
+        self.assertIn("101", ask("http://localhost:%d" % self.port, "localhost:%d" % self.port)[0])
+        self.assertIn("101", ask("http://localhost:%d" % self.allowed_port)[0])  # --allow-origin
+        refused = [("http://localhost:%d" % (self.allowed_port + 1), "127.0.0.1:%d" % self.port),
+                   ("http://127.0.0.1:%d" % (self.port + 1), "127.0.0.1:%d" % self.port),
+                   ("https://evil.example", "127.0.0.1:%d" % self.port), ("null", "127.0.0.1:%d" % self.port),
+                   # DNS rebinding: a name resolving to 127.0.0.1 matches its own Host.
+                   ("http://rebind.example:%d" % self.port, "rebind.example:%d" % self.port)]
+        for origin, host in refused:
+            line, body = ask(origin, host)
+            self.assertIn("403", line, origin)
+            self.assertIn("caracara-bridge: a page from %s may not use this bridge" % origin, body)
+        # The recorded dives too; the cockpit's files are the same for everyone.
+        self.assertIn("403", ask("https://evil.example", target=b"/dives/", upgrade=False)[0])
+        self.assertIn("200", ask(None, target=b"/dives/", upgrade=False)[0])
+        self.assertIn("200", ask(own, target=b"/dives/", upgrade=False)[0])
+        self.assertIn("200", ask("https://evil.example", target=b"/", upgrade=False)[0])
+        with open(os.path.join(self.rig.dir, "caracara-bridge.log"), errors="replace") as f:
+            log = f.read()
+        for origin, _ in refused:
+            self.assertIn("caracara-bridge: refused a WebSocket upgrade from origin '%s'" % origin, log)
+        self.assertIn("caracara-bridge: refused a request for dives from origin 'https://evil.example'", log)
+        self.assertIn("caracara-bridge: pages from http://localhost:%d may connect (--allow-origin)" % self.allowed_port,
+                      log)
+        # An allow-list entry that is not an origin stops the bridge at its start.
+        exe = harness.EMULATOR + [os.path.join(BUILD_DIR, "tools", "bridge", "caracara-bridge")]
+        for bad in ("app.foxglove.dev", "https://app.foxglove.dev/", "null"):
+            r = subprocess.run(exe + ["--listen", "unix:" + os.path.join(self.rig.dir, "x.sock"), "--allow-origin", bad,
+                                      "--bus-address", self.rig.address], capture_output=True, text=True, timeout=30)
+            self.assertEqual(r.returncode, 2, r.stderr)
+            self.assertIn("--allow-origin takes an origin, scheme://host[:port]", r.stderr)
 
     def test_2_socket_is_for_the_group_only(self):
         st = os.stat(self.socket)
@@ -370,6 +496,10 @@ class BridgeTest(BridgeRig, unittest.TestCase):
             self.assertIn("101", status(b"/", b"Authorization: bearer " + token.encode() + b"\r\n"))
             self.assertIn("101", status(b"/", b"Authorization: BEARER " + token.encode() + b"\r\n"))
             self.assertIn("401", status(b"/", b"Authorization: bearer " + token.upper().encode() + b"\r\n"))
+            # With the token, the page the bridge serves under any name is its own (a rebinding page
+            # has no token); another page is refused even with the token.
+            self.assertIn("101", status(b"/?token=" + token.encode(), b"Origin: http://x\r\n"))
+            self.assertIn("403", status(b"/?token=" + token.encode(), b"Origin: http://localhost:1\r\n"))
 
             def plain(target):
                 with socket.create_connection(("127.0.0.1", port), timeout=10) as s:

@@ -4,6 +4,7 @@ real `ssh -L` forward (the rig, bridge and private sshd of test_bridge.py), judg
 simulator's side (its inspection API and wire log). chromium is installed here when missing
 (about 460 MB; not for the demo). Under CI (CI=true) a missing chromium, node or sshd fails.
 Screenshots of the ready, driving and killed states go to BUILD/tests/cockpit-artifacts.
+Which pages may drive (issue 46): origin.test.mjs through `caracaractl bridge`'s forward and its key.
 The sticks are judged by where the simulated vehicle went (tests/e2e/vehicle_motion.py, issue 43),
 on a rig of their own whose thrusters are all mounted as configured.
 """
@@ -13,7 +14,7 @@ import subprocess
 import sys
 import unittest
 
-from test_bridge import BUILD_DIR, HERE, BridgeRig, HeldPilot, missing, npm_ci
+from test_bridge import BUILD_DIR, HERE, BridgeRig, HeldPilot, free_port, missing, npm_ci
 from vehicle_motion import describe, judge
 
 CHROMIUM = "/usr/bin/chromium"
@@ -52,6 +53,17 @@ class CockpitTest(BridgeRig, unittest.TestCase):
                   CARACARA_CHROMIUM=CHROMIUM, CARACARA_ARTIFACTS=artifacts, CARACARA_FORWARD_PID=str(forward.pid),
                   CARACARA_DIVES_DIR=self.rig.dives_dir)
         self.assertIsNone(self.bridge.poll(), "the bridge survived the cockpit")
+
+    def test_other_origins_and_the_forward_key_in_chromium(self):
+        # Issue 46: through caracaractl bridge's forward (its key), to the rig's bridge (its Origin
+        # check, one allow-listed origin); origin.test.mjs serves the other pages itself.
+        port = free_port()
+        _, ws_url, http_url, _, err_path, _ = self.caracaractl_bridge(port)
+        self.node("origin.test.mjs", CARACARA_FORWARD_HTTP=http_url, CARACARA_FORWARD_WS=ws_url,
+                  CARACARA_FORWARD_PORT=str(port), CARACARA_OTHER_PORT=str(free_port()),
+                  CARACARA_ALLOWED_PORT=str(self.allowed_port), CARACARA_CHROMIUM=CHROMIUM,
+                  CARACARA_BRIDGE_LOG=os.path.join(self.rig.dir, "caracara-bridge.log"), CARACARA_FORWARD_LOG=err_path)
+        self.assertIsNone(self.bridge.poll(), "the bridge survived")
 
     def test_z_bridge_stops_cleanly(self):
         self.check_bridge_stops_cleanly()

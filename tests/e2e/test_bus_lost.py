@@ -10,6 +10,7 @@ import dbus
 
 import harness
 from bounds import BUS_LOCKUP_KILL_LATENESS_MS_MAX
+from figures import figure
 from harness import (ERR, MOTORS, VehicleTestCase, error_name, poll, speed_byte)
 from vehicle_checks import (packet)
 
@@ -93,7 +94,7 @@ class LongLockupKillsTest(VehicleTestCase):
             poll(lambda: rig.state() == "killed", 10, message="a long lockup did not kill")
             took_ms = (time.monotonic() - t0) * 1000
             timeout_ms = self.CONTROL["command_timeout_ms"]
-            print("\nlockup to kill: %.0f ms (command timeout %d ms)" % (took_ms, timeout_ms))
+            figure("bus_lockup.kill_ms", took_ms, "ms", "lockup to kill (command timeout %d ms)" % timeout_ms)
             self.assertEqual(rig.vget("KillSource"), "bus")
             self.assertEqual(bus_state(rig), "lost")
             # The recovery's timer starts at the first failed transfer, after the hold began.

@@ -6,6 +6,7 @@ import time
 import unittest
 
 from bounds import DEADLINE_SEEN_EARLY_MS_MAX, DEADLINE_SEEN_LATE_MS_MAX
+from figures import figure
 from harness import (MOTORS, VehicleTestCase, speed_byte)
 
 
@@ -24,7 +25,8 @@ class CommandTimeoutTest(VehicleTestCase):
         # Given up well after the bound, so that a late zero is reported with its figure.
         rig.wait_sim_zero(5)
         silent_ms = (time.monotonic() - sent) * 1000
-        print("\nzeroed %.0f ms after the last command (command timeout %d ms)" % (silent_ms, timeout_ms))
+        figure("command_timeout.zeroed_ms", silent_ms, "ms", "zeroed after the last command (command timeout %d ms)"
+               % timeout_ms)
         self.assertGreaterEqual(silent_ms, timeout_ms - DEADLINE_SEEN_EARLY_MS_MAX,
                                 "zeroed %.0f ms after the command: before the timeout" % silent_ms)
         self.assertLessEqual(silent_ms, timeout_ms + DEADLINE_SEEN_LATE_MS_MAX,

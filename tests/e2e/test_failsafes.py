@@ -19,6 +19,7 @@ import dbus
 from harness import (DEFAULT_MT, ERR, MOTORS, ROOT, SEED_AXIS_MOTORS, VEHICLE, ZERO, Rig, budget_limit, command,
                      error_name, poll, pump_main_loop, speed_byte)
 from bounds import FAILSAFE_LATENESS_MS_MAX, KILL_REPLY_MS_MAX, SURFACE_ASCENT_EARLY_MS_MAX
+from figures import figure
 from vehicle_checks import KILL_OUT
 
 THRUSTER_CONDITIONS = ["water-detect", "ground-fault", "overtemp", "stall", "hall"]
@@ -109,7 +110,7 @@ def assert_deadline_kept(case, announced, edge, what):
     case.assertLessEqual(len(announced.values), 6, "%s announced at every reading: %r" % (what, announced.values))
     at_ns = running[0] * 1000
     late_ms = (edge.time_ns - at_ns) / 1e6
-    print("\n%s -> kill output edge: %.0f ms" % (what, late_ms))
+    figure("failsafe_deadline.%s.kill_late_ms" % what.lower(), late_ms, "ms", "%s -> kill output edge" % what)
     case.assertGreaterEqual(edge.time_ns, at_ns, "killed before %s" % what)
     case.assertLessEqual(late_ms, FAILSAFE_LATENESS_MS_MAX)
     return at_ns

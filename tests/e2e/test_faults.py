@@ -9,6 +9,7 @@ import unittest
 
 from bounds import (HUNG_KILL_OUTPUT_MS_MAX, HUNG_DEVICE_DBUS_MS_MAX, VANISHED_LOG_LINES_MAX,
                     VANISHED_WINDOW_S)
+from figures import figure
 from harness import (ERR, MOTORS, ZERO, Rig, error_name, poll, speed_byte)
 from vehicle_checks import KILL_OUT, assert_idle_cpu, cpu_seconds
 
@@ -90,8 +91,8 @@ class HungThrusterTest(unittest.TestCase):
             self.rig.sim_thruster_call(HUNG, "SetHang", 0, signature="u")
             self.assert_kill_output_first(since, edge, "Kill()")
             poll(lambda: error_name(self.rig.vcall, "ClearKill") is None, 10)
-        print("\nKill() -> kill output with a thruster hanging 1 s: p50 %.2f ms, max %.2f ms" %
-              (statistics.median(lat), max(lat)))
+        for ms in lat:
+            figure("hung_thruster.kill_output_ms", ms, "ms", "Kill() -> kill output with a thruster hanging 1 s")
         # On the event loop's thread the kill would wait for the transfer on the wire (up to 1 s).
         self.assertLess(max(lat), HUNG_KILL_OUTPUT_MS_MAX)
 
@@ -112,8 +113,9 @@ class HungThrusterTest(unittest.TestCase):
             self.rig.sim_thruster_call(HUNG, "SetHang", 0, signature="u")
             self.assert_kill_output_first(since, edge, "kill switch")
             poll(lambda: error_name(self.rig.vcall, "ClearKill") is None, 10)
-        print("\nkill switch edge -> kill output with a thruster hanging 1 s: p50 %.2f ms, max %.2f ms" %
-              (statistics.median(lat), max(lat)))
+        for ms in lat:
+            figure("hung_thruster.switch_kill_output_ms", ms, "ms",
+                   "kill switch edge -> kill output with a thruster hanging 1 s")
         self.assertLess(max(lat), HUNG_KILL_OUTPUT_MS_MAX)
 
     def test_dbus_keeps_answering(self):
@@ -130,9 +132,9 @@ class HungThrusterTest(unittest.TestCase):
             t0 = time.monotonic_ns()
             get("org.caracara.Vehicle1", "MotorValues")
             gets.append((time.monotonic_ns() - t0) / 1e6)
-        print("\nwith a thruster hanging 1 s: %d Ping p50 %.2f p99 %.2f max %.2f ms; %d Get p99 %.2f max %.2f ms" %
-              (len(pings), statistics.median(pings), pct(pings, 0.99), max(pings), len(gets), pct(gets, 0.99),
-               max(gets)))
+        figure("hung_thruster.ping_p99_ms", pct(pings, 0.99), "ms", "Ping p99 of %d, a thruster hanging 1 s" % len(pings))
+        figure("hung_thruster.get_p99_ms", pct(gets, 0.99), "ms", "Get p99 of %d, a thruster hanging 1 s" % len(gets))
+        figure("hung_thruster.dbus_max_ms", max(pings + gets), "ms", "slowest Ping or Get, a thruster hanging 1 s")
         self.assertLess(max(pings + gets), HUNG_DEVICE_DBUS_MS_MAX)
         # Three timeouts in a row (3 s here): the thruster is unreachable, and keeps its last order.
         poll(lambda: self.rig.state() == "killed", 5, message="the hung thruster did not kill")
@@ -196,8 +198,10 @@ class HungTeensyTest(unittest.TestCase):
             finally:
                 if source == "switch":
                     self.rig.sim_call("SetKillSwitch", False, signature="b")
-        print("\nKill() / kill switch -> kill output with the Teensy holding each frame %d ms: %.2f / %.2f ms" %
-              (TEENSY_HANG_MS, lat[0], lat[1]))
+        figure("hung_teensy.kill_output_ms", lat[0], "ms", "Kill() -> kill output, the Teensy holding each frame %d ms"
+               % TEENSY_HANG_MS)
+        figure("hung_teensy.switch_kill_output_ms", lat[1], "ms",
+               "kill switch edge -> kill output, the Teensy holding each frame %d ms" % TEENSY_HANG_MS)
         self.assertLess(max(lat), HUNG_KILL_OUTPUT_MS_MAX)
 
     def test_dbus_keeps_answering(self):
@@ -213,8 +217,10 @@ class HungTeensyTest(unittest.TestCase):
             t0 = time.monotonic_ns()
             self.rig.thrust([1000] * MOTORS)
             calls.append((time.monotonic_ns() - t0) / 1e6)
-        print("\nwith the Teensy holding each frame %d ms: %d Ping/SetThrust p50 %.2f max %.2f ms" %
-              (TEENSY_HANG_MS, len(calls), statistics.median(calls), max(calls)))
+        figure("hung_teensy.dbus_p50_ms", statistics.median(calls), "ms",
+               "Ping/SetThrust p50 of %d, the Teensy holding each frame %d ms" % (len(calls), TEENSY_HANG_MS))
+        figure("hung_teensy.dbus_max_ms", max(calls), "ms",
+               "slowest Ping/SetThrust, the Teensy holding each frame %d ms" % TEENSY_HANG_MS)
         self.assertLess(max(calls), HUNG_DEVICE_DBUS_MS_MAX)
         # The loop kept cycling: the thrusters got the last command.
         self.rig.wait_sim_speeds([speed_byte(1000)] * MOTORS)
@@ -240,8 +246,8 @@ class HungThrusterDefaultTimeoutTest(unittest.TestCase):
                 e.result == "timeout"]
         t0 = [e for e in log if e.bus == "i2c" and not e.read and e.result == "ack" and
               e.addr == rig.sim_thruster(0, "Address") >> 1 and len(e.data) == 3]
-        print("\nhung thruster, default timeout: %d timed-out transfers, thruster 0 refreshed %d times in 2 s" %
-              (len(hung), len(t0)))
+        figure("hung_thruster_default_timeout.timeouts", len(hung), "count", "timed-out transfers in 2 s")
+        figure("hung_thruster_default_timeout.refreshes", len(t0), "count", "thruster 0 refreshed in 2 s")
         self.assertGreater(len(hung), 10)
         self.assertGreaterEqual(len(t0), 40)  # a 50 Hz loop, less what the hung transfers take
         self.assertFalse(rig.vget("Online", path="/org/caracara/Vehicle1/thruster/%d" % HUNG,
@@ -276,8 +282,8 @@ class UnreachableThrusterTest(unittest.TestCase):
             others = [i for i in range(MOTORS) if i != 4]
             poll(lambda: [rig.sim_speeds()[i] for i in others] == [ZERO] * len(others), 5,
                  message="%s: the reachable thrusters were not zeroed" % what)
-            print("\n%s: first failed transfer to kill output %.1f ms (%d failed transfers)" %
-                  (what, (edge.time_ns - failed[0].time_ns) / 1e6, len(failed)))
+            figure("unreachable_thruster.%s.kill_output_ms" % what.split()[0].lower(),
+                   (edge.time_ns - failed[0].time_ns) / 1e6, "ms", "%s: first failed transfer to kill output" % what)
         finally:
             release()
         poll(lambda: rig.vget("Online", path="/org/caracara/Vehicle1/thruster/4",
@@ -328,8 +334,8 @@ class VanishTest(unittest.TestCase):
         back = time.monotonic() - t0
         self.assertEqual(rig.state(), "killed")
         self.assertEqual(rig.log().count("recovery is not configured"), 1)
-        print("\nI2C adapter gone for 1.5 s: killed after %.0f ms, bus ok again %.1f s after it went" %
-              (killed * 1000, back))
+        figure("vanish.adapter.killed_ms", killed * 1000, "ms", "I2C adapter gone for 1.5 s: killed after")
+        figure("vanish.adapter.back_s", back, "s", "I2C adapter gone for 1.5 s: bus ok again after it went")
         self.back_and_driving()
 
     def test_teensy_spi(self):
@@ -346,8 +352,8 @@ class VanishTest(unittest.TestCase):
         back = time.monotonic() - t0
         self.assertEqual(rig.state(), "killed")
         self.assertEqual(rig.log().count("Teensy SPI"), 2)  # went away; is back
-        print("\nTeensy SPI gone for 1.5 s: killed after %.0f ms, online again %.1f s after it went" %
-              (killed * 1000, back))
+        figure("vanish.teensy.killed_ms", killed * 1000, "ms", "Teensy SPI gone for 1.5 s: killed after")
+        figure("vanish.teensy.back_s", back, "s", "Teensy SPI gone for 1.5 s: online again after it went")
         self.back_and_driving()
 
 
@@ -373,8 +379,10 @@ class SimulatorRestartTest(unittest.TestCase):
         time.sleep(VANISHED_WINDOW_S)
         cpu = (cpu_seconds(pid) - cpu0) / (time.monotonic() - t0) * 100
         lines = rig.log().count("\n") - lines0
-        print("\nsimulator gone: CPU %.2f %% of a core over %.0f s, %d log lines, KillSource %s, bus %s" %
-              (cpu, VANISHED_WINDOW_S, lines, rig.vget("KillSource"), bus_state(rig)))
+        print("\nsimulator gone: KillSource %s, bus %s" % (rig.vget("KillSource"), bus_state(rig)))
+        figure("simulator_gone.cpu_percent", cpu, "%", "daemon CPU over %.0f s with the simulator gone" % VANISHED_WINDOW_S)
+        figure("simulator_gone.log_lines", lines, "count", "log lines over %.0f s with the simulator gone"
+               % VANISHED_WINDOW_S)
         assert_idle_cpu(self, cpu)
         self.assertLessEqual(lines, VANISHED_LOG_LINES_MAX)
         self.assertEqual(error_name(rig.vcall, "ClearKill")[:len(ERR)], ERR)
@@ -390,7 +398,7 @@ class SimulatorRestartTest(unittest.TestCase):
         rig.thrust([700] * MOTORS)
         rig.wait_sim_speeds([speed_byte(700)] * MOTORS)
         poll(lambda: rig.sim_get("KillOutput") is not None and not rig.sim_get("KillOutput"), 5)
-        print("simulator back: bus ok after %.1f s, killed until ClearKill, then driving again" % back)
+        figure("simulator_back.bus_ok_s", back, "s", "simulator back: bus ok after (killed until ClearKill)")
 
 
 if __name__ == "__main__":

@@ -12,6 +12,7 @@ import dbus
 
 import harness
 from bounds import CLIENT_LOSS_ZERO_MS_MAX, FAILSAFE_LATENESS_MS_MAX
+from figures import figure
 from harness import MOTORS, ROOT, VEHICLE, ZERO, Rig, poll, pump_main_loop, speed_byte
 from test_failsafes import Announced, FailsafeSignals, assert_deadline_kept, kill_edges, nonzero_after_kill, orders
 
@@ -100,7 +101,8 @@ class PilotCase(unittest.TestCase):
         self.assertEqual(rig.vget("KillSource"), "failsafe")
         edge = poll(lambda: kill_edges(rig.wire_log(since)[1]), 5, message="no kill output edge")[0]
         after_ms = (edge.time_ns - left_at) / 1e6
-        print("\nlast pilot left -> kill output edge: %.0f ms (persistence %d ms)" % (after_ms, PERSISTENCE_MS))
+        figure("pilot_lost.kill_after_ms", after_ms, "ms",
+               "last pilot left -> kill output edge (persistence %d ms)" % PERSISTENCE_MS)
         self.assertGreaterEqual(after_ms, PERSISTENCE_MS, "killed before the persistence time")
         self.assertLessEqual(after_ms, PERSISTENCE_MS + FAILSAFE_LATENESS_MS_MAX)
         log = rig.wire_log(since)[1]
@@ -130,7 +132,7 @@ class PilotCase(unittest.TestCase):
         first = poll(zeros, 5, message="the pilot's thrust did not go")
         worst = max(e for e in first.values())
         ms = (worst.time_ns - left_at) / 1e6
-        print("\npilot left -> its last zero order: %.1f ms" % ms)
+        figure("pilot_left.last_zero_ms", ms, "ms", "pilot left -> its last zero order")
         self.assertLessEqual(ms, CLIENT_LOSS_ZERO_MS_MAX)
         edges = kill_edges(rig.wire_log(since)[1])
         self.assertTrue(not edges or edges[0].index > worst.index, "the kill output came before the zeros")

@@ -11,6 +11,7 @@ import time
 import unittest
 
 from bounds import TEENSY_SILENCE_EARLY_MS_MAX, TEENSY_SILENCE_LATENESS_MS_MAX
+from figures import figure
 from harness import ERR, MOTORS, TEENSY_IFACE, TEENSY_PATH, ZERO, Rig, error_name, poll, speed_byte
 from test_failsafes import kill_edges, nonzero_after_kill, orders
 
@@ -59,8 +60,11 @@ class TeensySilenceTest(unittest.TestCase):
         for e, i, s in orders(log):
             if e.index > edge.index and s == ZERO and i not in zeros:
                 zeros[i] = (e.time_ns - silent_at) / 1e6
-        print("\n%s: kill output %.1f ms, last thruster zero %.1f ms after the Teensy fell silent (silence_ms %d)"
-              % (self._testMethodName, late_ms, max(zeros.values()) if zeros else -1, SILENCE_MS))
+        figure("teensy_silence.kill_output_ms", late_ms, "ms",
+               "%s: kill output after the Teensy fell silent (silence_ms %d)" % (self._testMethodName, SILENCE_MS))
+        if zeros:
+            figure("teensy_silence.last_zero_ms", max(zeros.values()), "ms",
+                   "%s: last thruster zero after the Teensy fell silent" % self._testMethodName)
         # Not before the silence: the last valid frame was at most one poll (20 ms) before.
         self.assertGreaterEqual(late_ms, SILENCE_MS - TEENSY_SILENCE_EARLY_MS_MAX)
         self.assertLess(late_ms, SILENCE_MS + TEENSY_SILENCE_LATENESS_MS_MAX)

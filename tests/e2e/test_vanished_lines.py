@@ -6,6 +6,7 @@ import time
 import unittest
 
 from bounds import (VANISHED_LOG_LINES_MAX, VANISHED_WINDOW_S)
+from figures import figure
 from harness import (ERR, MOTORS, Rig, error_name, poll, speed_byte)
 from vehicle_checks import assert_idle_cpu, cpu_seconds
 
@@ -32,8 +33,10 @@ class VanishedLinesTest(unittest.TestCase):
         time.sleep(VANISHED_WINDOW_S)
         cpu = (cpu_seconds(pid) - cpu0) / (time.monotonic() - t0) * 100
         lines = rig.log().count("\n") - log_before
-        print("\nsimulator gone: daemon CPU %.2f %% of a core over %.0f s, %d log lines, KillSource %s"
-              % (cpu, VANISHED_WINDOW_S, lines, rig.vget("KillSource")))
+        print("\nsimulator gone: KillSource %s" % rig.vget("KillSource"))
+        figure("simulator_gone.cpu_percent", cpu, "%", "daemon CPU over %.0f s with the simulator gone" % VANISHED_WINDOW_S)
+        figure("simulator_gone.log_lines", lines, "count", "log lines over %.0f s with the simulator gone"
+               % VANISHED_WINDOW_S)
         # Everything went with the simulator; the kill is the first loss noticed: the switch (its
         # edge source), the bus, the kill output read back every 100 ms (device) or the Teensy
         # link (failsafe). test_gpio_lines takes the switch away alone.

@@ -15,7 +15,9 @@ scenario without a result line is a failure. An unknown name is an error.
 
 import errno
 import fcntl
+import grp
 import os
+import pwd
 import re
 import signal
 import struct
@@ -1057,10 +1059,9 @@ def device_nodes():
     return nodes + [DRIVER + "/bind", DRIVER + "/unbind"]
 
 
-def as_user(user, argv, **kw):
-    """argv run as `user` with that user's groups (setpriv --init-groups), as a login would."""
-    return subprocess.run(["setpriv", "--reuid=" + user, "--regid=" + user, "--init-groups"] + argv,
-                          capture_output=True, text=True, timeout=60, **kw)
+def as_user(user, argv):
+    """argv to run as `user` with that user's groups (setpriv --init-groups), as a login would."""
+    return ["setpriv", "--reuid=" + user, "--regid=" + user, "--init-groups"] + argv
 
 
 def users_from_sysusers():
@@ -1109,7 +1110,6 @@ def sc_device_access(rig):
     users_from_sysusers()
     udevd = nodes_from_udev()
     try:
-        import grp
         io_gid = grp.getgrnam("caracara-io").gr_gid
         check(grp.getgrnam("caracara-io").gr_mem == ["caracara"], "caracara-io members %s" % grp.getgrnam("caracara-io").gr_mem)
         check("pilot" in grp.getgrnam("caracara").gr_mem, "the pilot is not in caracara")
@@ -1122,7 +1122,8 @@ def sc_device_access(rig):
         probe = ("import os,sys\nfor n in sys.argv[1:]:\n"
                  "    try:\n        os.close(os.open(n, os.O_WRONLY if n.endswith('bind') else os.O_RDWR)); print(n, 'opened')\n"
                  "    except OSError as e:\n        print(n, e.errno)\n")
-        r = as_user("pilot", ["/usr/bin/python3", "-c", probe] + nodes)
+        r = subprocess.run(as_user("pilot", ["/usr/bin/python3", "-c", probe] + nodes), capture_output=True,
+                           text=True, timeout=60)
         got = dict(line.rsplit(" ", 1) for line in r.stdout.split("\n") if line)
         check(got == {n: str(errno.EACCES) for n in nodes}, "the pilot's open(): %s %s" % (got, r.stderr))
         # The daemon's user: caracarad drives them (the dives' and the rig's files readable to it).
@@ -1130,10 +1131,10 @@ def sc_device_access(rig):
         rig.stop_daemon()
         for d in (rig.dir, rig.dives_dir):
             os.chmod(d, 0o755)
-        os.chown(rig.dives_dir, pwd_uid("caracara"), io_gid)
+        os.chown(rig.dives_dir, pwd.getpwnam("caracara").pw_uid, io_gid)
         rig.daemon_exit = None
-        rig._spawn("caracarad", ["setpriv", "--reuid=caracara", "--regid=caracara", "--init-groups", binary("caracarad"),
-                                 "--bus-address", rig.address, "--config", rig.config_path])
+        rig._spawn("caracarad", as_user("caracara", [binary("caracarad"), "--bus-address", rig.address,
+                                                     "--config", rig.config_path]))
         poll(lambda: rig.conn.name_has_owner(VEHICLE) or rig._died("caracarad"), rig.START_TIMEOUT,
              message="caracarad (as caracara) did not take its name")
         rig._check_alive("caracarad")
@@ -1164,10 +1165,6 @@ def sc_device_access(rig):
             rig.stop_daemon()
         rig.start_daemon()
 
-
-def pwd_uid(user):
-    import pwd
-    return pwd.getpwnam(user).pw_uid
 
 
 

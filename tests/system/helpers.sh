@@ -10,6 +10,9 @@ SP=/org/caracara/Simulator1
 pass() { echo "PASS: ${label:-}$*" | tee -a "$results"; }
 fail() { echo "FAIL: ${label:-}$*" | tee -a "$results"; }
 info() { echo "INFO: $*"; }
+# figure KEY VALUE UNIT WHAT: a measured figure, as tests/e2e/figures.py prints it (the suite's
+# record keeps it, scripts/doc_figures.py quotes it in the docs).
+figure() { echo "FIGURE: $1 $2 $3  # $4"; }
 # check NAME COMMAND...: PASS if the command succeeds.
 check() {
   local name=$1
@@ -54,6 +57,6 @@ pilot_lost_kill() {
   seen=$(mono_us)
   [ "$(prop $V $VP $V KillSource)" = failsafe ] || { info "KillSource $(prop $V $VP $V KillSource)"; return 1; }
   [ -n "${1:-}" ] || return 0
-  info "the last pilot left -> killed seen after $(((seen - $1) / 1000)) ms (pilot-lost persistence $PILOT_LOST_MS ms)"
+  figure system.pilot_lost_kill_seen_ms $(((seen - $1) / 1000)) ms "the last pilot left -> killed, as State polled shows it (pilot-lost persistence $PILOT_LOST_MS ms)"
   [ $((seen - $1)) -ge $((PILOT_LOST_MS * 1000)) ] && [ $((seen - $1)) -le $(((PILOT_LOST_MS + PILOT_LOST_KILL_LATENESS_MS_MAX) * 1000)) ]
 }

@@ -75,7 +75,7 @@ cannot_run() {
 # re-arm, after the busctl pilot of check.sh and after each of topside.sh's three pilots that
 # leave), the bridge's own user (+3: its user in the group, the name it may not own,
 # MemoryMax), real-time scheduling (+2: the loop's policy, its memory locked) and the zeroing
-# step judged on this step's own zero orders and journal lines (+4: the three BOUND: lines of
+# step judged on this step's own zero orders and journal lines (+4: the three FIGURE lines of
 # check.sh asserted against tests/bounds.json, the step's zeros before the next daemon's start
 # and its report after a cursor, in place of zeros that a restart also sends), caracara-ros's
 # own user (+8 with --debs, +6 with a build tree: its package installed and purged, its start,

@@ -187,7 +187,7 @@ sed 's/^/  hold | /' "$TOP/hold.log"
 check "dropped link: the daemon zeroes all eight thrusters" wait_until 5 all_zero_since "$idx"
 z=$(first_zeros_us "$idx")
 drop_ms=$(((z - t_kill) / 1000))
-echo "BOUND: dropped link (ssh killed on the topside): $drop_ms ms to the last thruster's first zero order"
+figure topside.dropped_link_zero_ms "$drop_ms" ms "dropped link (ssh killed on the topside) to the last thruster's first zero order"
 check "dropped link: zero on the wire within CLIENT_LOSS_ZERO_MS_MAX ($CLIENT_LOSS_ZERO_MS_MAX ms) of the kill ($drop_ms ms)" \
   bash -c '[ -n "$1" ] && [ "$2" -le "$3" ]' _ "$z" "$drop_ms" "$CLIENT_LOSS_ZERO_MS_MAX"
 check "dropped link: the last pilot gone, killed by the failsafe (pilot-lost) after its persistence" \
@@ -205,7 +205,7 @@ ip link set tether up
 wait_until 10 state_is ready # the link is back (a read gets through)
 z=$(first_zeros_us "$idx")
 stall_ms=$(( (${z:-0} - t_cut) / 1000))
-echo "BOUND: stalled link (tether down, TCP open): $stall_ms ms to the last thruster's first zero order (CommandTimeoutMs $timeout_ms)"
+figure topside.stalled_link_zero_ms "$stall_ms" ms "stalled link (tether down, TCP open) to the last thruster's first zero order (CommandTimeoutMs $timeout_ms)"
 check "stalled link: the command timeout zeroes all eight thrusters within ${timeout_ms} + STALLED_LINK_ZERO_MARGIN_MS ($STALLED_LINK_ZERO_MARGIN_MS) ms ($stall_ms ms)" \
   bash -c '[ -n "$1" ] && [ "$2" -le $(($3 + $4)) ]' _ "$z" "$stall_ms" "$timeout_ms" "$STALLED_LINK_ZERO_MARGIN_MS"
 sleep 1

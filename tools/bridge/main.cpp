@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <vector>
 #include <systemd/sd-daemon.h>
 
 namespace {
@@ -25,6 +26,10 @@ void help() {
                  "  --listen tcp:ADDRESS:PORT  Listen on TCP instead; needs --token-file (docs/topside.md)\n"
                  "  --token-file FILE          The token every TCP client must bring (?token= or\n"
                  "                             Authorization: Bearer)\n"
+                 "  --allow-origin ORIGIN      A web page's origin that may connect besides the cockpit served\n"
+                 "                             here (e.g. https://app.foxglove.dev); repeatable. Pages of any\n"
+                 "                             other origin are refused (403); clients that send no Origin\n"
+                 "                             (Foxglove desktop, scripts) are taken (docs/foxglove.md)\n"
                  "  --max-clients N            WebSocket clients at once (default 16); a connection takes\n"
                  "                             a slot only once its request (and token) is good\n"
                  "  --cockpit-dir DIR          The cockpit's files, served to browsers on the same socket\n"
@@ -48,6 +53,7 @@ int main(int argc, char** argv) {
     session.cockpit_dir = kDefaultCockpit;
     session.dives_dir = kDefaultDives;
     std::string token_file;
+    std::vector<std::string> allowed_origins;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -82,6 +88,12 @@ int main(int argc, char** argv) {
                 return usage("--dives-dir needs a directory");
         } else if (a == "--token-file") {
             token_file = value();
+        } else if (a == "--allow-origin") {
+            const std::string o = value();
+            if (!caracara::bridge::OriginCheck::normalize(o))
+                return usage("--allow-origin takes an origin, scheme://host[:port] with no path (e.g. "
+                             "https://app.foxglove.dev), not '" + o + "'");
+            allowed_origins.push_back(o);
         } else if (a == "--max-clients") {
             const std::string n = value();
             const auto [end, ec] = std::from_chars(n.data(), n.data() + n.size(), listen.max_clients);
@@ -112,6 +124,9 @@ int main(int argc, char** argv) {
     } else if (!token_file.empty()) {
         return usage("--token-file applies to --listen tcp: only");
     }
+    session.origins = caracara::bridge::OriginCheck(allowed_origins, !session.token.empty());
+    for (const std::string& o : session.origins.allowed())
+        std::fprintf(stderr, "caracara-bridge: pages from %s may connect (--allow-origin)\n", o.c_str());
     try {
         boost::asio::io_context io(1);
         caracara::bridge::BridgeServer server(io, listen, session);

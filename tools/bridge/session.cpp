@@ -4,6 +4,7 @@
 #include "tools/bridge/dive_worker.hpp"
 #include "tools/bridge/static_files.hpp"
 
+#include "tools/client/same_secret.hpp"
 #include "tools/foxglove/channels.hpp"
 
 #include <boost/algorithm/string/predicate.hpp>
@@ -49,16 +50,6 @@ std::string token_of(const http::request<http::string_body>& req) {
         return "";
     const auto end = target.find('&', q);
     return std::string(target.substr(q + 6, end == std::string_view::npos ? std::string_view::npos : end - q - 6));
-}
-
-// Compares in a time that does not depend on where the first difference is.
-bool same(const std::string& a, const std::string& b) {
-    if (a.size() != b.size())
-        return false;
-    unsigned char diff = 0;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        diff |= static_cast<unsigned char>(a[i] ^ b[i]);
-    return diff == 0;
 }
 
 bool offers_subprotocol(const http::request<http::string_body>& req) {
@@ -143,6 +134,32 @@ void Session::reject(http::status status, std::string body) {
     answer(std::move(res));
 }
 
+bool Session::origin_taken(bool upgrade) {
+    const auto field = request_.find(http::field::origin);
+    const std::optional<std::string_view> origin =
+        field == request_.end() ? std::nullopt : std::optional<std::string_view>(view(field->value()));
+    const auto verdict = config_.origins.judge(origin, view(request_[http::field::host]));
+    if (!config_.origins.refused(verdict))
+        return true;
+    // The origin is the page's, the host the browser's: both are only printed, never trusted.
+    auto printable = [](std::string_view s) {
+        std::string out(s.substr(0, 200));
+        for (char& c : out)
+            c = (c < 0x20 || c > 0x7e) ? '?' : c;
+        return out;
+    };
+    const std::string from = printable(*origin), host = printable(view(request_[http::field::host]));
+    const bool rebind = verdict == OriginCheck::Verdict::Rebindable;
+    const std::string why = rebind ? "the bridge's Host '" + host + "' is a name that DNS rebinding can forge (use "
+                                     "localhost or an IP address, or give --allow-origin " + from + ")"
+                                   : "not the bridge's own page (http://" + host + ") nor given with --allow-origin";
+    std::fprintf(stderr, "caracara-bridge: refused %s from origin '%s': %s\n",
+                 upgrade ? "a WebSocket upgrade" : "a request for dives", from.c_str(), why.c_str());
+    reject(http::status::forbidden, "caracara-bridge: a page from " + from + " may not use this bridge: " + why +
+                                        " (docs/foxglove.md, \"Which pages may connect\")");
+    return false;
+}
+
 void Session::answer(std::shared_ptr<http::response<http::string_body>> res, std::shared_ptr<void> ticket) {
     close_after(ticket ? kDiveAnswerTimeout : kAnswerTimeout);
     http::async_write(ws_.next_layer(), *res, [self = shared_from_this(), res, ticket](boost::system::error_code, std::size_t) {
@@ -163,7 +180,9 @@ void Session::on_request(boost::system::error_code ec) {
     if (!upgrade && !dives)
         return answer(std::make_shared<http::response<http::string_body>>(
             StaticFiles(config_.cockpit_dir).respond(request_)));
-    if (!config_.token.empty() && !same(token_of(request_), config_.token))
+    if (!origin_taken(upgrade))
+        return;
+    if (!config_.token.empty() && !client::same_secret(token_of(request_), config_.token))
         return reject(http::status::unauthorized, "caracara-bridge: a valid token is required");
     if (!upgrade) {
         // Listing and converting take their time: on the worker, never on this (the I/O) thread.

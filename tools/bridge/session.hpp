@@ -1,5 +1,5 @@
-// One Foxglove client: the HTTP upgrade (subprotocol foxglove.websocket.v1, and the token when
-// the bridge listens on TCP), serverInfo and advertise, then its frames through ClientProtocol
+// One Foxglove client: the HTTP upgrade (its Origin, OriginCheck; subprotocol
+// foxglove.websocket.v1, and the token when the bridge listens on TCP), serverInfo and advertise, then its frames through ClientProtocol
 // and its commands through its own CommandLink. Messages to it wait in a bounded queue: when
 // the client does not keep up, the oldest messages are dropped, so it never holds up the
 // bridge or another client. Its replies and status messages are bounded in bytes: past
@@ -12,6 +12,7 @@
 #include "tools/bridge/client_protocol.hpp"
 #include "tools/bridge/client_slots.hpp"
 #include "tools/bridge/command_link.hpp"
+#include "tools/bridge/origin_check.hpp"
 #include "tools/bridge/send_queue.hpp"
 #include "tools/bridge/telemetry.hpp"
 
@@ -32,6 +33,7 @@ class DiveWorker;
 struct SessionConfig {
     caracara::dbus::BusChoice bus;
     std::string token;                  // required in the request when not empty (TCP)
+    OriginCheck origins;                // which pages may upgrade or read /dives/ (--allow-origin)
     std::size_t max_message_bytes = 64 * 1024;
     std::size_t max_queued = 256;       // messageData frames waiting for a slow client
     std::size_t max_reply_bytes = 256 * 1024; // replies and status messages waiting: past it, closed
@@ -60,6 +62,8 @@ private:
 
     void on_request(boost::system::error_code ec);
     void reject(boost::beast::http::status status, std::string body);
+    // False (the request answered 403 and logged) when a browser page of another origin sent it.
+    bool origin_taken(bool upgrade);
     // ticket: a DiveWorker's, held until the answer is written.
     void answer(std::shared_ptr<boost::beast::http::response<boost::beast::http::string_body>> res,
                 std::shared_ptr<void> ticket = nullptr);

@@ -1,19 +1,18 @@
 #include "tools/caracaractl/bridge_forward.hpp"
 
+#include "tools/caracaractl/forward_relay.hpp"
 #include "tools/client/client.hpp"
 #include "tools/client/ssh_stderr.hpp"
 #include "tools/client/ssh_target.hpp"
 
-#include <arpa/inet.h>
 #include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -28,18 +27,29 @@ constexpr uint16_t kDefaultPort = 8765; // Foxglove's default for a WebSocket co
 
 [[noreturn]] void usage(const std::string& m) { throw Failure{kExitUsage, m}; }
 
-bool port_listens(uint16_t port) {
-    const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    if (fd < 0)
-        return false;
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    const bool ok = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-    ::close(fd);
-    return ok;
-}
+// A directory of the pilot's alone (0700) for ssh's end of the forward: in $XDG_RUNTIME_DIR
+// (itself 0700) when there is one, else /tmp; removed with what is in it when the forward ends.
+class PrivateDir {
+public:
+    PrivateDir() {
+        const char* runtime = std::getenv("XDG_RUNTIME_DIR");
+        std::string tmpl = std::string(runtime && *runtime && ::access(runtime, W_OK) == 0 ? runtime : "/tmp") +
+                           "/caracaractl-bridge.XXXXXX";
+        if (!::mkdtemp(tmpl.data()))
+            throw Failure{kExitUnavailable, "mkdtemp " + tmpl + ": " + std::strerror(errno)};
+        path_ = tmpl;
+    }
+    ~PrivateDir() {
+        ::unlink(socket().c_str());
+        ::rmdir(path_.c_str());
+    }
+    PrivateDir(const PrivateDir&) = delete;
+    PrivateDir& operator=(const PrivateDir&) = delete;
+    std::string socket() const { return path_ + "/bridge.sock"; }
+
+private:
+    std::string path_;
+};
 
 // ssh's exit: 255 is its own failure (not reached, refused), anything else the forward's end.
 int exit_of(int status) {
@@ -56,7 +66,8 @@ const char* bridge_forward_help() {
            "                                   Forward the vehicle's bridge socket to localhost:N\n"
            "                                   (default 8765) with ssh -L and print the addresses to\n"
            "                                   open in Foxglove (ws://) and in a browser (http://,\n"
-           "                                   the cockpit); held until ^C\n";
+           "                                   the cockpit), with this session's key (?key=): the port\n"
+           "                                   refuses requests without it (403); held until ^C\n";
 }
 
 int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vector<std::string>& args) {
@@ -88,15 +99,18 @@ int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vecto
     const auto target = parse_ssh_target(choice.address);
     if (!target)
         usage("-H needs [USER@]HOST[:PORT], not '" + choice.address + "'");
-    if (port_listens(port))
-        throw Failure{kExitRefused, "localhost:" + std::to_string(port) + " is in use; choose another with --port"};
+    // The port is caracaractl's own (bound now: in use is said before ssh runs); ssh's end is a
+    // socket in a directory no other local user can enter, and only requests with the key go on.
+    const PrivateDir dir;
+    const ForwardKey key = ForwardKey::random(port);
+    ForwardRelay relay(port, dir.socket(), key);
 
     std::vector<std::string> argv = {"ssh", "-N", "-T", "-x", "-o", "ExitOnForwardFailure=yes"};
     if (!ssh_config.empty())
         argv.insert(argv.end(), {"-F", ssh_config});
     if (!target->port.empty())
         argv.insert(argv.end(), {"-p", target->port});
-    argv.insert(argv.end(), {"-L", "127.0.0.1:" + std::to_string(port) + ":" + socket_path, "--", target->destination()});
+    argv.insert(argv.end(), {"-L", dir.socket() + ":" + socket_path, "--", target->destination()});
 
     sigset_t mask;
     sigemptyset(&mask);
@@ -136,17 +150,20 @@ int run_bridge_forward(const caracara::dbus::BusChoice& choice, const std::vecto
                                                     "); the forward is gone"};
             return kExitOk;
         }
-        if (!announced && port_listens(port)) {
+        if (!announced && ::access(dir.socket().c_str(), F_OK) == 0) {
             announced = true;
-            // The Foxglove address, then the cockpit's (the same socket serves both, docs/cockpit.md).
-            std::printf("ws://localhost:%u\nhttp://localhost:%u/\n", port, port);
+            // The Foxglove address, then the cockpit's (the same socket serves both, docs/cockpit.md),
+            // each with the session's key; a browser trades it for a cookie on its first load.
+            std::printf("ws://localhost:%u/?key=%s\nhttp://localhost:%u/?key=%s\n", port, key.key().c_str(), port,
+                        key.key().c_str());
             std::fflush(stdout);
-            std::fprintf(stderr, "caracaractl: open ws://localhost:%u in Foxglove (Open connection, Foxglove "
-                                 "WebSocket), or the cockpit at http://localhost:%u/ in a browser; Ctrl-C ends "
-                                 "the forward\n", port, port);
+            std::fprintf(stderr, "caracaractl: open the ws:// address in Foxglove (Open connection, Foxglove "
+                                 "WebSocket), or the http:// one, the cockpit, in a browser; they carry this "
+                                 "session's key (no other user of this computer has it). Ctrl-C ends the forward\n");
         }
-        const timespec tick{0, 50'000'000};
-        const int sig = sigtimedwait(&mask, nullptr, &tick);
+        relay.run_once(50, announced);
+        const timespec now{0, 0};
+        const int sig = sigtimedwait(&mask, nullptr, &now);
         if (sig == SIGINT || sig == SIGTERM) {
             ::kill(pid, SIGTERM);
             ::waitpid(pid, &status, 0);

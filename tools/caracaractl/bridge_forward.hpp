@@ -1,6 +1,8 @@
 // caracaractl -H pilot@vehicle bridge: brings caracara-bridge's Unix socket on the vehicle to a
-// local port with OpenSSH's socket forwarding (ssh -N -L 127.0.0.1:PORT:SOCKET), prints the
-// address to open in Foxglove, and holds the forward until Ctrl-C (docs/foxglove.md).
+// private local socket with OpenSSH's socket forwarding (ssh -N -L DIR/bridge.sock:SOCKET),
+// serves it on 127.0.0.1:PORT to requests that bring this session's key (ForwardRelay), prints
+// the addresses to open in Foxglove and a browser, with the key, and holds the forward until
+// Ctrl-C (docs/foxglove.md).
 #pragma once
 
 #include "drivers/sdbus/sdbus.hpp"

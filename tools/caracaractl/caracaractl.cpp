@@ -237,8 +237,8 @@ int main(int argc, char** argv) {
             usage_error("--for and --once exclude each other");
         if (command->nargs == kWordArgs ? args.empty() || args.size() > 6 : args.size() != command->nargs)
             usage_error(command->nargs == kWordArgs
-                            ? strf("%s takes 1 to 6 WORD=VALUE arguments (%s), got %zu", command->name, kMotionWords,
-                                   args.size())
+                            ? strf("%s takes 1 to 6 WORD=VALUE arguments (%s), got %zu", command->name,
+                                   motion_words().c_str(), args.size())
                             : strf("%s takes %zu argument%s, got %zu", command->name, command->nargs,
                                    command->nargs == 1 ? "" : "s", args.size()));
         Client client(choice);

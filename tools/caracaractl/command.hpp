@@ -25,8 +25,6 @@ using CommandRun = int(Client&, const Args&, const Options&);
 
 // nargs of a command that takes 1 to 6 WORD=VALUE arguments (motion), checked by the command.
 inline constexpr size_t kWordArgs = ~size_t{0};
-// motion's words, as its usage and errors list them.
-inline constexpr const char* kMotionWords = "forward, starboard, up, turn-right, nose-up, roll-right";
 
 struct Command {
     const char* name;

@@ -22,6 +22,16 @@ int cmd_thrust(Client& c, const Args& a, const Options& o) {
     return hold_command(c, "SetThrust", int_array(values), "SetThrust(" + int_list(values) + ")", o.hold);
 }
 
+std::string motion_words() {
+    std::string words;
+    for (const auto& n : EnumNames<frames::PilotAxis>::table) {
+        std::string w(n.name);
+        std::replace(w.begin(), w.end(), '_', '-');
+        words += (words.empty() ? "" : ", ") + w;
+    }
+    return words;
+}
+
 int cmd_motion(Client& c, const Args& a, const Options& o) {
     // A pilot's words (docs/frames.md), converted to the D-Bus contract's axes in core/frames and
     // nowhere else: WORD=VALUE, each word at most once, a word left out is 0.
@@ -33,7 +43,7 @@ int cmd_motion(Client& c, const Args& a, const Options& o) {
         std::replace(word.begin(), word.end(), '-', '_');
         const std::optional<frames::PilotAxis> axis = parse_name<frames::PilotAxis>(word);
         if (!axis)
-            usage_error("motion takes WORD=VALUE (" + std::string(kMotionWords) + "), each -1..1, negative for the "
+            usage_error("motion takes WORD=VALUE (" + motion_words() + "), each -1..1, negative for the "
                         "opposite motion; not '" + arg + "' (docs/frames.md)");
         if (!given.insert(*axis).second)
             usage_error("motion: '" + arg.substr(0, eq) + "' given twice");

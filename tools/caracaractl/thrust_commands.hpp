@@ -4,10 +4,14 @@
 
 #include "tools/caracaractl/command.hpp"
 
+#include <string>
+
 namespace caracara::ctl {
 
 CommandRun cmd_thrust;
 CommandRun cmd_motion;
+// motion's words as it takes them: EnumNames<frames::PilotAxis>, '_' spelled '-' ("turn-right").
+std::string motion_words();
 // A packet that kills or powers off is sent once, whatever --for says.
 CommandRun cmd_packet;
 

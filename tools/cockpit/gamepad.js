@@ -65,9 +65,13 @@ export function loadMapping(storage = localStorage) {
   try {
     stored = JSON.parse(storage.getItem(KEY) ?? "{}");
   } catch {
+    stored = undefined;
+  }
+  // Only an object is a mapping: a string or an array would spread its indices into it.
+  if (stored === null || typeof stored !== "object" || Array.isArray(stored)) {
     return { mapping: { ...DEFAULT_MAPPING }, notice: "The saved gamepad mapping could not be read: the defaults are in use." };
   }
-  if (stored && typeof stored === "object" && OLD_AXES.some((a) => a in stored)) {
+  if (OLD_AXES.some((a) => a in stored)) {
     storage.setItem(KEY, JSON.stringify(DEFAULT_MAPPING));
     return { mapping: { ...DEFAULT_MAPPING }, notice: "The gamepad mapping saved in this browser named the old axes " +
       "(x, y, z, yaw, pitch, roll), which drove the wrong way: it was reset to the defaults (left stick forward: " +
