@@ -36,12 +36,12 @@ void TeensyPoll::ask() {
 void TeensyPoll::answered() {
     out_ = false;
     if (frame_.ok) {
-        if (frame_.slot < 3 && tm_.orientation[frame_.slot] != frame_.value) {
+        if (frame_.slot >= 3) {
+            tm_.distances[frame_.sensor] = static_cast<uint16_t>(frame_.value);
+        } else if (tm_.orientation[frame_.slot] != frame_.value) {
             tm_.orientation[frame_.slot] = frame_.value;
             tm_.orientation_read_ns = frame_.read_ns;
         }
-        else
-            tm_.distances[frame_.sensor] = static_cast<uint16_t>(frame_.value);
     }
     done_(frame_.ok ? Outcome::Answered : frame_.err == ENODEV ? Outcome::Gone : Outcome::Failed);
 }
