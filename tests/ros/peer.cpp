@@ -12,7 +12,9 @@
 //                                       turn, one JSON line each {"sent","t_ns"}; hold: then sleeps;
 //                                       stdin: then goes on at HZ with the last sample, each hex line
 //                                       read from stdin the sample from then on, until stdin closes;
-//                                       a line "stop" stops the writes (the writer stays) until the next
+//                                       a line "stop" stops the writes (the writer stays) until the next;
+//                                       on ros_discovery_info the writer is transient-local, keep-last 1,
+//                                       as a ROS 2 node's
 //   peer roundtrip TYPE HEX             Fast CDR's bytes for the sample the hex decodes to
 // t_ns is CLOCK_MONOTONIC, the clock of the simulator's wire log.
 // TYPE is "pkg/Name"; TOPIC the DDS topic ("rt/caracara/imu"). The participant's lease is 2 s;
@@ -325,6 +327,10 @@ int main(int argc, char** argv) {
         DataWriterQos wq = DATAWRITER_QOS_DEFAULT;
         wq.reliability().kind = RELIABLE_RELIABILITY_QOS;
         wq.durability().kind = VOLATILE_DURABILITY_QOS;
+        if (std::string(argv[2]) == "ros_discovery_info") { // as rmw_dds_common's graph cache writes it
+            wq.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+            wq.history().depth = 1;
+        }
         wq.representation().m_value.push_back(XCDR_DATA_REPRESENTATION);
         DataWriter* w = part->create_publisher(PUBLISHER_QOS_DEFAULT)->create_datawriter(topic, wq);
         std::vector<void*> samples;

@@ -236,6 +236,7 @@ class RosTestCase(VehicleTestCase):
     """One rig, one caracara-ros (commands as COMMANDS says) per class."""
     COMMANDS = False
     DISTRO = "humble"
+    LAYOUT_IN_CONFIG = True  # range_layout = DISTRO; else caracara-ros finds the distro itself
     ROS_CONFIG = ""  # more [ros] lines
     EXTRA_CONFIG = {"failsafe": {"pilot-lost": {"action": "kill", "persistence_ms": 60000}}}
 
@@ -248,8 +249,9 @@ class RosTestCase(VehicleTestCase):
         cls.addClassCleanup(cls.codec.close)
         conf = os.path.join(cls.rig.dir, "ros.toml")
         with open(conf, "w") as f:
-            f.write('[ros]\nnamespace = "/caracara"\ncommands = %s\nrange_layout = "%s"\n%s[network]\ninterface = "lo"\n'
-                    % ("true" if cls.COMMANDS else "false", cls.DISTRO, cls.ROS_CONFIG))
+            f.write('[ros]\nnamespace = "/caracara"\ncommands = %s\n%s%s[network]\ninterface = "lo"\n'
+                    % ("true" if cls.COMMANDS else "false",
+                       'range_layout = "%s"\n' % cls.DISTRO if cls.LAYOUT_IN_CONFIG else "", cls.ROS_CONFIG))
         cls.ros = cls.rig._spawn("caracara-ros", harness.EMULATOR + [
             os.path.join(BUILD_DIR, "tools", "ros", "caracara-ros"), "--bus-address", cls.rig.address, "--config", conf])
         cls.addClassCleanup(cls.stop_ros)
@@ -300,7 +302,8 @@ class RosTestCase(VehicleTestCase):
         """ros_discovery_info as ROS 2's graph cache reads it: the participant's gid is the GUID the
         peer discovered (zeros after it to the distro's Gid size), one node caracara_ros in the
         namespace, and its writer and reader gids exactly the GUIDs of the writers and readers the
-        peer discovered on that participant (the discovery info's own writer is not the node's)."""
+        peer discovered on that participant (the discovery info's own writer and reader are not the
+        node's)."""
         samples, participants, writers, endpoints = self.listen(3, {**PUBLISHED, **DISCOVERY_INFO})
         # By GUID: a participant found again (after a lease lapse under load) is the same one.
         ros = {p["guid"] for p in participants if p["user_data"] == "enclave=/;"}
@@ -311,7 +314,8 @@ class RosTestCase(VehicleTestCase):
         w = writers["ros_discovery_info"]
         self.assertEqual(w["type"], "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_")
         self.assertTrue(w["reliable"] and w["transient_local"] and w["xcdr1"], w)
-        info = samples["ros_discovery_info"][-1][1]
+        # caracara-ros's own (a test's peer may write one too): its gid begins with the GUID.
+        info = [m for _, m in samples["ros_discovery_info"] if bytes(m["gid"]["data"]).hex().startswith(prefix)][-1]
         pad = "00" * (GID_BYTES[self.DISTRO] - 16)
         gid_hex = lambda g: bytes(g["data"]).hex()  # noqa: E731
         self.assertEqual(gid_hex(info["gid"]), guid + pad)
@@ -324,7 +328,8 @@ class RosTestCase(VehicleTestCase):
             self.assertTrue(g.endswith(pad), g)
         ours = {o["guid"]: o for o in endpoints if o["guid"].startswith(prefix)}.values()
         seen_writers = [o["guid"] for o in ours if o.get("writer", "ros_discovery_info") != "ros_discovery_info"]
-        seen_readers = [o for o in ours if "reader" in o]
+        # Nor is the participant's reader of the discovery info (rmw's graph cache has one too).
+        seen_readers = [o for o in ours if o.get("reader", "ros_discovery_info") != "ros_discovery_info"]
         self.assertEqual(sorted(g[:32] for g in listed_writers), sorted(seen_writers))
         self.assertEqual(sorted(g[:32] for g in listed_readers), sorted(o["guid"] for o in seen_readers))
         self.assertEqual(sorted(o["reader"] for o in seen_readers), sorted(reader_topics))
@@ -341,14 +346,16 @@ class RosTestCase(VehicleTestCase):
         return r
 
     @contextlib.contextmanager
-    def driving(self, topic, type_, msg, hz=50, short_lease=False):
+    def driving(self, topic, type_, msg, hz=50, short_lease=False, distro=None):
         """The peer publishing `msg` at `hz` (50: as a pilot's stack would) until the block ends,
         then SIGKILLed: a writer that goes away without a word. short_lease: its participant's
-        lease 100 ms (peer.cpp), for a test that times how soon its death is noticed."""
-        hex_ = self.codec.encode(type_, msg, self.DISTRO)
+        lease 100 ms (peer.cpp), for a test that times how soon its death is noticed. distro: the
+        peer built from that distro's definitions (else the class's)."""
+        distro = distro or self.DISTRO
+        hex_ = self.codec.encode(type_, msg, distro)
         env = dict(os.environ, PEER_SHORT_LEASE="1" if short_lease else "0")
         with tempfile.TemporaryFile("w+") as err:
-            p = subprocess.Popen([self.peer, "publish", topic, type_, hex_, "1000000", str(hz), "hold"],
+            p = subprocess.Popen([build_peer(distro), "publish", topic, type_, hex_, "1000000", str(hz), "hold"],
                                  stdout=subprocess.DEVNULL, stderr=err, text=True, env=env)
             try:
                 yield p
@@ -736,6 +743,68 @@ class JazzyRangeTest(RosTestCase):
     def test_discovery_info_with_jazzy_gids(self):
         """Jazzy's 16-byte Gid, read by the peer built from Jazzy's rmw_dds_common."""
         self.check_discovery_info(["rt/caracara/kill"])
+
+
+def distro_status(samples):
+    """The last /diagnostics' "caracara: ros distro" status, its values as a dict."""
+    msgs = samples.get("rt/diagnostics")
+    assert msgs, "no /diagnostics received"
+    st = [s for s in msgs[-1][1]["status"] if s["name"] == "caracara: ros distro"]
+    assert len(st) == 1, [s["name"] for s in msgs[-1][1]["status"]]
+    return {**st[0], "values": {kv["key"]: kv["value"] for kv in st[0]["values"]}}
+
+
+class AutoDistroTest(RosTestCase):
+    """No range_layout in the config: caracara-ros speaks what the ROS 2 machines around speak, read
+    from their ros_discovery_info (Jazzy's 16-byte Gid or Humble's 24, told apart by size). A
+    Jazzy node appears (the peer built from Jazzy's definitions writes its ParticipantEntitiesInfo,
+    transient-local as rmw does): Range and caracara-ros's own ros_discovery_info turn to Jazzy's
+    layouts, read by that peer. A Humble node joins: both are about, caracara-ros keeps Jazzy (a
+    tie keeps what it speaks) and says so in the journal and on /diagnostics (WARN)."""
+    DISTRO = "jazzy"
+    LAYOUT_IN_CONFIG = False
+    DIAGNOSTICS = {"rt/diagnostics": "diagnostic_msgs/DiagnosticArray"}
+
+    def ros_node(self, distro, name):
+        """A peer built from `distro`'s definitions writing a ROS 2 node's ros_discovery_info in
+        that distro's layout (2 Hz) until the block ends."""
+        gid = {"data": list(range(0x40, 0x50)) + [0] * (GID_BYTES[distro] - 16)}
+        msg = {"gid": gid, "node_entities_info_seq": [{"node_namespace": "/", "node_name": name,
+                                                       "reader_gid_seq": [gid], "writer_gid_seq": []}]}
+        return self.driving("ros_discovery_info", "rmw_dds_common/ParticipantEntitiesInfo", msg, hz=2, distro=distro)
+
+    def test_speaks_what_the_peers_speak(self):
+        rig = self.rig
+        status = distro_status(self.listen(2.5, self.DIAGNOSTICS)[0])
+        self.assertEqual((status["values"]["speaking"], status["level"]), ("humble", 0), status)
+        self.assertIn("no ROS 2 peer seen yet", status["message"])
+        log_start = len(rig.log("caracara-ros"))
+        with self.ros_node("jazzy", "talker"):
+            poll(lambda: "speaking jazzy" in rig.log("caracara-ros")[log_start:], 20,
+                 message="caracara-ros never turned to Jazzy")
+            self.assertIn("speaking jazzy: the peers' ros_discovery_info: 1 participant, all jazzy",
+                          rig.log("caracara-ros"))
+            # Range in Jazzy's layout, read by the peer built from Jazzy's definitions.
+            samples, _, _, _ = self.listen(2.5, {"rt/caracara/range/0": "sensor_msgs/Range", **self.DIAGNOSTICS})
+            r = samples["rt/caracara/range/0"][-1][1]
+            self.assertEqual(r["variance"], 0.0)
+            self.assertAlmostEqual(r["range"], int(rig.sim_teensy("Distances")[0]) / 1000, delta=0.002)
+            status = distro_status(samples)
+            self.assertEqual((status["values"]["speaking"], status["values"]["jazzy peers"], status["level"]),
+                             ("jazzy", "1", 0), status)
+            # caracara-ros's own ros_discovery_info with Jazzy's 16-byte gids, its Range writers
+            # those listed (the Humble-layout ones are gone).
+            self.check_discovery_info(["rt/caracara/kill"])
+            log_start = len(rig.log("caracara-ros"))
+            with self.ros_node("humble", "listener"):
+                poll(lambda: "peers of both distros" in rig.log("caracara-ros")[log_start:], 20,
+                     message="caracara-ros never said it found both distros")
+                self.assertIn("speaking jazzy: peers of both distros (humble 1 participant, jazzy 1 participant): "
+                              "jazzy, spoken already", rig.log("caracara-ros"))
+                status = distro_status(self.listen(2.5, self.DIAGNOSTICS)[0])
+                self.assertEqual((status["values"]["speaking"], status["values"]["humble peers"],
+                                  status["values"]["jazzy peers"], status["level"]), ("jazzy", "1", "1", 1), status)
+                self.assertIn("set range_layout to choose", status["message"])
 
 
 class NedFrdTest(RosTestCase):

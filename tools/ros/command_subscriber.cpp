@@ -65,8 +65,8 @@ std::string gid_text(const dds_guid_t& g, RangeLayout distro) {
 } // namespace
 
 CommandSubscriber::CommandSubscriber(sd_event* event, DdsParticipant& dds, const RosConfig& config,
-                                     CommandRecord& record, std::function<void()> kill)
-    : event_(event), config_(config), kill_(std::move(kill)), record_(record) {
+                                     CommandRecord& record, const SpokenDistro& distro, std::function<void()> kill)
+    : event_(event), config_(config), distro_(distro), kill_(std::move(kill)), record_(record) {
     wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     sd_event_source* s = nullptr;
     if (wake_fd_ < 0 || sd_event_add_io(event_, &s, wake_fd_, EPOLLIN, on_wake, this) < 0)
@@ -137,7 +137,7 @@ const std::string& CommandSubscriber::gid(dds_entity_t reader, dds_instance_hand
     if (added) {
         dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(reader, writer);
         if (e) {
-            it->second = gid_text(e->key, config_.range_layout);
+            it->second = gid_text(e->key, distro_.layout);
             dds_builtintopic_free_endpoint(e);
         } else { // no longer matched: its instance handle is all there is to name it by
             char b[32];

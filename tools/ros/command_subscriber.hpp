@@ -10,6 +10,7 @@
 #pragma once
 
 #include "tools/ros/dds_participant.hpp"
+#include "tools/ros/spoken_distro.hpp"
 #include "tools/ros/pilot.hpp"
 
 #include <functional>
@@ -22,6 +23,7 @@ class CommandSubscriber {
 public:
     // kill(): send Kill on any connection (the daemon takes it from every client).
     CommandSubscriber(sd_event* event, DdsParticipant& dds, const RosConfig& config, CommandRecord& record,
+                      const SpokenDistro& distro,
                       std::function<void()> kill);
     ~CommandSubscriber();
     CommandSubscriber(const CommandSubscriber&) = delete;
@@ -45,6 +47,7 @@ private:
 
     sd_event* event_;
     const RosConfig& config_;
+    const SpokenDistro& distro_; // a GID is printed in its Gid size
     std::function<void()> kill_;
     int wake_fd_ = -1;
     caracara::SourcePtr wake_;

@@ -111,6 +111,7 @@ std::string load_config(const std::string& path, RosConfig& c) {
         c.domain_id = static_cast<uint32_t>(*v);
     }
     if (auto v = ros["range_layout"].value<std::string>()) {
+        c.range_layout_given = true;
         if (*v == "humble")
             c.range_layout = RangeLayout::Humble;
         else if (*v == "jazzy")

@@ -59,8 +59,9 @@ double actual_fraction(const Props& p) {
 } // namespace
 
 TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config,
-                                       CommandRecord& commands)
-    : event_(event), dds_(dds), config_(config), commands_(commands),
+                                       CommandRecord& commands, SpokenDistro& distro)
+    : event_(event), dds_(dds), config_(config), commands_(commands), distro_(distro),
+      detector_(config.range_layout_given ? nullptr : std::make_unique<DistroDetector>(dds.handle())),
       world_frame_(world_frame_id(config.world_frame, config.frame_convention)),
       body_frame_(body_frame_id(config.base_frame, config.frame_convention)),
       sensor_period_us_(static_cast<uint64_t>(1e6 / config.sensor_rate_hz)),
@@ -246,6 +247,8 @@ int TelemetryPublisher::on_sensor_tick(sd_event_source* s, uint64_t usec, void* 
     const uint64_t next = usec + self->sensor_period_us_;
     sd_event_source_set_time(s, next > now ? next : now + self->sensor_period_us_);
     sd_event_source_set_enabled(s, SD_EVENT_ON);
+    if (self->detector_ && self->detector_->update())
+        self->choose_distro();
     if (!self->client_ || !self->orientation_read_at_.tv_sec)
         return 0; // nothing read yet
     // An offline Teensy's last attitude is no reading: the Imu and /tf stop, as a driver's do
@@ -327,7 +330,7 @@ void TelemetryPublisher::write_ranges() {
     const Value& d = get(props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Distances");
     const bool more = d.items.size() > ranges_.size();
     for (std::size_t i = ranges_.size(); i < d.items.size(); ++i)
-        ranges_.push_back(dds_.writer(config_.range_layout == RangeLayout::Jazzy ? &jazzy_range_ : &sensor_msgs_msg_dds__Range__desc,
+        ranges_.push_back(dds_.writer(distro_.layout == RangeLayout::Jazzy ? &jazzy_range_ : &sensor_msgs_msg_dds__Range__desc,
                                       ros_topic(config_, "range/" + std::to_string(i)), Profile::Default));
     if (more && d.items.size() > config_.ranges.size())
         write_static_frames(); // a sensor the config does not list: its frame, at the origin
@@ -335,7 +338,7 @@ void TelemetryPublisher::write_ranges() {
         const std::string frame = range_mount(config_, i).frame;
         const float metres = range_metres(static_cast<uint32_t>(d.items[i].unsigned_integer()));
         // radiation_type ULTRASOUND (0): the Teensy does not say which kind of sensor it reads.
-        if (config_.range_layout == RangeLayout::Jazzy) {
+        if (distro_.layout == RangeLayout::Jazzy) {
             jazzy_sensor_msgs_msg_dds__Range_ r{header(frame, teensy_read_at_), 0, config_.range_fov_rad, config_.range_min_m,
                                                 config_.range_max_m, metres, 0.0f};
             dds_write(ranges_[i], &r);
@@ -345,6 +348,38 @@ void TelemetryPublisher::write_ranges() {
             dds_write(ranges_[i], &r);
         }
     }
+}
+
+void TelemetryPublisher::choose_distro() {
+    const unsigned humble = detector_->peers(RangeLayout::Humble), jazzy = detector_->peers(RangeLayout::Jazzy);
+    if (!humble && !jazzy)
+        return; // the last peer left: what it spoke stays until another says otherwise
+    const RangeLayout before = distro_.layout;
+    const auto count = [](unsigned n) { return std::to_string(n) + (n == 1 ? " participant" : " participants"); };
+    if (!humble || !jazzy) {
+        distro_.layout = humble ? RangeLayout::Humble : RangeLayout::Jazzy;
+        distro_.why = "the peers' ros_discovery_info: " + count(humble + jazzy) + ", all " +
+                      std::string(name_of(distro_.layout));
+    } else {
+        // Both: the distro of more peers (on a tie, the one spoken already: no flapping). The
+        // others cannot read Range nor list this node: a setting to make (range_layout).
+        if (humble != jazzy)
+            distro_.layout = humble > jazzy ? RangeLayout::Humble : RangeLayout::Jazzy;
+        distro_.why = "peers of both distros (humble " + count(humble) + ", jazzy " + count(jazzy) + "): " +
+                      std::string(name_of(distro_.layout)) + (humble != jazzy ? ", the more" : ", spoken already") +
+                      "; the others cannot read Range or list this node (set range_layout to choose)";
+    }
+    std::fprintf(stderr, "caracara-ros: speaking %s: %s\n", std::string(name_of(distro_.layout)).c_str(),
+                 distro_.why.c_str());
+    mark(kDiagnostics);
+    if (distro_.layout == before)
+        return;
+    // ros_discovery_info's Gid and Range's layout from now on: the Range writers made anew.
+    dds_.discovery_info().set_layout(distro_.layout);
+    for (const dds_entity_t w : ranges_)
+        dds_.delete_writer(w);
+    ranges_.clear();
+    mark(kRanges);
 }
 
 void TelemetryPublisher::write_static_frames() {
@@ -389,6 +424,8 @@ std::vector<uint8_t> TelemetryPublisher::levels() const {
     // The ROS commands: WARN while a refusal is recent, so a monitor shows it, then OK again.
     const uint64_t last = commands_.last_refusal_ns();
     out.push_back(last && monotonic_ns() < last + kRefusalWarnNs ? 1 : 0);
+    // The distro: WARN while peers of both are about (some of them cannot read what is sent).
+    out.push_back(detector_ && detector_->peers(RangeLayout::Humble) && detector_->peers(RangeLayout::Jazzy) ? 1 : 0);
     return out;
 }
 
@@ -453,6 +490,11 @@ void TelemetryPublisher::write_diagnostics() {
         cs.values.push_back({"refused " + std::string(n.name), std::to_string(commands_.refusals(n.value))});
     cs.values.push_back({"last refusal", commands_.last_refusal()});
     st.push_back(std::move(cs));
+    const auto peers = [&](RangeLayout d) { return detector_ ? std::to_string(detector_->peers(d)) : std::string("not read"); };
+    st.push_back({lv[kThrusters + 5], "caracara: ros distro", std::string(name_of(distro_.layout)) + ": " + distro_.why,
+                  "caracara-ros",
+                  {{"speaking", std::string(name_of(distro_.layout))}, {"why", distro_.why},
+                   {"humble peers", peers(RangeLayout::Humble)}, {"jazzy peers", peers(RangeLayout::Jazzy)}}});
     std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> kvs(st.size());
     std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_> out;
     for (std::size_t i = 0; i < st.size(); ++i) {

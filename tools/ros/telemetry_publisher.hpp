@@ -12,8 +12,11 @@
 #include "tools/client/object_mirror.hpp"
 #include "tools/ros/command_record.hpp"
 #include "tools/ros/dds_participant.hpp"
+#include "tools/ros/distro_detector.hpp"
+#include "tools/ros/spoken_distro.hpp"
 
 #include <array>
+#include <memory>
 #include <ctime>
 #include <string>
 #include <vector>
@@ -23,8 +26,10 @@ namespace caracara::ros {
 class TelemetryPublisher {
 public:
     // `commands`: the ROS writers' holder and refusals, a status of /diagnostics; its command
-    // timeout is set from the daemon's CommandTimeoutMs.
-    TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config, CommandRecord& commands);
+    // timeout is set from the daemon's CommandTimeoutMs. `distro`: what it speaks; unless the
+    // config names it, chosen here from the peers' ros_discovery_info (and said why).
+    TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config, CommandRecord& commands,
+                       SpokenDistro& distro);
     ~TelemetryPublisher();
     TelemetryPublisher(const TelemetryPublisher&) = delete;
     TelemetryPublisher& operator=(const TelemetryPublisher&) = delete;
@@ -54,12 +59,15 @@ private:
     void write_static_frames();
     void write_state();
     void write_diagnostics();
+    void choose_distro();
     std::vector<uint8_t> levels() const;
 
     sd_event* event_;
     DdsParticipant& dds_;
     const RosConfig& config_;
     CommandRecord& commands_;
+    SpokenDistro& distro_;
+    std::unique_ptr<DistroDetector> detector_; // none when the config names the distro
     // The Imu's and /tf's frame names in the config's convention (headers point into them).
     const std::string world_frame_, body_frame_;
     std::unique_ptr<client::Client> client_;
