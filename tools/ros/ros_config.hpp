@@ -13,8 +13,6 @@
 
 namespace caracara::ros {
 
-enum class RangeLayout { Humble, Jazzy };
-
 // Where a sensor sits on the vehicle, for /tf_static: its frame's name, its position in metres
 // and its orientation in radians (URDF's rpy: roll about x, pitch about y, yaw about z, fixed
 // axes) in the base frame, REP 103's body FLU (x forward, y left, z up).

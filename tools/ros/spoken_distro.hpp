@@ -3,7 +3,6 @@
 // says (DistroDetector), chosen by the TelemetryPublisher; read where a Gid is written or printed.
 #pragma once
 
-#include "core/enum_names.hpp"
 #include "tools/ros/ros_config.hpp"
 
 #include <string>
@@ -19,14 +18,3 @@ struct SpokenDistro {
 
 } // namespace caracara::ros
 
-namespace caracara {
-
-template <>
-struct EnumNames<ros::RangeLayout> {
-    static constexpr std::array<EnumName<ros::RangeLayout>, 2> table{{
-        {ros::RangeLayout::Humble, "humble"},
-        {ros::RangeLayout::Jazzy, "jazzy"},
-    }};
-};
-
-} // namespace caracara
