@@ -74,6 +74,7 @@ constexpr Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("GetDistance", SD_BUS_ARGS("y", sensor), SD_BUS_RESULT("q", millimeters), m_distance,
                                    kUnpriv)),
     property<[](C c) { const auto& o = c.telemetry().orientation; return std::tuple{o[0], o[1], o[2]}; }>("Orientation", kChange, kTick),
+    property<[](C c) { return c.telemetry().orientation_read_ns; }>("OrientationReadNs", kChange, kTick),
     property<[](C c) -> const auto& { return c.telemetry().distances; }>("Distances", kChange, kTick),
     property<[](C c) -> const auto& { return c.telemetry().servos; }>("Servos", kChange, kTick),
     property<[](C c) { return c.telemetry().turning ? "turning" : "idle"; }>("Task", kChange, kTick),

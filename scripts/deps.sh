@@ -13,7 +13,7 @@ if [ "$(. /etc/os-release && echo "${VERSION_CODENAME:-}")" = bookworm ]; then
   fastdds=libfastrtps-dev
 fi
 pkgs=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev "$catch2" libtomlplusplus-dev
-      dbus python3 python3-dbus python3-gi systemd debootstrap systemd-container valgrind stress-ng
+      dbus python3 python3-dbus python3-gi python3-yaml systemd debootstrap systemd-container valgrind stress-ng
       clang libclang-rt-dev python3-matplotlib python3-pil ccache libboost-dev nlohmann-json3-dev openssh-client
       udev)
 # udev: the kernel test applies the shipped udev rules with systemd-udevd (devices_for_the_daemon_alone).

@@ -1,5 +1,7 @@
 #include "daemon/teensy/teensy_poll.hpp"
 
+#include "core/clock.hpp"
+
 #include <cerrno>
 
 namespace caracara {
@@ -25,6 +27,7 @@ void TeensyPoll::ask() {
                 frame_.value = r.value;
             }
             frame_.ok = e == teensy::TeensyError::None;
+            frame_.read_ns = monotonic_ns();
             frame_.err = io_errno_(e);
         },
         [this] { answered(); }, false);
@@ -33,10 +36,12 @@ void TeensyPoll::ask() {
 void TeensyPoll::answered() {
     out_ = false;
     if (frame_.ok) {
-        if (frame_.slot < 3)
-            tm_.orientation[frame_.slot] = frame_.value;
-        else
+        if (frame_.slot >= 3) {
             tm_.distances[frame_.sensor] = static_cast<uint16_t>(frame_.value);
+        } else if (tm_.orientation[frame_.slot] != frame_.value) {
+            tm_.orientation[frame_.slot] = frame_.value;
+            tm_.orientation_read_ns = frame_.read_ns;
+        }
     }
     done_(frame_.ok ? Outcome::Answered : frame_.err == ENODEV ? Outcome::Gone : Outcome::Failed);
 }

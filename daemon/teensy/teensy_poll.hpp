@@ -46,6 +46,7 @@ private:
         unsigned sensor = 0;
         bool ok = false;
         double value = 0;
+        uint64_t read_ns = 0; // when the answer came (CLOCK_MONOTONIC)
         int err = 0;
     } frame_; // the worker's while a frame is out
 };

@@ -10,6 +10,9 @@ namespace caracara {
 struct TeensyTelemetry {
     bool online = false;
     std::array<double, 3> orientation{}; // yaw, pitch, roll
+    // CLOCK_MONOTONIC ns of the reading that last changed `orientation` (0: none yet): what the
+    // announced value is as of, for a client that stamps it (caracara-ros's Imu and /tf).
+    uint64_t orientation_read_ns = 0;
     std::vector<uint16_t> distances;
     std::vector<uint8_t> servos;
     bool turning = false;

@@ -25,13 +25,20 @@ import tempfile
 import time
 import unittest
 
+try:
+    import yaml  # python3-yaml: rosbag2 keeps a topic's QoS as YAML
+except ImportError:
+    yaml = None
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(SOURCE, "tests", "e2e"))
 
 import harness  # noqa: E402
 from harness import missing, npm_ci  # noqa: E402
-from bounds import CLIENT_LOSS_ZERO_MS_MAX, ORIENTATION_TO_JUDGE_MIN_RAD  # noqa: E402
+from bounds import CLIENT_LOSS_ZERO_MS_MAX, ORIENTATION_TO_JUDGE_MIN_RAD, ROS_READING_STAMP_AGE_MS_MAX  # noqa: E402
+from bounds import ROS_SENSOR_RATE_MAX_FRACTION, ROS_SENSOR_RATE_MIN_FRACTION, ROS_SENSOR_RATE_WINDOW_S  # noqa: E402
+from bounds import ROS_TAKEOVER_EARLY_MS_MAX  # noqa: E402
 from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, angle_diff, poll, speed_byte  # noqa: E402
 from test_failsafes import kill_edges, orders  # noqa: E402
 from vehicle_motion import START_HEADING_RAD, judge, place  # noqa: E402
@@ -45,10 +52,14 @@ PUBLISHED = {"rt/caracara/imu": "sensor_msgs/Imu", "rt/caracara/joint_states": "
              "rt/caracara/thrusters/ordered": "sensor_msgs/JointState", "rt/caracara/range/0": "sensor_msgs/Range",
              "rt/diagnostics": "diagnostic_msgs/DiagnosticArray", "rt/caracara/killed": "std_msgs/Bool",
              "rt/caracara/state": "std_msgs/String", "rt/caracara/kill_source": "std_msgs/String",
-             "rt/tf": "tf2_msgs/TFMessage"}
+             "rt/tf": "tf2_msgs/TFMessage", "rt/tf_static": "tf2_msgs/TFMessage"}
+LATCHED = ("killed", "state", "kill_source", "tf_static")  # transient-local, as ROS latches them
 DISCOVERY_INFO = {"ros_discovery_info": "rmw_dds_common/ParticipantEntitiesInfo"}
 GID_BYTES = {"humble": 24, "jazzy": 16}  # rmw_dds_common's Gid: char[24] in Humble, char[16] since Iron
 MOTOR_MAX = 8850
+DAEMON_TELEMETRY_HZ = 5.0  # daemon/control/control_loop.cpp's kTelemetryPeriodNs: [ros] sensor_rate_hz's default
+STEADY_TOPICS = {"rt/caracara/imu": "sensor_msgs/Imu", "rt/tf": "tf2_msgs/TFMessage",
+                 "rt/caracara/joint_states": "sensor_msgs/JointState"}
 
 
 def build_peer(distro):
@@ -216,6 +227,14 @@ def fixed_sample(type_, distro="humble"):
     }[type_]
 
 
+def peer_exited(p, err):
+    """A publishing peer that exited by itself before the test was done with it (no reader matched
+    it in time, say): that, with what it said, is the failure."""
+    if p.poll() is not None:
+        err.seek(0)
+        raise AssertionError("the publishing peer exited with %s: %s" % (p.returncode, err.read().strip()))
+
+
 def nonzero_orders(log):
     """The thruster orders of the log that are not zero."""
     return [e for e, _, speed in orders(log) if speed != ZERO]
@@ -261,6 +280,21 @@ def expected_axes(attitude, convention):
     return (forward[0], forward[1], -forward[2]), (right[0], right[1], -right[2])
 
 
+def sim_attitude(rig):
+    """(CLOCK_REALTIME ns, [yaw, pitch, roll]): the simulator's attitude, timed at the middle of
+    the call that read it (timed before it, a slow reply on the loaded machine made the simulator
+    seem ahead of what it was at that time)."""
+    before = time.time_ns()
+    att = [float(x) for x in rig.sim_teensy("Orientation")]
+    return ((before + time.time_ns()) // 2, att)
+
+
+def stamp_of(topic, m):
+    """A message's header stamp in ns (CLOCK_REALTIME); /tf's of its one transform."""
+    head = m["transforms"][0]["header"] if topic == "rt/tf" else m["header"]
+    return head["stamp"]["sec"] * 10 ** 9 + head["stamp"]["nanosec"]
+
+
 def unwrap(angles):
     out = angles[:1]
     for a in angles[1:]:
@@ -272,6 +306,7 @@ class RosTestCase(VehicleTestCase):
     """One rig, one caracara-ros (commands as COMMANDS says) per class."""
     COMMANDS = False
     DISTRO = "humble"
+    LAYOUT_IN_CONFIG = True  # range_layout = DISTRO; else caracara-ros finds the distro itself
     ROS_CONFIG = ""  # more [ros] lines
     EXTRA_CONFIG = {"failsafe": {"pilot-lost": {"action": "kill", "persistence_ms": 60000}}}
 
@@ -284,8 +319,9 @@ class RosTestCase(VehicleTestCase):
         cls.addClassCleanup(cls.codec.close)
         conf = os.path.join(cls.rig.dir, "ros.toml")
         with open(conf, "w") as f:
-            f.write('[ros]\nnamespace = "/caracara"\ncommands = %s\nrange_layout = "%s"\n%s[network]\ninterface = "lo"\n'
-                    % ("true" if cls.COMMANDS else "false", cls.DISTRO, cls.ROS_CONFIG))
+            f.write('[ros]\nnamespace = "/caracara"\ncommands = %s\n%s%s[network]\ninterface = "lo"\n'
+                    % ("true" if cls.COMMANDS else "false",
+                       'range_layout = "%s"\n' % cls.DISTRO if cls.LAYOUT_IN_CONFIG else "", cls.ROS_CONFIG))
         cls.ros = cls.rig._spawn("caracara-ros", harness.EMULATOR + [
             os.path.join(BUILD_DIR, "tools", "ros", "caracara-ros"), "--bus-address", cls.rig.address, "--config", conf])
         cls.addClassCleanup(cls.stop_ros)
@@ -336,7 +372,8 @@ class RosTestCase(VehicleTestCase):
         """ros_discovery_info as ROS 2's graph cache reads it: the participant's gid is the GUID the
         peer discovered (zeros after it to the distro's Gid size), one node caracara_ros in the
         namespace, and its writer and reader gids exactly the GUIDs of the writers and readers the
-        peer discovered on that participant (the discovery info's own writer is not the node's)."""
+        peer discovered on that participant (the discovery info's own writer and reader are not the
+        node's)."""
         samples, participants, writers, endpoints = self.listen(3, {**PUBLISHED, **DISCOVERY_INFO})
         # By GUID: a participant found again (after a lease lapse under load) is the same one.
         ros = {p["guid"] for p in participants if p["user_data"] == "enclave=/;"}
@@ -347,7 +384,8 @@ class RosTestCase(VehicleTestCase):
         w = writers["ros_discovery_info"]
         self.assertEqual(w["type"], "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_")
         self.assertTrue(w["reliable"] and w["transient_local"] and w["xcdr1"], w)
-        info = samples["ros_discovery_info"][-1][1]
+        # caracara-ros's own (a test's peer may write one too): its gid begins with the GUID.
+        info = [m for _, m in samples["ros_discovery_info"] if bytes(m["gid"]["data"]).hex().startswith(prefix)][-1]
         pad = "00" * (GID_BYTES[self.DISTRO] - 16)
         gid_hex = lambda g: bytes(g["data"]).hex()  # noqa: E731
         self.assertEqual(gid_hex(info["gid"]), guid + pad)
@@ -360,7 +398,8 @@ class RosTestCase(VehicleTestCase):
             self.assertTrue(g.endswith(pad), g)
         ours = {o["guid"]: o for o in endpoints if o["guid"].startswith(prefix)}.values()
         seen_writers = [o["guid"] for o in ours if o.get("writer", "ros_discovery_info") != "ros_discovery_info"]
-        seen_readers = [o for o in ours if "reader" in o]
+        # Nor is the participant's reader of the discovery info (rmw's graph cache has one too).
+        seen_readers = [o for o in ours if o.get("reader", "ros_discovery_info") != "ros_discovery_info"]
         self.assertEqual(sorted(g[:32] for g in listed_writers), sorted(seen_writers))
         self.assertEqual(sorted(g[:32] for g in listed_readers), sorted(o["guid"] for o in seen_readers))
         self.assertEqual(sorted(o["reader"] for o in seen_readers), sorted(reader_topics))
@@ -377,32 +416,45 @@ class RosTestCase(VehicleTestCase):
         return r
 
     @contextlib.contextmanager
-    def driving(self, topic, type_, msg, hz=50):
+    def driving(self, topic, type_, msg, hz=50, short_lease=False, distro=None):
         """The peer publishing `msg` at `hz` (50: as a pilot's stack would) until the block ends,
-        then SIGKILLed: a writer that goes away without a word."""
-        hex_ = self.codec.encode(type_, msg, self.DISTRO)
-        p = subprocess.Popen([self.peer, "publish", topic, type_, hex_, "1000000", str(hz), "hold"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        try:
-            yield p
-        finally:
-            p.send_signal(signal.SIGKILL)
-            p.wait(10)
+        then SIGKILLed: a writer that goes away without a word. short_lease: its participant's
+        lease 100 ms (peer.cpp), for a test that times how soon its death is noticed. distro: the
+        peer built from that distro's definitions (else the class's)."""
+        distro = distro or self.DISTRO
+        hex_ = self.codec.encode(type_, msg, distro)
+        env = dict(os.environ, PEER_SHORT_LEASE="1" if short_lease else "0")
+        with tempfile.TemporaryFile("w+") as err:
+            p = subprocess.Popen([build_peer(distro), "publish", topic, type_, hex_, "1000000", str(hz), "hold"],
+                                 stdout=subprocess.DEVNULL, stderr=err, text=True, env=env)
+            try:
+                yield p
+            except Exception:
+                peer_exited(p, err)
+                raise
+            finally:
+                p.send_signal(signal.SIGKILL)
+                p.wait(10)
 
     @contextlib.contextmanager
     def steering(self, topic, type_, msg, hz=50):
         """The peer publishing `msg` at `hz` until the block ends, as a pilot's stack would;
-        send(m) makes it publish m from then on (one writer throughout). At the end it leaves in
-        good order."""
+        send(m) makes it publish m from then on (one writer throughout); send("stop") stops it
+        sending, its writer still there. At the end it leaves in good order."""
+        err = tempfile.TemporaryFile("w+")
+        self.addCleanup(err.close)
         p = subprocess.Popen([self.peer, "publish", topic, type_, self.codec.encode(type_, msg, self.DISTRO), "1",
                               str(hz), "stdin"], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
-                             stderr=subprocess.DEVNULL, text=True)
+                             stderr=err, text=True)
 
-        def send(m):
-            p.stdin.write(self.codec.encode(type_, m, self.DISTRO) + "\n")
+        def send(m):  # "stop": the writer stops sending and stays
+            p.stdin.write((m if m == "stop" else self.codec.encode(type_, m, self.DISTRO)) + "\n")
             p.stdin.flush()
         try:
             yield send
+        except Exception:
+            peer_exited(p, err)
+            raise
         finally:
             p.stdin.close()
             try:
@@ -419,16 +471,22 @@ class RosTestCase(VehicleTestCase):
         self.assertIn("rt/caracara/imu", samples, "no Imu received")
         self.assertEqual("rt/tf" in samples, publish_tf)
         self.assertGreater(len(attitude), 10)
+        unjudged = {}
         for topic, msgs in samples.items():
             for _, m in msgs:
                 if topic == "rt/tf":
                     tf = m["transforms"][0]
                     self.assertEqual((tf["header"]["frame_id"], tf["child_frame_id"]), (world, body))
-                    head, q = tf["header"], tf["transform"]["rotation"]
+                    q = tf["transform"]["rotation"]
                 else:
                     self.assertEqual(m["header"]["frame_id"], body)
-                    head, q = m["header"], m["orientation"]
-                stamp = head["stamp"]["sec"] * 10 ** 9 + head["stamp"]["nanosec"]
+                    q = m["orientation"]
+                stamp = stamp_of(topic, m)
+                if stamp + 50e6 < attitude[0][0]:
+                    # A reading from before the record began (the first message of a steady
+                    # stream may carry the reading of up to a second ago): nothing to judge it by.
+                    unjudged[topic] = unjudged.get(topic, 0) + 1
+                    continue
                 near = [a for t, a in attitude if -200e6 <= t - stamp <= 50e6] or \
                     [min(attitude, key=lambda a: abs(a[0] - stamp))[1]]
                 got = rotate(q, (1, 0, 0)), rotate(q, (0, 1, 0))
@@ -437,8 +495,14 @@ class RosTestCase(VehicleTestCase):
                     want = expected_axes(att, convention)
                     return max(abs(got[axis][k] - want[axis][k]) for axis in range(2) for k in range(3))
                 att = min(near, key=error)
-                self.assertLessEqual(error(att), delta, "%s: body axes x, y in %s: got %s, the simulator's %s gives %s"
-                                     % (topic, world, got, att, expected_axes(att, convention)))
+                if error(att) > delta:
+                    best_t, best = min(attitude, key=lambda a: error(a[1]))
+                    self.fail("%s: body axes x, y in %s: got %s, the simulator's %s gives %s (error %.3f); the best "
+                              "match of the whole record, %s (error %.3f), was %.0f ms from the stamp"
+                              % (topic, world, got, att, expected_axes(att, convention), error(att), best,
+                                 error(best), (best_t - stamp) / 1e6))
+        for topic, n in unjudged.items():
+            self.assertLessEqual(n, 2, "%s: %d of %d messages stamped before the record began" % (topic, n, len(samples[topic])))
 
     def hold_motion(self, seconds, **axes):
         """SetMotion(axes) over D-Bus, renewed within the command timeout, for `seconds`."""
@@ -446,6 +510,47 @@ class RosTestCase(VehicleTestCase):
         while time.monotonic() < end:
             self.rig.motion(**axes)
             time.sleep(0.1)
+
+    def check_steady_rates(self, rate_hz, topics=STEADY_TOPICS):
+        """A late subscriber on a still vehicle (placed at rest, no thrust: nothing changes, so
+        caracarad announces only its counters, once a second) gets each of `topics` at `rate_hz`,
+        each message stamped with the time of the reading it carries: at or before its arrival and
+        at most ROS_READING_STAMP_AGE_MS_MAX older, never going back, and the same reading sent
+        again carries the same stamp (so fewer stamps than messages: not the time of sending)."""
+        rig = self.rig
+        rig.reset()
+        time.sleep(1.0)  # an earlier test's thrust fully died away: placed, the vehicle stays
+        self.place_and_wait(0.4)
+        time.sleep(1.5)  # this subscriber joins long after the values last changed
+        realtime_minus_monotonic = time.time_ns() - time.monotonic_ns()
+        # Counted from 2.5 s after the first message: the first one or two come as the peer's
+        # readers match, then there may be a gap before the stream runs (1 s at 5 Hz and 2.4 s once
+        # with the listening peer's old 100 ms lease; 0.2 s with its 2 s one); from then on the rate.
+        samples, _, _, _ = self.listen(ROS_SENSOR_RATE_WINDOW_S + 3.5, topics)
+        expected = rate_hz * ROS_SENSOR_RATE_WINDOW_S
+        for topic in topics:
+            with self.subTest(topic=topic):
+                got = samples.get(topic, [])
+                self.assertTrue(got, "nothing on " + topic)
+                start = got[0][0] + 2.5e9
+                startup_gap_ms = max((b[0] - a[0]) / 1e6 for a, b in zip(got, got[1:]) if a[0] < start)
+                got = [(t, m) for t, m in got if start <= t < start + ROS_SENSOR_RATE_WINDOW_S * 10 ** 9]
+                stamps = []
+                for t_ns, m in got:
+                    stamp = stamp_of(topic, m)
+                    age_ms = (t_ns + realtime_minus_monotonic - stamp) / 1e6
+                    self.assertGreaterEqual(age_ms, 0, "%s stamped after it arrived" % topic)
+                    self.assertLessEqual(age_ms, ROS_READING_STAMP_AGE_MS_MAX, "%s: a stamp %.0f ms old" % (topic, age_ms))
+                    stamps.append(stamp)
+                print("%s: %d messages in %.1f s on a still vehicle (%.1f Hz configured), %d distinct stamps; "
+                      "before the window the longest gap %.0f ms" % (topic, len(got), ROS_SENSOR_RATE_WINDOW_S, rate_hz,
+                                                                    len(set(stamps)), startup_gap_ms), file=sys.stderr)
+                self.assertGreaterEqual(len(got), ROS_SENSOR_RATE_MIN_FRACTION * expected)
+                self.assertLessEqual(len(got), ROS_SENSOR_RATE_MAX_FRACTION * expected)
+                self.assertEqual(stamps, sorted(stamps), "stamps went back")
+                self.assertLess(len(set(stamps)), len(stamps), "every message stamped anew: the time of sending")
+        # The vehicle was still: the counts are the rate's, not the changes'.
+        self.assertLess(abs(angle_diff(float(rig.sim_teensy("Orientation")[0]), 0.4)), 0.002, "the vehicle turned")
 
     def place_and_wait(self, heading):
         """The simulated vehicle placed (vehicle_motion.place), and caracarad's Teensy reading it:
@@ -469,7 +574,7 @@ class RosTestCase(VehicleTestCase):
             if time.monotonic() - last[0] > 0.1:
                 rig.motion(**axes)
                 last[0] = time.monotonic()
-            attitude.append((time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")]))
+            attitude.append(sim_attitude(rig))
         try:
             samples, _, _, _ = self.listen(2, ORIENTATION_TOPICS, during=lambda: during(pitch=0.5, roll=0.5))
         finally:
@@ -480,6 +585,9 @@ class RosTestCase(VehicleTestCase):
         # A clockwise turn (the seed's yaw, + clockwise seen from above).
         rig.reset()
         self.place_and_wait(0.3)
+        # A whole poll round (yaw, pitch, roll, a distance: one a cycle) and a telemetry tick: the
+        # reading now held is all of the placed vehicle, not the heading alone.
+        time.sleep(0.3)
         attitude.clear()
         try:
             samples, _, _, _ = self.listen(2.5, ORIENTATION_TOPICS, during=lambda: during(yaw=0.5))
@@ -491,12 +599,22 @@ class RosTestCase(VehicleTestCase):
         self.check_orientation(samples, attitude, convention, world, body, delta=0.05)
         sign = -1 if convention == "enu" else 1
         for topic in ORIENTATION_TOPICS:
+            # The turn's readings: not one from before the record began (check_orientation).
+            msgs = [m for _, m in samples[topic] if stamp_of(topic, m) + 50e6 >= attitude[0][0]]
             qs = [m["orientation"] if topic == "rt/caracara/imu" else m["transforms"][0]["transform"]["rotation"]
-                  for _, m in samples[topic]]
+                  for m in msgs]
             yaws = unwrap([quaternion_yaw(q) for q in qs])
+            # The simulator's turn between the first and the last message's stamps: the messages
+            # come only once the peer's readers matched (late, under load), so they span less of
+            # the turn than the whole record does.
+            at = lambda stamp: min(attitude, key=lambda a: abs(a[0] - stamp))[1][0]  # noqa: E731
+            span = angle_diff(at(stamp_of(topic, msgs[-1])), at(stamp_of(topic, msgs[0])))
             with self.subTest(topic=topic):
-                self.assertGreater(sign * (yaws[-1] - yaws[0]), 0.4,
-                                   "a clockwise turn of %.2f rad read as yaw %+.2f rad" % (turned, yaws[-1] - yaws[0]))
+                self.assertGreater(span, ORIENTATION_TO_JUDGE_MIN_RAD, "the messages span too little of the turn")
+                # Each reading matched the simulator within 0.05 (check_orientation): their turn, twice that.
+                self.assertAlmostEqual(sign * (yaws[-1] - yaws[0]), span, delta=0.1,
+                                       msg="a clockwise turn of %.2f rad (%.2f between the first and last message) "
+                                       "read as yaw %+.2f rad" % (turned, span, yaws[-1] - yaws[0]))
                 steps = [sign * (b - a) for a, b in zip(yaws, yaws[1:])]
                 self.assertGreater(min(steps), -0.02, "yaw went the other way during the turn: %s" % steps)
 
@@ -655,10 +773,22 @@ class BytesTest(unittest.TestCase):
                 codec.close()
 
 
+# rosbag2_storage's QoS profile (rosbag2_storage/src/rosbag2_storage/qos.cpp, the YAML it reads back
+# from a channel's offered_qos_profiles): its field names, and rmw's policy numbers where a bag
+# without serialized_metadata is read as version 8 (Humble reads numbers too).
+ROSBAG2_QOS_KEYS = {"history", "depth", "reliability", "durability", "deadline", "lifespan", "liveliness",
+                    "liveliness_lease_duration", "avoid_ros_namespace_conventions"}
+RMW_KEEP_LAST, RMW_RELIABLE, RMW_TRANSIENT_LOCAL, RMW_VOLATILE, RMW_LIVELINESS_AUTOMATIC = 1, 1, 1, 2, 1
+LATCHED_TOPICS = ("/caracara/state", "/caracara/killed", "/caracara/kill_source")
+
+
 class DiveExportTest(unittest.TestCase):
     """caracaractl export --format mcap --encoding cdr on the regression dives (tests/dives): read
     as rosbag2 would (mcap_ros_check.mjs: @mcap/core, ros2msg schemas, every message decoded by
-    rosmsg2-serialization and written back to the same bytes), judged against the dive's CSV."""
+    rosmsg2-serialization and written back to the same bytes), judged against the dive's CSV; each
+    channel's offered_qos_profiles parsed as YAML against rosbag2's field names (the state topics
+    transient-local, so they replay latched), the "rosbag2" record's ROS_DISTRO; with --distro
+    jazzy, Range in Jazzy's layout."""
 
     def test_regression_dives(self):
         npm_ci(HERE)
@@ -678,8 +808,41 @@ class DiveExportTest(unittest.TestCase):
                                            text=True)
                     self.assertEqual(check.returncode, 0, check.stderr)
                     self.judge(json.loads(check.stdout), path, ctl)
+            # Jazzy's: the same topics, Range with its variance, ROS_DISTRO jazzy.
+            path, out = os.path.join(dives, names[0]), os.path.join(d, "jazzy.mcap")
+            r = subprocess.run(ctl + ["export", path, "--format", "mcap", "--encoding", "cdr", "--distro", "jazzy",
+                                      "--out", out], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            check = subprocess.run(["node", "mcap_ros_check.mjs", out], cwd=HERE, capture_output=True, text=True)
+            self.assertEqual(check.returncode, 0, check.stderr)
+            self.judge(json.loads(check.stdout), path, ctl, distro="jazzy")
+            r = subprocess.run(ctl + ["export", path, "--format", "mcap", "--encoding", "cdr", "--distro", "iron",
+                                      "--out", out], capture_output=True, text=True)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("--distro takes humble or jazzy, not 'iron'", r.stderr)
 
-    def judge(self, bag, path, ctl):
+    def judge_replay(self, bag, distro):
+        """What `ros2 bag play` offers each topic with, and what `ros2 bag info` names the distro."""
+        if yaml is None:
+            missing("python3-yaml is needed to read the bag's QoS profiles as rosbag2 does (scripts/deps.sh)")
+        self.assertEqual(bag["records"], [{"name": "rosbag2", "metadata": {"ROS_DISTRO": distro}}])
+        for topic, t in bag["topics"].items():
+            with self.subTest(topic=topic):
+                profiles = yaml.safe_load(t["metadata"]["offered_qos_profiles"])
+                self.assertEqual(len(profiles), 1, profiles)
+                p = profiles[0]
+                self.assertEqual(set(p), ROSBAG2_QOS_KEYS)
+                latched = topic in LATCHED_TOPICS
+                self.assertEqual((p["history"], p["depth"], p["reliability"], p["durability"], p["liveliness"]),
+                                 (RMW_KEEP_LAST, 1 if latched else 10, RMW_RELIABLE,
+                                  RMW_TRANSIENT_LOCAL if latched else RMW_VOLATILE, RMW_LIVELINESS_AUTOMATIC))
+                for k in ("deadline", "lifespan", "liveliness_lease_duration"):
+                    self.assertEqual(p[k], {"sec": 0, "nsec": 0})
+                self.assertIs(p["avoid_ros_namespace_conventions"], False)
+        self.assertLessEqual(set(LATCHED_TOPICS), set(bag["topics"]))
+
+    def judge(self, bag, path, ctl, distro="humble"):
+        self.judge_replay(bag, distro)
         csv = subprocess.run(ctl + ["export", path], capture_output=True, text=True, check=True).stdout.splitlines()
         cols = csv[0].split(",")
         rows = [dict(zip(cols, line.split(","))) for line in csv[1:]]
@@ -715,7 +878,9 @@ class DiveExportTest(unittest.TestCase):
             self.assertEqual(tf["transform"]["rotation"], q)
             distances = row["distances_mm"].split()
             for k, mm in enumerate(distances):
-                self.assertAlmostEqual(msgs["/caracara/range/%d" % k][n]["range"], int(mm) / 1000, places=4)
+                r = msgs["/caracara/range/%d" % k][n]
+                self.assertAlmostEqual(r["range"], int(mm) / 1000, places=4)
+                self.assertEqual("variance" in r, distro == "jazzy")
         states = [e.split(",")[2].split()[0] for e in events if e.split(",")[1] == "state"]
         got = [m["data"] for m in msgs["/caracara/state"]]
         # The first state message is the dive's start (arming); each change after it follows the events.
@@ -737,7 +902,7 @@ class PublishedTest(RosTestCase):
                 self.assertEqual(w["type"], "%s::msg::dds_::%s_" % (pkg, name))
                 self.assertTrue(w["reliable"])
                 self.assertTrue(w["xcdr1"])
-                self.assertEqual(w["transient_local"], topic.split("/")[-1] in ("killed", "state", "kill_source"))
+                self.assertEqual(w["transient_local"], topic.split("/")[-1] in LATCHED)
 
     def test_discovery_info_lists_the_node(self):
         """`ros2 node list` / `ros2 node info` see caracara_ros with its topics (Humble's 24-byte gid)."""
@@ -752,8 +917,7 @@ class PublishedTest(RosTestCase):
         # The simulator's attitude through the window (the body turns under this thrust), to
         # compare each Imu sample with the simulator's attitude at its stamp.
         attitude = []
-        samples, _, _, _ = self.listen(3, during=lambda: attitude.append(
-            (time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")])))
+        samples, _, _, _ = self.listen(3, during=lambda: attitude.append(sim_attitude(rig)))
         for topic in PUBLISHED:
             self.assertIn(topic, samples, "nothing received on " + topic)
         last = {t: s[-1][1] for t, s in samples.items()}
@@ -782,10 +946,14 @@ class PublishedTest(RosTestCase):
         for n in ["caracara: thruster_%d" % i for i in range(MOTORS)] + ["caracara: i2c bus", "caracara: teensy",
                                                                          "caracara: failsafes", "caracara: vehicle"]:
             self.assertIn(n, names)
-        # Rates follow the daemon's announcements: joint_states comes with the thrusters' telemetry
-        # (at most 5 Hz, one message a batch, and only when a reading changed: 10 in the 3 s on a
-        # loaded CI machine), not only with changes of state.
+        # joint_states comes at the steady sensor rate (5 Hz: test_steady_rates_on_a_still_vehicle
+        # counts it), not only with changes of state.
         self.assertGreaterEqual(len(samples["rt/caracara/joint_states"]), 5)
+
+    def test_steady_rates_on_a_still_vehicle(self):
+        """imu, /tf and joint_states at the daemon's telemetry rate (the default) to a late subscriber,
+        though nothing changes."""
+        self.check_steady_rates(DAEMON_TELEMETRY_HZ)
 
     def test_orientation_in_enu_flu(self):
         """REP 103 / 145: base_link (x forward, y left, z up) in odom (x east, y north, z up), the
@@ -838,13 +1006,79 @@ class JazzyRangeTest(RosTestCase):
         self.check_discovery_info(["rt/caracara/kill"])
 
 
+def distro_status(samples):
+    """The last /diagnostics' "caracara: ros distro" status, its values as a dict."""
+    msgs = samples.get("rt/diagnostics")
+    assert msgs, "no /diagnostics received"
+    st = [s for s in msgs[-1][1]["status"] if s["name"] == "caracara: ros distro"]
+    assert len(st) == 1, [s["name"] for s in msgs[-1][1]["status"]]
+    return {**st[0], "values": {kv["key"]: kv["value"] for kv in st[0]["values"]}}
+
+
+class AutoDistroTest(RosTestCase):
+    """No range_layout in the config: caracara-ros speaks what the ROS 2 machines around speak, read
+    from their ros_discovery_info (Jazzy's 16-byte Gid or Humble's 24, told apart by size). A
+    Jazzy node appears (the peer built from Jazzy's definitions writes its ParticipantEntitiesInfo,
+    transient-local as rmw does): Range and caracara-ros's own ros_discovery_info turn to Jazzy's
+    layouts, read by that peer. A Humble node joins: both are about, caracara-ros keeps Jazzy (a
+    tie keeps what it speaks) and says so in the journal and on /diagnostics (WARN)."""
+    DISTRO = "jazzy"
+    LAYOUT_IN_CONFIG = False
+    DIAGNOSTICS = {"rt/diagnostics": "diagnostic_msgs/DiagnosticArray"}
+
+    def ros_node(self, distro, name):
+        """A peer built from `distro`'s definitions writing a ROS 2 node's ros_discovery_info in
+        that distro's layout (2 Hz) until the block ends."""
+        gid = {"data": list(range(0x40, 0x50)) + [0] * (GID_BYTES[distro] - 16)}
+        msg = {"gid": gid, "node_entities_info_seq": [{"node_namespace": "/", "node_name": name,
+                                                       "reader_gid_seq": [gid], "writer_gid_seq": []}]}
+        return self.driving("ros_discovery_info", "rmw_dds_common/ParticipantEntitiesInfo", msg, hz=2, distro=distro)
+
+    def test_speaks_what_the_peers_speak(self):
+        rig = self.rig
+        status = distro_status(self.listen(2.5, self.DIAGNOSTICS)[0])
+        self.assertEqual((status["values"]["speaking"], status["level"]), ("humble", 0), status)
+        self.assertIn("no ROS 2 peer seen yet", status["message"])
+        log_start = len(rig.log("caracara-ros"))
+        with self.ros_node("jazzy", "talker"):
+            poll(lambda: "speaking jazzy" in rig.log("caracara-ros")[log_start:], 20,
+                 message="caracara-ros never turned to Jazzy")
+            self.assertIn("speaking jazzy: the peers' ros_discovery_info: 1 participant, all jazzy",
+                          rig.log("caracara-ros"))
+            # Range in Jazzy's layout, read by the peer built from Jazzy's definitions.
+            samples, _, _, _ = self.listen(2.5, {"rt/caracara/range/0": "sensor_msgs/Range", **self.DIAGNOSTICS})
+            r = samples["rt/caracara/range/0"][-1][1]
+            self.assertEqual(r["variance"], 0.0)
+            self.assertAlmostEqual(r["range"], int(rig.sim_teensy("Distances")[0]) / 1000, delta=0.002)
+            status = distro_status(samples)
+            self.assertEqual((status["values"]["speaking"], status["values"]["jazzy peers"], status["level"]),
+                             ("jazzy", "1", 0), status)
+            # caracara-ros's own ros_discovery_info with Jazzy's 16-byte gids, its Range writers
+            # those listed (the Humble-layout ones are gone).
+            self.check_discovery_info(["rt/caracara/kill"])
+            log_start = len(rig.log("caracara-ros"))
+            with self.ros_node("humble", "listener"):
+                poll(lambda: "peers of both distros" in rig.log("caracara-ros")[log_start:], 20,
+                     message="caracara-ros never said it found both distros")
+                self.assertIn("speaking jazzy: peers of both distros (humble 1 participant, jazzy 1 participant): "
+                              "jazzy, spoken already", rig.log("caracara-ros"))
+                status = distro_status(self.listen(2.5, self.DIAGNOSTICS)[0])
+                self.assertEqual((status["values"]["speaking"], status["values"]["humble peers"],
+                                  status["values"]["jazzy peers"], status["level"]), ("jazzy", "1", "1", 1), status)
+                self.assertIn("set range_layout to choose", status["message"])
+
+
 class NedFrdTest(RosTestCase):
     """frame_convention = "ned": base_link_frd (x forward, y right, z down) in odom_ned (x north,
     y east, z down); a clockwise turn reads as yaw increasing."""
-    ROS_CONFIG = 'frame_convention = "ned"\n'
+    ROS_CONFIG = 'frame_convention = "ned"\nsensor_rate_hz = 10\n'
 
     def test_orientation_in_ned_frd(self):
         self.check_attitude_and_turn("ned", "odom_ned", "base_link_frd")
+
+    def test_configured_sensor_rate(self):
+        """[ros] sensor_rate_hz = 10: imu, /tf and joint_states at 10 Hz on a still vehicle."""
+        self.check_steady_rates(10.0)
 
 
 class NoOdomTfTest(RosTestCase):
@@ -861,7 +1095,7 @@ class NoOdomTfTest(RosTestCase):
             if time.monotonic() - last[0] > 0.1:
                 rig.motion(yaw=0.3)
                 last[0] = time.monotonic()
-            attitude.append((time.time_ns(), [float(x) for x in rig.sim_teensy("Orientation")]))
+            attitude.append(sim_attitude(rig))
         try:
             samples, _, writers, _ = self.listen(2, {"rt/caracara/imu": "sensor_msgs/Imu"}, during=turning)
         finally:
@@ -872,8 +1106,155 @@ class NoOdomTfTest(RosTestCase):
         self.check_orientation(samples, attitude, "enu", "odom", "base_link", publish_tf=False, delta=0.05)
 
 
+def quaternion_from_rpy(roll, pitch, yaw):
+    """URDF's rpy (fixed axes x, y, z) as a quaternion, the test's own: q = qz(yaw) qy(pitch) qx(roll)."""
+    def mul(a, b):
+        ax, ay, az, aw = a
+        bx, by, bz, bw = b
+        return (aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz)
+    qx = (math.sin(roll / 2), 0, 0, math.cos(roll / 2))
+    qy = (0, math.sin(pitch / 2), 0, math.cos(pitch / 2))
+    qz = (0, 0, math.sin(yaw / 2), math.cos(yaw / 2))
+    x, y, z, w = mul(qz, mul(qy, qx))
+    return {"x": x, "y": y, "z": z, "w": w}
+
+
+def ros_gid(guid_hex, distro):
+    """A 16-byte DDS GUID (32 hex digits) as `ros2 topic info -v` prints the GID (rclpy: each byte
+    as two hex digits, dotted), zero-padded to the distro's Gid size."""
+    data = bytes.fromhex(guid_hex) + bytes(GID_BYTES[distro] - 16)
+    return ".".join("%02x" % b for b in data)
+
+
+def commands_status(samples):
+    """The last /diagnostics' "caracara: ros commands" status, its values as a dict."""
+    msgs = samples.get("rt/diagnostics")  # once a second: a listen of 2.5 s or more gets one
+    assert msgs, "no /diagnostics received"
+    return commands_status_of(msgs[-1][1])
+
+
+def commands_status_of(msg):
+    st = [s for s in msg["status"] if s["name"] == "caracara: ros commands"]
+    assert len(st) == 1, [s["name"] for s in msg["status"]]
+    return {**st[0], "values": {kv["key"]: kv["value"] for kv in st[0]["values"]}}
+
+
+class OneWriterTest(RosTestCase):
+    """One commanding writer: the first writer of cmd_wrench / cmd_thrust that commands holds the
+    vehicle until it stops for the command timeout (the vehicle's, 500 ms here) or leaves; a second
+    writer's samples are refused by name, move nothing (the simulator's wire log), are logged with
+    its GID as `ros2 topic info -v` prints it and counted on /diagnostics, which name the holder."""
+    COMMANDS = True
+    CONTROL = {"arming_delay_ms": 300, "command_timeout_ms": 500}
+    DIAGNOSTICS = {"rt/diagnostics": "diagnostic_msgs/DiagnosticArray"}
+
+    def test_second_writer_refused_until_the_first_stops(self):
+        rig = self.rig
+        rig.rearm()
+        timeout_s = int(rig.vget("CommandTimeoutMs")) / 1000
+        thrust = lambda d: {"layout": {"dim": [], "data_offset": 0}, "data": d}  # noqa: E731
+        first, second = [0.3, 0.3] + [0] * 6, [0] * 6 + [0.4, 0.4]  # different thrusters each
+        speeds = lambda d: [speed_byte(round(v * MOTOR_MAX)) for v in d]  # noqa: E731
+        with self.steering("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray", thrust(first)) as send_first:
+            rig.wait_sim_speeds(speeds(first))
+            # The first writer's GUID as the peer discovered it: the one cmd_thrust writer so far.
+            samples, _, writers, _ = self.listen(2.5, self.DIAGNOSTICS)
+            first_guid = writers["rt/caracara/cmd_thrust"]["guid"]
+            first_gid = ros_gid(first_guid, self.DISTRO)
+            status = commands_status(samples)
+            self.assertEqual(status["values"]["holder"], first_gid)
+            self.assertEqual(status["message"], "held by writer " + first_gid)
+            since = rig.wire_next()
+            log_start = len(rig.log("caracara-ros"))
+            with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray", thrust(second)):
+                try:
+                    poll(lambda: "(not-holder)" in rig.log("caracara-ros")[log_start:], 20)
+                except harness.Timeout:
+                    self.fail("the second writer was never refused; caracara-ros's log since it began:\n" +
+                              rig.log("caracara-ros")[log_start:])
+                samples, _, _, endpoints = self.listen(3.5, self.DIAGNOSTICS)
+                # Nothing of the second writer's moved: the wire carried the first's orders only.
+                log = rig.wire_log(since)[1]
+                self.assertEqual([(i, sp) for e, i, sp in orders(log) if i >= 2 and sp != ZERO], [])
+                self.assertEqual({sp for e, i, sp in orders(log) if i < 2}, set(speeds(first)[:2]))
+                self.assertEqual(rig.motor_values(), [round(v * MOTOR_MAX) for v in first])
+                second_guids = {o["guid"] for o in endpoints if o.get("writer") == "rt/caracara/cmd_thrust"} - {first_guid}
+                self.assertEqual(len(second_guids), 1, endpoints)
+                second_gid = ros_gid(second_guids.pop(), self.DISTRO)
+                # Refused by name, logged with its GID, the holder named.
+                self.assertIn("cmd_thrust from writer %s refused (not-holder): the vehicle is held by writer %s"
+                              % (second_gid, first_gid), rig.log("caracara-ros"))
+                # On /diagnostics: the holder, the refusals counted and growing, message by message
+                # (a refusal is there within a second: the diagnostics come at 1 Hz), the last named.
+                counts = []
+                for t_ns, m in samples["rt/diagnostics"]:
+                    st = commands_status_of(m)
+                    self.assertEqual(st["values"]["holder"], first_gid)
+                    self.assertEqual(st["level"], 1, "a recent refusal is a WARN")
+                    counts.append((t_ns, int(st["values"]["refused not-holder"])))
+                self.assertGreaterEqual(len(counts), 2, counts)
+                for (t0, c0), (t1, c1) in zip(counts, counts[1:]):
+                    self.assertLessEqual(t1 - t0, 1.5e9, "diagnostics more than a second apart")
+                    self.assertGreater(c1, c0, "refusals not counted on /diagnostics as they came: %s" % counts)
+                self.assertIn("not-holder from writer " + second_gid, st["values"]["last refusal"])
+                # The first stops (its writer stays): past the command timeout the second takes over.
+                send_first("stop")
+                stopped = time.monotonic()
+                rig.wait_sim_speeds(speeds(second), 20)
+                took_s = time.monotonic() - stopped
+                print("first writer stopped -> second writer's thrust on the thrusters: %.2f s (command timeout %.1f s)"
+                      % (took_s, timeout_s), file=sys.stderr)
+                # Not before the timeout ran out from the first writer's last sample, which went out
+                # up to one of its 50 Hz periods before "stop" reached it (0.49 s once, in a whole run).
+                self.assertGreaterEqual(took_s * 1000, timeout_s * 1000 - ROS_TAKEOVER_EARLY_MS_MAX)
+                self.assertIn("writer %s holds the vehicle" % second_gid, rig.log("caracara-ros"))
+                status = commands_status(self.listen(2.5, self.DIAGNOSTICS)[0])
+                self.assertEqual(status["values"]["holder"], second_gid)
+        rig.wait_sim_zero()
+
+
+class StaticFramesTest(RosTestCase):
+    """/tf_static as tf2's static broadcaster sends it (transient-local, one TFMessage holding every
+    static transform): the IMU's and each distance sensor's mount from the config, in base_link
+    (REP 103 body FLU); each Range in its own frame."""
+    MOUNTS = {"imu_link": ((0.12, -0.05, 0.03), (0.0, 0.0, math.pi / 2)),
+              "sonar_front": ((0.45, 0.0, -0.1), (0.0, 0.2, 0.0))}
+    ROS_CONFIG = ('[ros.imu]\nframe = "imu_link"\nxyz = [0.12, -0.05, 0.03]\nrpy = [0.0, 0.0, %r]\n'
+                  '[[ros.range]]\nframe = "sonar_front"\nxyz = [0.45, 0.0, -0.1]\nrpy = [0.0, 0.2, 0.0]\n' % (math.pi / 2))
+
+    def test_late_subscriber_gets_the_mounts(self):
+        time.sleep(1.0)  # joins late: caracara-ros sent /tf_static long before
+        samples, _, writers, _ = self.listen(2, {"rt/tf_static": "tf2_msgs/TFMessage",
+                                                 "rt/caracara/range/0": "sensor_msgs/Range"})
+        w = writers["rt/tf_static"]
+        self.assertTrue(w["reliable"] and w["transient_local"], w)
+        # Keep-last 1: the one (last) message, holding every static transform.
+        self.assertEqual(len(samples.get("rt/tf_static", [])), 1, samples.get("rt/tf_static"))
+        transforms = {t["child_frame_id"]: t for t in samples["rt/tf_static"][0][1]["transforms"]}
+        distances = len(self.rig.sim_teensy("Distances"))
+        # The config's two, and range_N for each distance sensor beyond the config's one.
+        self.assertEqual(set(transforms), set(self.MOUNTS) | {"range_%d" % i for i in range(1, distances)})
+        for frame, t in transforms.items():
+            with self.subTest(frame=frame):
+                xyz, rpy = self.MOUNTS.get(frame, ((0, 0, 0), (0, 0, 0)))
+                self.assertEqual(t["header"]["frame_id"], "base_link")
+                tr, q = t["transform"]["translation"], t["transform"]["rotation"]
+                for k, axis in enumerate("xyz"):
+                    self.assertAlmostEqual(tr[axis], xyz[k], places=9)
+                want = quaternion_from_rpy(*rpy)
+                for c in "xyzw":
+                    self.assertAlmostEqual(q[c], want[c], places=9)
+        # The IMU turned a quarter left (yaw pi/2): its x axis is base_link's left (+y).
+        imu_x = rotate(transforms["imu_link"]["transform"]["rotation"], (1, 0, 0))
+        for got, want in zip(imu_x, (0, 1, 0)):
+            self.assertAlmostEqual(got, want, places=6)
+        # The Range is in its sensor's own frame.
+        self.assertEqual(samples["rt/caracara/range/0"][-1][1]["header"]["frame_id"], "sonar_front")
+
+
 class ConfigTest(unittest.TestCase):
-    """The [ros] keys of the frames: a bad value is refused at start, by name, before any DDS."""
+    """The [ros] keys of the frames and rates: a bad value is refused at start, by name, before any DDS."""
 
     def test_bad_frame_options_refused_by_name(self):
         exe = os.path.join(BUILD_DIR, "tools", "ros", "caracara-ros")
@@ -881,7 +1262,20 @@ class ConfigTest(unittest.TestCase):
                  ('frame_convention = 1', 'ros.frame_convention must be "enu" or "ned"'),
                  ('publish_odom_tf = "no"', "ros.publish_odom_tf must be true or false"),
                  ('commands = "true"', "ros.commands must be true or false"),
-                 ('odom_tf = false', "unknown key ros.odom_tf")]
+                 ('odom_tf = false', "unknown key ros.odom_tf"),
+                 ('sensor_rate_hz = 0', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50"),
+                 ('sensor_rate_hz = 51.5', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50"),
+                 ('sensor_rate_hz = "5"', "ros.sensor_rate_hz must be a number of Hz above 0 and at most 50"),
+                 ('[ros.imu]\nxyz = [0.1, 0.2]', "ros.imu.xyz must be 3 numbers, metres from the base frame "
+                  "(x forward, y left, z up), each within 10"),
+                 ('[ros.imu]\nxyz = [0.1, 0.2, 120]', "ros.imu.xyz must be 3 numbers"),
+                 ('[ros.imu]\nrpy = [0, 0, 90]', "ros.imu.rpy must be 3 numbers, radians (roll, pitch, yaw about "
+                  "x, y, z), each within 2 pi"),
+                 ('[ros.imu]\nframe = "/imu"', 'ros.imu.frame must be a frame name (words of letters, digits and _ joined by /) ("/imu")'),
+                 ('[ros.imu]\nplace = [0, 0, 0]', "unknown key ros.imu.place"),
+                 ('[[ros.range]]\nxyz = [0, 0, 0]\n[[ros.range]]\nrpy = ["a", 0, 0]', "ros.range[1].rpy must be 3 numbers"),
+                 ('[[ros.range]]\nframe = "base_link"', 'sensor frame "base_link" is the vehicle\'s own'),
+                 ('[[ros.range]]\nframe = "imu_link"', 'sensor frame "imu_link" is named twice')]
         with tempfile.TemporaryDirectory() as d:
             conf = os.path.join(d, "ros.toml")
             for line, message in cases:
@@ -1069,12 +1463,16 @@ class CommandsTest(RosTestCase):
                       "between -1 and 1, got 2", rig.log("caracara-ros"))
         self.assertEqual(nonzero_orders(rig.wire_log(since)[1]), [])
         self.assertEqual(rig.motor_values(), [0] * MOTORS)
+        # Every refusal is on /diagnostics too, counted by kind (the 5 cases, each once at least).
+        status = commands_status(self.listen(2.5, {"rt/diagnostics": "diagnostic_msgs/DiagnosticArray"})[0])
+        self.assertGreaterEqual(int(status["values"]["refused bad-value"]), 5, status)
+        self.assertIn("bad-value from writer ", status["values"]["last refusal"])
 
     def test_peer_killed_zeros_within_the_client_loss_bound(self):
         rig = self.rig
         data = [0.3] * 2 + [0] * 6
         with self.driving("rt/caracara/cmd_thrust", "std_msgs/Float64MultiArray",
-                          {"layout": {"dim": [], "data_offset": 0}, "data": data}):
+                          {"layout": {"dim": [], "data_offset": 0}, "data": data}, short_lease=True):
             rig.wait_sim_speeds([speed_byte(round(v * MOTOR_MAX)) for v in data])
             since = rig.wire_next()
             killed_at = time.monotonic_ns()  # the block's end SIGKILLs the peer

@@ -41,7 +41,7 @@ build_timeout_s=${CARACARA_DEBIAN13_BUILD_TIMEOUT:-1500}
 # codec (its npm packages are installed from the host, below), iproute2 for the namespace; udev
 # for the kernel test's devices_for_the_daemon_alone (the shipped rules applied by systemd-udevd).
 packages=(build-essential cmake pkg-config libsystemd-dev libgpiod-dev libcatch2-dev
-          libtomlplusplus-dev libboost-dev nlohmann-json3-dev dbus python3 python3-dbus python3-gi python3-matplotlib
+          libtomlplusplus-dev libboost-dev nlohmann-json3-dev dbus python3 python3-dbus python3-gi python3-yaml python3-matplotlib
           systemd dpkg-dev debhelper lintian kmod i2c-tools openssh-client ccache cyclonedds-dev cyclonedds-tools
           libfastdds-dev fastddsgen nodejs iproute2 udev)
 # Bump when the way the cached root is made changes.

@@ -1,7 +1,7 @@
 // One pilot's own connection to caracarad: each WebSocket client gets one, so the daemon's
 // per-client rules hold per pilot (its thrust goes to zero when this connection closes; the
-// command timeout runs per client; a motor test stops when its keep-alives stop or this
-// connection closes). Commands are sent asynchronously and in order; a refusal comes back with
+// command timeout, which is the vehicle's, zeroes it when commands stop; a motor test stops when
+// its keep-alives stop or this connection closes). Commands are sent asynchronously and in order; a refusal comes back with
 // the daemon's error name, and a reply that carries something (command_spec's reply) as JSON.
 #pragma once
 

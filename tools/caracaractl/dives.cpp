@@ -18,6 +18,7 @@
 #include <cstring>
 #include <ctime>
 #include <fstream>
+#include <optional>
 #include <iostream>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -44,6 +45,7 @@ struct DiveOptions {
     bool partial = false;
     bool mcap = false;          // export --format mcap
     bool cdr = false;           // --encoding cdr: the ROS 2 topics for rosbag2 (docs/ros2.md)
+    std::optional<caracara::ros::RangeLayout> distro; // --distro humble|jazzy: Range's layout, ROS_DISTRO
     bool detection = false;     // plot --detection: one direction detection run (plot_detection.py)
     std::string wire;           // plot --detection --wire FILE: the simulator's orders, time_ns,thruster,speed
     std::string run = "-1";     // plot --detection --run N: which run of the dive (-1 the last)
@@ -90,6 +92,12 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
                 usage("--encoding takes json or cdr, not '" + e + "'");
             o.cdr = e == "cdr";
         }
+        else if (a == "--distro" && name == "export") {
+            const std::string d = value("--distro");
+            o.distro = parse_name<caracara::ros::RangeLayout>(d);
+            if (!o.distro)
+                usage("--distro takes humble or jazzy, not '" + d + "'");
+        }
         else if (a == "--partial" && name != "dives")
             o.partial = true;
         else if (a.starts_with("--"))
@@ -101,6 +109,8 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
         usage("--events applies to --format csv (in MCAP the events are the /events channel)");
     if (name == "export" && !o.mcap && o.cdr)
         usage("--encoding applies to --format mcap");
+    if (name == "export" && o.distro && !o.cdr)
+        usage("--distro applies to --format mcap --encoding cdr");
     if (name == "export" && !o.mcap && !o.out.empty())
         usage("--out applies to --format mcap");
     if (name == "plot" && !o.detection && (!o.wire.empty() || o.run != "-1"))
@@ -269,10 +279,10 @@ int cmd_dives(const DiveOptions& o) {
 
 // The dive as MCAP on the live bridge's channels (JSON) or caracara-ros's topics (CDR), to --out
 // or to stdout when it is no terminal.
-int export_mcap(const dive::Dive& d, const std::string& out, bool cdr) {
+int export_mcap(const dive::Dive& d, const std::string& out, bool cdr, caracara::ros::RangeLayout distro) {
     if (out.empty() && ::isatty(STDOUT_FILENO))
         usage("MCAP is binary: give --out FILE or redirect the output");
-    const std::vector<uint8_t> bytes = cdr ? caracara::foxglove::dive_to_ros_mcap(d) : caracara::foxglove::dive_to_mcap(d);
+    const std::vector<uint8_t> bytes = cdr ? caracara::foxglove::dive_to_ros_mcap(d, distro) : caracara::foxglove::dive_to_mcap(d);
     std::ofstream file;
     if (!out.empty()) {
         file.open(out, std::ios::binary | std::ios::trunc);
@@ -290,7 +300,7 @@ int export_mcap(const dive::Dive& d, const std::string& out, bool cdr) {
 int cmd_export(const DiveOptions& o) {
     const dive::Dive d = load(resolve(o), o.partial);
     if (o.mcap)
-        return export_mcap(d, o.out, o.cdr);
+        return export_mcap(d, o.out, o.cdr, o.distro.value_or(caracara::ros::RangeLayout::Humble));
     if (o.events)
         write_events(std::cout, d);
     else
@@ -402,9 +412,11 @@ const char* dive_help() {
            "  export DIVE --format mcap [--out FILE] [--dir DIR] [--partial]\n"
            "                                   Write the dive as MCAP on the channels of\n"
            "                                   caracara-bridge, for Foxglove (docs/foxglove.md)\n"
-           "  export DIVE --format mcap --encoding cdr [--out FILE] [--dir DIR] [--partial]\n"
-           "                                   Write it as caracara-ros's ROS 2 topics (CDR, ros2msg\n"
-           "                                   schemas) for rosbag2: ros2 bag play (docs/ros2.md)\n"
+           "  export DIVE --format mcap --encoding cdr [--distro humble|jazzy] [--out FILE] [--dir DIR]\n"
+           "         [--partial]               Write it as caracara-ros's ROS 2 topics (CDR, ros2msg\n"
+           "                                   schemas, each with the QoS caracara-ros offers) for\n"
+           "                                   rosbag2: ros2 bag play (docs/ros2.md); --distro: Range's\n"
+           "                                   layout and the bag's ROS_DISTRO (default humble)\n"
            "  DIVE is a path, a file name in DIR, or \"last\". A truncated or corrupt file is refused\n"
            "  (status 1, the problem and its byte offset named); --partial uses what came before it.\n";
 }

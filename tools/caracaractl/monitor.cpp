@@ -32,12 +32,13 @@ struct Counter {
     std::string_view property;
 };
 
-// Counters that move with every control-loop cycle, status read or Teensy frame: printed, they
-// would bury every other change. Error counters (Nacks, Timeouts, Errors, ...) are not here.
+// Counters that move with every control-loop cycle, status read or Teensy frame, and the time of
+// each orientation reading (Orientation's own line says what changed): printed, they would bury
+// every other change. Error counters (Nacks, Timeouts, Errors, ...) are not here.
 constexpr Counter kFastCounters[] = {
     {kVehicleIface, "Cycles"},       {kVehicleIface, "CommandAgeMs"}, {kThrusterIface, "OrdersSent"},
     {kThrusterIface, "StatusReads"}, {kTeensyIface, "Frames"},        {kTeensyIface, "BusyRetries"},
-    {kBusIface, "Transactions"},
+    {kBusIface, "Transactions"},     {kTeensyIface, "OrientationReadNs"},
 };
 
 void print_line(const std::string& text) { std::cout << timestamp_now() << ' ' << text << std::endl; }

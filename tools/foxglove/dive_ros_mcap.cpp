@@ -29,6 +29,7 @@ struct Topic {
     const char* name;
     const char* type;
     std::string schema;
+    bool latched = false; // transient-local, keep-last 1, as caracara-ros offers it
 };
 
 const Topic kImu{"/caracara/imu", "sensor_msgs/msg/Imu",
@@ -46,23 +47,40 @@ const std::string kJointStateSchema =
     "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n" + kHeader;
 const Topic kJoints{"/caracara/joint_states", "sensor_msgs/msg/JointState", kJointStateSchema};
 const Topic kOrdered{"/caracara/thrusters/ordered", "sensor_msgs/msg/JointState", kJointStateSchema};
-const std::string kRangeSchema = "uint8 ULTRASOUND=0\nuint8 INFRARED=1\nstd_msgs/Header header\nuint8 radiation_type\n"
-                                 "float32 field_of_view\nfloat32 min_range\nfloat32 max_range\nfloat32 range\n" + kHeader;
+const std::string kRangeFields = "uint8 ULTRASOUND=0\nuint8 INFRARED=1\nstd_msgs/Header header\nuint8 radiation_type\n"
+                                 "float32 field_of_view\nfloat32 min_range\nfloat32 max_range\nfloat32 range\n";
+const std::string kRangeSchema = kRangeFields + kHeader;
+const std::string kJazzyRangeSchema = kRangeFields + "float32 variance\n" + kHeader;
 const Topic kDiagnostics{"/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
                          "std_msgs/Header header\ndiagnostic_msgs/DiagnosticStatus[] status\n" + kHeader + kSep +
                              "MSG: diagnostic_msgs/DiagnosticStatus\nbyte OK=0\nbyte WARN=1\nbyte ERROR=2\nbyte STALE=3\n"
                              "byte level\nstring name\nstring message\nstring hardware_id\ndiagnostic_msgs/KeyValue[] values\n" +
                              kSep + "MSG: diagnostic_msgs/KeyValue\nstring key\nstring value\n"};
-const Topic kState{"/caracara/state", "std_msgs/msg/String", "string data\n"};
-const Topic kKillSource{"/caracara/kill_source", "std_msgs/msg/String", "string data\n"};
-const Topic kKilled{"/caracara/killed", "std_msgs/msg/Bool", "bool data\n"};
+const Topic kState{"/caracara/state", "std_msgs/msg/String", "string data\n", true};
+const Topic kKillSource{"/caracara/kill_source", "std_msgs/msg/String", "string data\n", true};
+const Topic kKilled{"/caracara/killed", "std_msgs/msg/Bool", "bool data\n", true};
+
+// The QoS caracara-ros offers on a topic (tools/ros/dds_qos.cpp), as rosbag2 keeps it in a
+// channel's offered_qos_profiles: a YAML list of one profile, rosbag2_storage's field names and
+// rmw's policy numbers (history 1 keep-last; reliability 1 reliable; durability 1 transient-local,
+// 2 volatile; liveliness 1 automatic; durations 0 unspecified). Numbers, not Jazzy's words: a
+// bag without serialized_metadata is read as version 8, which takes numbers, as Humble does.
+std::string offered_qos(bool latched) {
+    const std::string zero = "\n    sec: 0\n    nsec: 0\n";
+    return std::string("- history: 1\n  depth: ") + (latched ? "1" : "10") + "\n  reliability: 1\n  durability: " +
+           (latched ? "1" : "2") + "\n  deadline:" + zero + "  lifespan:" + zero + "  liveliness: 1\n" +
+           "  liveliness_lease_duration:" + zero + "  avoid_ros_namespace_conventions: false\n";
+}
 
 constexpr uint64_t kDiagnosticsPeriodNs = 1'000'000'000;
 const char* const kBusStates[] = {"ok", "recovering", "lost", "lost"};
 
 class RosBag {
 public:
-    RosBag() : w_("ros2", "caracaractl export") {}
+    explicit RosBag(ros::RangeLayout distro) : w_("ros2", "caracaractl export") {
+        // rosbag2's record of the bag: `ros2 bag info` shows the distro.
+        w_.add_metadata("rosbag2", {{"ROS_DISTRO", std::string(name_of(distro))}});
+    }
 
     void put(const Topic& t, uint64_t ns, const CdrWriter& m) { put(t.name, t, ns, m); }
     void put(const std::string& name, const Topic& t, uint64_t ns, const CdrWriter& m) {
@@ -71,7 +89,8 @@ public:
             auto s = schemas_.find(t.type);
             if (s == schemas_.end())
                 s = schemas_.emplace(t.type, w_.add_schema(t.type, "ros2msg", t.schema)).first;
-            it = channels_.emplace(name, w_.add_channel(s->second, name, "cdr")).first;
+            it = channels_.emplace(name, w_.add_channel(s->second, name, "cdr",
+                                                        {{"offered_qos_profiles", offered_qos(t.latched)}})).first;
         }
         const auto& b = m.bytes();
         w_.add_message(it->second, ns, ns, std::string_view(reinterpret_cast<const char*>(b.data()), b.size()));
@@ -138,8 +157,9 @@ void diagnostics(RosBag& bag, uint64_t ns, const dive::Sample& s, const std::str
 
 } // namespace
 
-std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d) {
-    RosBag bag;
+std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d, ros::RangeLayout distro) {
+    RosBag bag(distro);
+    const bool jazzy = distro == ros::RangeLayout::Jazzy;
     const uint64_t start_ns = d.header.start_unix_ms * 1'000'000u;
     auto at = [&](uint32_t t_100us) { return start_ns + uint64_t{t_100us} * 100'000u; };
     // A dive starts at a ClearKill or the daemon's start: arming, as dive_mcap.cpp has it.
@@ -218,7 +238,10 @@ std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d) {
             r.u8(0); // ULTRASOUND: the Teensy does not say which kind of sensor it reads
             for (const float v : {0.0f, 0.0f, 65.535f, ros::range_metres(s.distances[i])})
                 r.f32(v);
-            bag.put("/caracara/range/" + std::to_string(i), Topic{"", "sensor_msgs/msg/Range", kRangeSchema}, ns, r);
+            if (jazzy)
+                r.f32(0.0f); // variance: unknown
+            bag.put("/caracara/range/" + std::to_string(i),
+                    Topic{"", "sensor_msgs/msg/Range", jazzy ? kJazzyRangeSchema : kRangeSchema}, ns, r);
         }
         if (!diagnostics_written || ns >= diagnostics_ns + kDiagnosticsPeriodNs) {
             diagnostics(bag, ns, s, state);

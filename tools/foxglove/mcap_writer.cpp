@@ -14,7 +14,8 @@ constexpr uint8_t kMagic[] = {0x89, 'M', 'C', 'A', 'P', 0x30, '\r', '\n'};
 
 enum Op : uint8_t {
     kHeader = 0x01, kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kChunk = 0x06,
-    kMessageIndex = 0x07, kChunkIndex = 0x08, kStatistics = 0x0B, kSummaryOffset = 0x0E, kDataEnd = 0x0F,
+    kMessageIndex = 0x07, kChunkIndex = 0x08, kStatistics = 0x0B, kMetadata = 0x0C, kMetadataIndex = 0x0D,
+    kSummaryOffset = 0x0E, kDataEnd = 0x0F,
 };
 
 // A record: opcode, u64 length of the content, content (appended by `body`).
@@ -33,6 +34,19 @@ void record(std::vector<uint8_t>& out, uint8_t op, F body) {
 void string(ByteWriter& w, std::string_view s) {
     w.u32(static_cast<uint32_t>(s.size()));
     w.raw(s);
+}
+
+// A Map<string, string>: its byte length, then each key and value as a string.
+void map(ByteWriter& w, std::vector<uint8_t>& out, const std::map<std::string, std::string>& m) {
+    const std::size_t at = out.size();
+    w.u32(0);
+    for (const auto& [k, v] : m) {
+        string(w, k);
+        string(w, v);
+    }
+    const auto length = static_cast<uint32_t>(out.size() - at - 4);
+    for (int i = 0; i < 4; ++i)
+        out[at + static_cast<std::size_t>(i)] = static_cast<uint8_t>(length >> (8 * i));
 }
 
 uint32_t crc(const std::vector<uint8_t>& v, std::size_t from, std::size_t to) {
@@ -57,11 +71,22 @@ uint16_t McapWriter::add_schema(std::string_view name, std::string_view encoding
     return id;
 }
 
-uint16_t McapWriter::add_channel(uint16_t schema_id, std::string_view topic, std::string_view message_encoding) {
+uint16_t McapWriter::add_channel(uint16_t schema_id, std::string_view topic, std::string_view message_encoding,
+                                 const Map& metadata) {
     const auto id = static_cast<uint16_t>(channels_.size() + 1);
-    channels_.push_back({id, schema_id, std::string(topic), std::string(message_encoding)});
+    channels_.push_back({id, schema_id, std::string(topic), std::string(message_encoding), metadata});
     write_channel(file_, channels_.back());
     return id;
+}
+
+void McapWriter::add_metadata(std::string_view name, const Map& metadata) {
+    // In the data section, outside any chunk; its index in the summary.
+    const uint64_t offset = file_.size();
+    record(file_, kMetadata, [&](ByteWriter& w) {
+        string(w, name);
+        map(w, file_, metadata);
+    });
+    metadata_indexes_.push_back({offset, file_.size() - offset, std::string(name)});
 }
 
 void McapWriter::write_schema(std::vector<uint8_t>& out, const Schema& s) const {
@@ -79,7 +104,7 @@ void McapWriter::write_channel(std::vector<uint8_t>& out, const Channel& c) cons
         w.u16(c.schema_id);
         string(w, c.topic);
         string(w, c.encoding);
-        w.u32(0); // metadata: an empty map
+        map(w, out, c.metadata);
     });
 }
 
@@ -168,7 +193,7 @@ std::vector<uint8_t> McapWriter::finish() {
             w.u16(static_cast<uint16_t>(schemas_.size()));
             w.u32(static_cast<uint32_t>(channels_.size()));
             w.u32(0); // attachments
-            w.u32(0); // metadata
+            w.u32(static_cast<uint32_t>(metadata_indexes_.size()));
             w.u32(static_cast<uint32_t>(chunk_indexes_.size()));
             w.u64(start_time_);
             w.u64(end_time_);
@@ -195,6 +220,14 @@ std::vector<uint8_t> McapWriter::finish() {
                 string(w, "");
                 w.u64(c.records_size); // compressed size: the same, uncompressed
                 w.u64(c.records_size);
+            });
+    });
+    group(kMetadataIndex, [&] {
+        for (const MetadataIndex& m : metadata_indexes_)
+            record(file_, kMetadataIndex, [&](ByteWriter& w) {
+                w.u64(m.offset);
+                w.u64(m.length);
+                string(w, m.name);
             });
     });
     const uint64_t offsets_start = file_.size();

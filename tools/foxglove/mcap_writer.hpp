@@ -22,7 +22,12 @@ public:
 
     // Ids start at 1 (schema id 0 means "no schema").
     uint16_t add_schema(std::string_view name, std::string_view encoding, std::string_view data);
-    uint16_t add_channel(uint16_t schema_id, std::string_view topic, std::string_view message_encoding);
+    using Map = std::map<std::string, std::string>;
+    // metadata: the channel's (rosbag2 keeps a topic's offered_qos_profiles there).
+    uint16_t add_channel(uint16_t schema_id, std::string_view topic, std::string_view message_encoding,
+                         const Map& metadata = {});
+    // A Metadata record (rosbag2's "rosbag2" with ROS_DISTRO), indexed in the summary.
+    void add_metadata(std::string_view name, const Map& metadata);
     // Messages in any order of time; each channel's sequence counts from 0.
     void add_message(uint16_t channel_id, uint64_t log_time, uint64_t publish_time, std::string_view data);
 
@@ -33,7 +38,8 @@ public:
 
 private:
     struct Schema { uint16_t id; std::string name, encoding, data; };
-    struct Channel { uint16_t id, schema_id; std::string topic, encoding; uint32_t sequence = 0; };
+    struct Channel { uint16_t id, schema_id; std::string topic, encoding; Map metadata; uint32_t sequence = 0; };
+    struct MetadataIndex { uint64_t offset, length; std::string name; };
     struct ChunkIndex {
         uint64_t start_time, end_time, offset, length, index_length, records_size;
         std::map<uint16_t, uint64_t> index_offsets;
@@ -47,6 +53,7 @@ private:
     std::vector<uint8_t> file_;     // magic, header, and the data section so far
     std::vector<Schema> schemas_;
     std::vector<Channel> channels_;
+    std::vector<MetadataIndex> metadata_indexes_;
     // The open chunk: its records, message index entries per channel (time, offset), times.
     std::vector<uint8_t> chunk_;
     std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunk_index_;

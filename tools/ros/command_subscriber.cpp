@@ -1,5 +1,6 @@
 #include "tools/ros/command_subscriber.hpp"
 
+#include "core/clock.hpp"
 #include "core/frames.hpp"
 #include "core/motor.hpp"
 
@@ -48,17 +49,24 @@ std::string wrench_axes_note() {
     return note;
 }
 
-std::string writer_name(dds_instance_handle_t h) {
-    char b[24];
-    std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h));
-    return b;
+// A DDS GUID as ROS 2 prints a GID (rclpy's TopicEndpointInfo: each byte as two hex digits,
+// dotted), zero-padded to the distro's Gid: Humble's 24 bytes, 16 since Iron.
+std::string gid_text(const dds_guid_t& g, RangeLayout distro) {
+    std::string s;
+    char b[4];
+    const std::size_t size = distro == RangeLayout::Humble ? 24 : 16;
+    for (std::size_t i = 0; i < size; ++i) {
+        std::snprintf(b, sizeof b, "%02x", i < sizeof g.v ? g.v[i] : 0u);
+        s += (i ? "." : "") + std::string(b);
+    }
+    return s;
 }
 
 } // namespace
 
 CommandSubscriber::CommandSubscriber(sd_event* event, DdsParticipant& dds, const RosConfig& config,
-                                     std::function<void()> kill)
-    : event_(event), config_(config), kill_(std::move(kill)) {
+                                     CommandRecord& record, const SpokenDistro& distro, std::function<void()> kill)
+    : event_(event), config_(config), distro_(distro), kill_(std::move(kill)), record_(record) {
     wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     sd_event_source* s = nullptr;
     if (wake_fd_ < 0 || sd_event_add_io(event_, &s, wake_fd_, EPOLLIN, on_wake, this) < 0)
@@ -138,15 +146,54 @@ void CommandSubscriber::take_kills() {
     }
 }
 
+const std::string& CommandSubscriber::gid(dds_entity_t reader, dds_instance_handle_t writer) {
+    auto [it, added] = gids_.try_emplace(writer);
+    if (added) {
+        dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(reader, writer);
+        if (e) {
+            it->second = gid_text(e->key, distro_.layout);
+            dds_builtintopic_free_endpoint(e);
+        } else { // no longer matched: its instance handle is all there is to name it by
+            char b[32];
+            std::snprintf(b, sizeof b, "(handle %016llx)", static_cast<unsigned long long>(writer));
+            it->second = b;
+        }
+    }
+    return it->second;
+}
+
+Pilot* CommandSubscriber::commanding(dds_entity_t reader, dds_instance_handle_t writer, const char* topic) {
+    const uint64_t now = monotonic_ns();
+    const std::string& name = gid(reader, writer);
+    const std::string holder = record_.holder(now);
+    if (!holder.empty() && holder_ != writer) {
+        const std::string why = "the vehicle is held by writer " + holder + " (until it stops for the command timeout, " +
+                                std::to_string(record_.timeout_ms()) + " ms, or leaves)";
+        if (told_[writer] != holder_) { // once per hold; /diagnostics counts them all
+            std::fprintf(stderr, "caracara-ros: %s from writer %s refused (%s): %s\n", topic, name.c_str(),
+                         std::string(name_of(CommandRefusal::NotHolder)).c_str(), why.c_str());
+            told_[writer] = holder_;
+        }
+        record_.refused(name, CommandRefusal::NotHolder, why, now);
+        return nullptr;
+    }
+    if (holder.empty())
+        std::fprintf(stderr, "caracara-ros: writer %s holds the vehicle (%s)\n", name.c_str(), topic);
+    holder_ = writer;
+    record_.commanded(name, now);
+    return pilot(writer);
+}
+
 Pilot* CommandSubscriber::pilot(dds_instance_handle_t writer) {
     auto& p = pilots_[writer];
     if (!p) {
+        const std::string& name = gids_[writer];
         try {
             static const std::string kWrenchNote = wrench_axes_note();
-            p = std::make_unique<Pilot>(event_, config_.bus, writer_name(writer), kWrenchNote);
-            std::fprintf(stderr, "caracara-ros: writer %s commands as a pilot\n", writer_name(writer).c_str());
+            p = std::make_unique<Pilot>(event_, config_.bus, name, record_, kWrenchNote);
+            std::fprintf(stderr, "caracara-ros: writer %s commands as a pilot\n", name.c_str());
         } catch (const std::exception& e) {
-            std::fprintf(stderr, "caracara-ros: writer %s: %s\n", writer_name(writer).c_str(), e.what());
+            std::fprintf(stderr, "caracara-ros: writer %s: %s\n", name.c_str(), e.what());
             pilots_.erase(writer);
             return nullptr;
         }
@@ -160,7 +207,7 @@ void CommandSubscriber::take_wrenches() {
         // y left, z up), each -1..1 of the axis's full demand; core/frames turns it into the
         // seed's axes SetMotion takes. Range and NaN are the daemon's to refuse, by name.
         const frames::BodyMotion flu{{w.force.x, w.force.y, w.force.z}, {w.torque.x, w.torque.y, w.torque.z}};
-        if (Pilot* p = pilot(writer))
+        if (Pilot* p = commanding(wrench_reader_, writer, "cmd_wrench"))
             p->set_motion(frames::from_flu(flu));
     });
 }
@@ -170,20 +217,24 @@ void CommandSubscriber::take_thrusts() {
         // Each value -1..1 of full thrust becomes the motor value round(v * kMotorMax); the daemon
         // refuses a wrong count or a value out of range by name (a value past +-2 is sent as
         // +-2 * kMotorMax, out of range all the same). NaN has no motor value: refused here.
+        Pilot* p = commanding(thrust_reader_, writer, "cmd_thrust");
+        if (!p)
+            return;
         std::vector<int32_t> values;
         for (uint32_t k = 0; k < a.data._length; ++k) {
             const double v = a.data._buffer[k];
             if (!std::isfinite(v)) {
-                std::fprintf(stderr, "caracara-ros: cmd_thrust from writer %s refused: "
-                                     "org.caracara.Vehicle1.Error.InvalidValue: value %u is not a number\n",
-                             writer_name(writer).c_str(), k);
+                const std::string& name = gid(thrust_reader_, writer);
+                const std::string why = "org.caracara.Vehicle1.Error.InvalidValue: value " + std::to_string(k) +
+                                        " is not a number";
+                std::fprintf(stderr, "caracara-ros: cmd_thrust from writer %s refused: %s\n", name.c_str(), why.c_str());
+                record_.refused(name, CommandRefusal::BadValue, why, monotonic_ns());
                 return;
             }
             values.push_back(std::fabs(v) < 2.0 ? static_cast<int32_t>(std::lround(v * caracara::kMotorMax))
                                                 : (v > 0 ? 2 : -2) * caracara::kMotorMax);
         }
-        if (Pilot* p = pilot(writer))
-            p->set_thrust(values);
+        p->set_thrust(values);
     });
 }
 
@@ -200,9 +251,14 @@ void CommandSubscriber::drop_unmatched() {
             ++it;
             continue;
         }
-        std::fprintf(stderr, "caracara-ros: writer %s gone; its connection closed\n", writer_name(it->first).c_str());
+        const std::string name = gids_[it->first];
+        std::fprintf(stderr, "caracara-ros: writer %s gone; its connection closed\n", name.c_str());
+        record_.left(name);
         it = pilots_.erase(it);
     }
+    // Refused writers have no Pilot: their names go when they do.
+    std::erase_if(gids_, [&](const auto& g) { return !matched.contains(g.first); });
+    std::erase_if(told_, [&](const auto& t) { return !matched.contains(t.first); });
 }
 
 } // namespace caracara::ros

@@ -93,6 +93,11 @@ dds_entity_t DdsParticipant::writer(const dds_topic_descriptor_t* desc, const st
     return w;
 }
 
+void DdsParticipant::delete_writer(dds_entity_t writer) {
+    discovery_info_->remove_writer(writer);
+    dds_delete(writer);
+}
+
 dds_entity_t DdsParticipant::reader(const dds_topic_descriptor_t* desc, const std::string& ros_name, Profile p,
                                     const dds_listener_t* listener) {
     dds_qos_t* q = qos_for(p);

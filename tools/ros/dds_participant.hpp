@@ -33,6 +33,9 @@ public:
     dds_entity_t writer(const dds_topic_descriptor_t* desc, const std::string& ros_name, Profile profile);
     dds_entity_t reader(const dds_topic_descriptor_t* desc, const std::string& ros_name, Profile profile,
                         const dds_listener_t* listener);
+    // Deletes a writer made here, and takes it off the node's list.
+    void delete_writer(dds_entity_t writer);
+    DiscoveryInfo& discovery_info() { return *discovery_info_; }
 
 private:
     dds_entity_t topic(const dds_topic_descriptor_t* desc, const std::string& ros_name);

@@ -50,8 +50,13 @@ void write(dds_entity_t writer, const DiscoveryInfo::Guid& participant, const st
 } // namespace
 
 DiscoveryInfo::DiscoveryInfo(dds_entity_t participant, const RosConfig& config)
-    : jazzy_(config.range_layout == RangeLayout::Jazzy),
+    : jazzy_(config.range_layout == RangeLayout::Jazzy), participant_entity_(participant),
       namespace_(config.ros_namespace.empty() ? "/" : config.ros_namespace), participant_(guid_of(participant)) {
+    make_writer();
+}
+
+void DiscoveryInfo::make_writer() {
+    const dds_entity_t participant = participant_entity_;
     static const dds_topic_descriptor_t kJazzy = under_type_name(jazzy_rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc,
                                                                  "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_");
     // The topic is not under "rt/": rmw_dds_common names it so (avoid_ros_namespace_conventions).
@@ -64,6 +69,21 @@ DiscoveryInfo::DiscoveryInfo(dds_entity_t participant, const RosConfig& config)
     dds_delete_qos(q);
     if (writer_ < 0)
         throw std::runtime_error(std::string("DDS writer on ros_discovery_info: ") + dds_strretcode(writer_));
+    publish();
+}
+
+void DiscoveryInfo::set_layout(RangeLayout layout) {
+    if (jazzy_ == (layout == RangeLayout::Jazzy))
+        return;
+    // The other layout's topic beside this one (Cyclone takes both type layouts under one name);
+    // the old writer goes, so no peer gets a Gid size it cannot read.
+    dds_delete(writer_);
+    jazzy_ = layout == RangeLayout::Jazzy;
+    make_writer();
+}
+
+void DiscoveryInfo::remove_writer(dds_entity_t writer) {
+    std::erase(writers_, guid_of(writer));
     publish();
 }
 

@@ -28,12 +28,17 @@ public:
 
     void add_writer(dds_entity_t writer);
     void add_reader(dds_entity_t reader);
+    void remove_writer(dds_entity_t writer);
+    // Written from now on in `layout`'s Gid size (the distro caracara-ros speaks changed).
+    void set_layout(RangeLayout layout);
 
 private:
     void publish();
+    void make_writer();
 
     dds_entity_t writer_ = 0;
     bool jazzy_;
+    dds_entity_t participant_entity_;
     std::string namespace_;
     Guid participant_{};
     std::vector<Guid> writers_, readers_;

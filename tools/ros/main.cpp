@@ -2,6 +2,7 @@
 // One DDS participant named like a ROS 2 node's; a client of caracarad's D-Bus API and of nothing
 // else (docs/ros2.md).
 #include "tools/ros/command_subscriber.hpp"
+#include "tools/ros/spoken_distro.hpp"
 #include "tools/ros/telemetry_publisher.hpp"
 
 #include <csignal>
@@ -115,8 +116,13 @@ int main(int argc, char** argv) {
     sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
     try {
         caracara::ros::DdsParticipant dds(config);
-        caracara::ros::TelemetryPublisher telemetry(event.get(), dds, config);
-        caracara::ros::CommandSubscriber commands(event.get(), dds, config, [&] { kill_over(telemetry.bus(), config.bus); });
+        caracara::ros::CommandRecord record; // the writers' holder and refusals, on /diagnostics
+        caracara::ros::SpokenDistro distro{config.range_layout, config.range_layout_given
+                                                                    ? "range_layout in the config"
+                                                                    : "no ROS 2 peer seen yet: Humble's until one is"};
+        caracara::ros::TelemetryPublisher telemetry(event.get(), dds, config, record, distro);
+        caracara::ros::CommandSubscriber commands(event.get(), dds, config, record, distro,
+                                                  [&] { kill_over(telemetry.bus(), config.bus); });
         telemetry.start();
         dds.watch(event.get());
         std::fprintf(stderr, "caracara-ros: domain %u, namespace %s, commands %s, DDS Security %s%s\n", config.domain_id,

@@ -10,15 +10,23 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace caracara::ros {
 
-enum class RangeLayout { Humble, Jazzy };
+// Where a sensor sits on the vehicle, for /tf_static: its frame's name, its position in metres
+// and its orientation in radians (URDF's rpy: roll about x, pitch about y, yaw about z, fixed
+// axes) in the base frame, REP 103's body FLU (x forward, y left, z up).
+struct SensorMount {
+    std::string frame;
+    frames::Vec3 xyz, rpy;
+};
 
 struct RosConfig {
     std::string ros_namespace = "/caracara";
     uint32_t domain_id = 0;           // ROS_DOMAIN_ID, else 0; the file's domain_id wins
     RangeLayout range_layout = RangeLayout::Humble; // also ros_discovery_info's Gid: 24 bytes, Jazzy's 16
+    bool range_layout_given = false; // else the distro is the peers' (DistroDetector), Humble until one is seen
     bool commands = false;            // Wrench and per-thruster commands; kill is always taken
     // An SROS2 enclave directory (keystore/enclaves/<path>): DDS Security on, "" = off.
     std::string security;
@@ -37,6 +45,13 @@ struct RosConfig {
     // transform make tf2 jump between them.
     bool publish_odom_tf = true;
     float range_min_m = 0.0f, range_max_m = 65.535f, range_fov_rad = 0.0f;
+    // imu, /tf and joint_states go out at this rate whether their values change or not, as a ROS
+    // driver's do (tf2 and robot_localization wait for a steady stream).
+    double sensor_rate_hz = kDaemonTelemetryRateHz;
+    // [ros.imu] and [[ros.range]] (one per distance sensor, in the Teensy's order): by default at
+    // the base frame's origin, facing forward; a sensor the config does not list gets that too.
+    SensorMount imu{kDefaultImuFrame, {}, {}};
+    std::vector<SensorMount> ranges;
     caracara::dbus::BusChoice bus;
 };
 
@@ -49,6 +64,8 @@ std::string commands_refusal(const RosConfig& config, bool loopback);
 
 // Whether `interface` is a loopback interface of this machine ("" is not: Cyclone picks any).
 bool is_loopback(const std::string& interface);
+// Distance sensor i's mount: the config's, else range_i at the origin facing forward.
+SensorMount range_mount(const RosConfig& config, std::size_t i);
 
 // The ROS topic name under the namespace ("state" -> "/caracara/state"; "/diagnostics" stays).
 std::string ros_topic(const RosConfig& config, const std::string& name);

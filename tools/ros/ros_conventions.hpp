@@ -4,6 +4,7 @@
 // conversion is core/frames.hpp's, not here.
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/frames.hpp"
 #include "core/motor.hpp"
 
@@ -14,9 +15,22 @@ namespace caracara::ros {
 
 inline constexpr unsigned kThrusterJoints = 8;
 
+// A ROS 2 distro's layouts where they differ on the wire: sensor_msgs/Range (Jazzy's adds
+// variance) and rmw_dds_common's Gid (24 bytes in Humble, 16 since Iron).
+enum class RangeLayout { Humble, Jazzy };
+
+// caracarad announces its telemetry (the Teensy's attitude, the thrusters' readings) at 5 Hz
+// (daemon/control/control_loop.cpp, kTelemetryPeriodNs): the sensor topics' default rate.
+inline constexpr double kDaemonTelemetryRateHz = 5.0;
+// The highest sensor rate the config takes: beyond the daemon's loop (50 Hz by default) the
+// same reading would only be sent again.
+inline constexpr double kMaxSensorRateHz = 50.0;
+
 // The frame names of the defaults (REP 105): the world frame and the vehicle's body.
 inline const std::string kDefaultWorldFrame = "odom";
 inline const std::string kDefaultBaseFrame = "base_link";
+// The IMU's frame on the vehicle (/tf_static), as ROS drivers name it.
+inline const std::string kDefaultImuFrame = "imu_link";
 
 // A frame's name in a convention (core/frames.hpp): NED / FRD frames carry _ned / _frd, as MAVROS
 // names them, so a tool never takes them for REP 103's ENU / FLU ones.
@@ -40,3 +54,15 @@ inline float range_metres(uint32_t mm) { return static_cast<float>(mm) / 1000.0f
 inline bool state_is_killed(const std::string& state) { return state == "killed" || state == "powered-off"; }
 
 } // namespace caracara::ros
+
+namespace caracara {
+
+template <>
+struct EnumNames<ros::RangeLayout> {
+    static constexpr std::array<EnumName<ros::RangeLayout>, 2> table{{
+        {ros::RangeLayout::Humble, "humble"},
+        {ros::RangeLayout::Jazzy, "jazzy"},
+    }};
+};
+
+} // namespace caracara

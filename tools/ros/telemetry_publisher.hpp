@@ -1,17 +1,23 @@
 // caracara-ros's reading connection to caracarad and the topics it publishes: the vehicle's
-// objects (GetManagedObjects) kept current by PropertiesChanged, each change written to the
-// topics it touches once per batch of signals, so the rates are the daemon's announcement
-// rates; nothing is polled. The topics (docs/ros2.md): imu, joint_states, thrusters/ordered,
+// objects (GetManagedObjects) kept current by PropertiesChanged; nothing is polled. imu, /tf,
+// joint_states and thrusters/ordered go out at the config's sensor rate whether values change
+// or not, each stamped with the time of the reading it carries; the others when caracarad
+// announces a change, once per batch of signals. The topics (docs/ros2.md): imu, joint_states, thrusters/ordered,
 // range/N, /diagnostics (at most 1 Hz, at once when a level changes), killed, state and
 // kill_source (transient-local), /tf (unless the config leaves odom -> base_link to the
-// vehicle's localization).
+// vehicle's localization), /tf_static (the IMU's and each distance sensor's mount).
 #pragma once
 
 #include "tools/client/client.hpp"
 #include "tools/client/object_mirror.hpp"
+#include "tools/ros/command_record.hpp"
 #include "tools/ros/dds_participant.hpp"
+#include "tools/ros/distro_detector.hpp"
+#include "tools/ros/spoken_distro.hpp"
 
 #include <array>
+#include <memory>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -19,7 +25,11 @@ namespace caracara::ros {
 
 class TelemetryPublisher {
 public:
-    TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config);
+    // `commands`: the ROS writers' holder and refusals, a status of /diagnostics; its command
+    // timeout is set from the daemon's CommandTimeoutMs. `distro`: what it speaks; unless the
+    // config names it, chosen here from the peers' ros_discovery_info (and said why).
+    TelemetryPublisher(sd_event* event, DdsParticipant& dds, const RosConfig& config, CommandRecord& commands,
+                       SpokenDistro& distro);
     ~TelemetryPublisher();
     TelemetryPublisher(const TelemetryPublisher&) = delete;
     TelemetryPublisher& operator=(const TelemetryPublisher&) = delete;
@@ -30,39 +40,56 @@ public:
     sd_bus* bus() const { return client_ ? client_->bus() : nullptr; }
 
 private:
-    enum Dirty : unsigned { kImu = 1, kJoints = 2, kRanges = 4, kDiagnostics = 8, kState = 16 };
+    enum Dirty : unsigned { kRanges = 4, kDiagnostics = 8, kState = 16 };
     static int on_flush(sd_event_source* s, void* userdata);
     static int on_retry(sd_event_source* s, uint64_t usec, void* userdata);
     static int on_diagnostics_due(sd_event_source* s, uint64_t usec, void* userdata);
+    static int on_sensor_tick(sd_event_source* s, uint64_t usec, void* userdata);
     bool connect();
     void retry();
     void reload();
     void mark(unsigned dirty);
     void changed(const std::string& path, const client::Props& changes);
+    void teensy_changed(const client::Props& changes);
     const client::Props& props(const std::string& path, const char* iface) const { return mirror_.props(path, iface); }
 
     void write_imu_and_tf();
     void write_joints();
     void write_ranges();
+    void write_static_frames();
     void write_state();
     void write_diagnostics();
+    void choose_distro();
     std::vector<uint8_t> levels() const;
 
     sd_event* event_;
     DdsParticipant& dds_;
     const RosConfig& config_;
+    CommandRecord& commands_;
+    SpokenDistro& distro_;
+    std::unique_ptr<DistroDetector> detector_; // none when the config names the distro
     // The Imu's and /tf's frame names in the config's convention (headers point into them).
     const std::string world_frame_, body_frame_;
     std::unique_ptr<client::Client> client_;
-    caracara::SourcePtr flush_, retry_, diagnostics_timer_;
+    const uint64_t sensor_period_us_;
+    caracara::SourcePtr flush_, retry_, diagnostics_timer_, sensor_timer_;
+    // When the readings the mirror holds were taken (CLOCK_REALTIME). The orientation: the time
+    // caracarad gives with a changed value (OrientationReadNs), not its announcement's arrival,
+    // which comes up to a telemetry period later, more on a loaded machine (a turning vehicle's
+    // Imu would be that far behind its stamp). Otherwise the arrival of the object's latest
+    // announcement of a reading: caracarad announces a changed value at its next telemetry tick,
+    // so a later announcement of the Teensy's Frames or a thruster's counters (once a second)
+    // says the value held was read again unchanged. Zero: nothing read yet.
+    timespec orientation_read_at_{}, teensy_read_at_{}, thrusters_read_at_{};
     client::ObjectMirror mirror_;
     unsigned dirty_ = 0;
     uint64_t diagnostics_last_us_ = 0;
     std::vector<uint8_t> last_levels_;
     std::string last_state_, last_source_;
     bool state_written_ = false;
+    bool sent_static_frames_ = false;
 
-    dds_entity_t imu_, tf_ = 0, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
+    dds_entity_t imu_, tf_ = 0, tf_static_, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
     std::vector<dds_entity_t> ranges_;
     dds_topic_descriptor_t jazzy_range_;
 };

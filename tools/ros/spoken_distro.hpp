@@ -1,0 +1,20 @@
+// The ROS 2 distro caracara-ros speaks (sensor_msgs/Range's layout and ros_discovery_info's Gid
+// size): the config's range_layout when it names one, else what the peers' ros_discovery_info
+// says (DistroDetector), chosen by the TelemetryPublisher; read where a Gid is written or printed.
+#pragma once
+
+#include "tools/ros/ros_config.hpp"
+
+#include <string>
+
+namespace caracara::ros {
+
+struct SpokenDistro {
+    RangeLayout layout = RangeLayout::Humble;
+    // Why, as the journal and /diagnostics say it ("range_layout in the config", "the peers'
+    // ros_discovery_info: ...", "no ROS 2 peer seen yet: Humble's until one is").
+    std::string why;
+};
+
+} // namespace caracara::ros
+
