@@ -192,11 +192,15 @@ def fuzz_table(rec):
     rows = sorted(hs.items(), key=lambda kv: -kv[1].get("executions", 0))
     failed = [h for h, r in rows if not r.get("passed")]
     total = sum(r.get("executions", 0) for _, r in rows)
+    with open(os.path.join(TOP, "fuzz", "CMakeLists.txt")) as f:
+        declared = re.findall(r"^caracara_fuzzer\(([a-z_]+) ", f.read(), re.M)
+    missing = [h for h in declared if h not in hs]
     out = [FUZZ_BEGIN,
            f"The record, `bench/fuzz-results.json` (written by `scripts/fuzz.sh`, one harness at a time, each "
            f"from the seeds, the regression inputs and whatever corpus earlier runs grew in /var/tmp/caracara-fuzz): "
            + ("every harness passed" if not failed else "**failed: " + ", ".join(failed) + "**")
-           + f", **{total:,} executions** in all, the smallest {min((r.get('executions', 0) for _, r in rows), default=0):,}:",
+           + f", **{total:,} executions** in all, the smallest {min((r.get('executions', 0) for _, r in rows), default=0):,}"
+           + (f"; no long run recorded yet: {', '.join(missing)}" if missing else "") + ":",
            "",
            "    harness          executions  seconds   cov     ft  corpus files  limit                finished"]
     for h, r in rows:

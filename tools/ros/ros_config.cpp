@@ -154,9 +154,12 @@ std::string load_config(const std::string& path, RosConfig& c) {
             return path + ": ros.namespace must start with / (\"" + *v + "\")";
         c.ros_namespace = *v == "/" ? "" : *v;
     }
-    if (auto v = ros["domain_id"].value<int64_t>()) {
-        if (*v < 0 || *v > 232) // the RTPS port formula's limit, as ROS_DOMAIN_ID's documentation says
-            return path + ": ros.domain_id must be 0..232";
+    // value_exact: toml++ 3.3's value<int64_t>() of a float casts it unchecked, undefined past
+    // int64's range (fuzz_ros_config); a float domain is refused instead.
+    if (const toml::node* n = ros["domain_id"].node()) {
+        const auto v = n->value_exact<int64_t>();
+        if (!v || *v < 0 || *v > 232) // the RTPS port formula's limit, as ROS_DOMAIN_ID's documentation says
+            return path + ": ros.domain_id must be an integer 0..232";
         c.domain_id = static_cast<uint32_t>(*v);
     }
     if (auto v = ros["range_layout"].value<std::string>()) {
