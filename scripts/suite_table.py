@@ -351,8 +351,9 @@ def record(rows, steps, failed, record_path):
         "written_by": "scripts/suite_table.py --record (scripts/test.sh)",
         "finished": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%MZ"),
         "commit": commit,
-        # The record file itself is left out: it is the one file this run rewrites.
-        "tree_clean": all(line.split(maxsplit=1)[-1] == os.path.relpath(record_path, TOP)
+        # The records this run rewrites are left out: this one and the figures' (bench/figures.json).
+        "tree_clean": all(line.split(maxsplit=1)[-1] in (os.path.relpath(record_path, TOP),
+                                                         os.path.join("bench", "figures.json"))
                           for line in git("status", "--porcelain", "--untracked-files=no").splitlines())
         if commit else None,
         "ci": CI,
