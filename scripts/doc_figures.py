@@ -124,7 +124,9 @@ class Missing(Exception):
 def lookup(source, unit_word, records):
     """(values, unit) of a quoted figure's source."""
     if "#" not in source:
-        rec = records.setdefault(RECORD, load(RECORD))
+        if RECORD not in records:
+            records[RECORD] = load(RECORD)
+        rec = records[RECORD]
         fig = (rec.get("figures") or {}).get(source)
         if fig is None:
             raise Missing(f"{source}: no such figure in bench/figures.json (no test printed it in the recorded run)")

@@ -5,7 +5,8 @@ import os
 import time
 
 import harness
-from bounds import VANISHED_CPU_PERCENT_MAX
+from bounds import VANISHED_CPU_PERCENT_MAX, VANISHED_LOG_LINES_MAX, VANISHED_WINDOW_S
+from figures import figure
 from harness import (DEFAULT_MT, MOTORS, PROPS, ROOT, VEHICLE, poll, pump_main_loop, speed_byte)
 
 
@@ -27,6 +28,20 @@ def assert_idle_cpu(test, cpu_percent):
     the same idle loop, 0.5-0.6 % natively), as soak.py's RSS."""
     if not harness.EMULATOR and not harness.SANITIZED:
         test.assertLessEqual(cpu_percent, VANISHED_CPU_PERCENT_MAX)
+
+
+def assert_quiet_while_gone(test, rig, pid):
+    """The daemon (pid) with its devices gone, over VANISHED_WINDOW_S: its CPU and its log lines,
+    printed as figures, idle (assert_idle_cpu) and at most VANISHED_LOG_LINES_MAX lines."""
+    cpu0, t0 = cpu_seconds(pid), time.monotonic()
+    lines0 = rig.log().count("\n")
+    time.sleep(VANISHED_WINDOW_S)
+    cpu = (cpu_seconds(pid) - cpu0) / (time.monotonic() - t0) * 100
+    lines = rig.log().count("\n") - lines0
+    figure("simulator_gone.cpu_percent", cpu, "%", "daemon CPU over %.0f s with the simulator gone" % VANISHED_WINDOW_S)
+    figure("simulator_gone.log_lines", lines, "count", "log lines over %.0f s with the simulator gone" % VANISHED_WINDOW_S)
+    assert_idle_cpu(test, cpu)
+    test.assertLessEqual(lines, VANISHED_LOG_LINES_MAX)
 
 
 def hexes(bs):
