@@ -40,13 +40,20 @@ template <typename F> void each(std::string_view s, char sep, F f) {
     }
 }
 
+// The value of one name=value item when it is `name`'s; nullopt otherwise.
+std::optional<std::string_view> item_value(std::string_view item, std::string_view name) {
+    item = trim(item);
+    if (item.size() > name.size() && item.starts_with(name) && item[name.size()] == '=')
+        return item.substr(name.size() + 1);
+    return std::nullopt;
+}
+
 // name=value in a list of them ("a=1&key=K", "x=1; caracara_key_8765=K"); nullopt when absent.
 std::optional<std::string_view> value_of(std::string_view list, char sep, std::string_view name) {
     std::optional<std::string_view> found;
     each(list, sep, [&](std::string_view item) {
-        item = trim(item);
-        if (item.size() > name.size() && item.starts_with(name) && item[name.size()] == '=')
-            found = item.substr(name.size() + 1);
+        if (const auto v = item_value(item, name))
+            found = v;
     });
     return found;
 }
@@ -90,7 +97,10 @@ ForwardKey::Judgement ForwardKey::judge(std::string_view head) const {
     const std::string_view target = line.substr(sp1 + 1, sp2 - sp1 - 1);
     // No control byte in the request line: the target goes back out in a redirect's Location,
     // where a line break would add headers of the client's choosing (fuzz_bridge_http found it).
-    if (!target.starts_with('/') || std::any_of(line.begin(), line.end(), is_control))
+    // No space in the target either (RFC 9112 3.2): "/? key=K" would find the key and leave it
+    // in the Location (fuzz_bridge_http again).
+    if (!target.starts_with('/') || std::any_of(line.begin(), line.end(), is_control) ||
+        target.find(' ') != std::string_view::npos)
         return j;
     bool upgrade = false;
     std::optional<std::string_view> cookie;
@@ -117,7 +127,7 @@ ForwardKey::Judgement ForwardKey::judge(std::string_view head) const {
             // The same address without the key: it leaves the address bar and the page's own URL.
             std::string rest;
             each(query, '&', [&](std::string_view item) {
-                if (!item.empty() && !(item.starts_with(kKeyParam) && item.substr(kKeyParam.size()).starts_with('=')))
+                if (!item.empty() && !item_value(item, kKeyParam))
                     rest += (rest.empty() ? "" : "&") + std::string(item);
             });
             j.verdict = Verdict::Redirect;
