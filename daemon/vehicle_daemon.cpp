@@ -36,10 +36,7 @@ std::optional<FailsafeReading> VehicleDaemon::reading(std::size_t i) const {
     const auto& st = bus_.thruster(i).last_status();
     if (!st || !bus_.thruster(i).online())
         return std::nullopt;
-    FailsafeReading r{st->faults.bits, std::nullopt};
-    if (st->variant == Variant::SeaBotix)
-        r.temperature_c = st->seabotix.temperature_c;
-    return r;
+    return FailsafeReading{st->faults.bits, st->temperature_c};
 }
 
 std::string VehicleDaemon::start() {

@@ -11,22 +11,12 @@ namespace caracara::dbus {
 
 namespace {
 
-// Status fields of either controller variant, as the Thruster interface presents them; the
-// values before the first status read.
-constexpr uint8_t kStopped = 0x80;
-
-uint8_t actual_speed(const ThrusterStatus& s) {
-    if (s.variant == Variant::SeaBotix)
-        return s.seabotix.speed;
-    return s.legacy.max_power_meaning == MaxPowerMeaning::PowerSpeed ? s.legacy.max_power : kStopped;
-}
+// Status fields of either controller variant, as the Thruster interface presents them (0 where
+// the variant's reply does not carry one).
 double current_amps(const ThrusterStatus& s) { return s.current_deciamps ? *s.current_deciamps / 10.0 : 0.0; }
-double temperature_c(const ThrusterStatus& s) {
-    return s.variant == Variant::SeaBotix ? static_cast<double>(s.seabotix.temperature_c) : 0.0;
-}
-uint8_t firmware_revision(const ThrusterStatus& s) {
-    return s.variant == Variant::SeaBotix ? s.seabotix.firmware_revision : s.legacy.revision_code;
-}
+double temperature_c(const ThrusterStatus& s) { return s.temperature_c ? static_cast<double>(*s.temperature_c) : 0.0; }
+uint8_t actual_speed(const ThrusterStatus& s) { return s.actual_speed; }
+uint8_t firmware_revision(const ThrusterStatus& s) { return s.firmware_revision; }
 std::vector<std::string> fault_names(const ThrusterStatus& s) {
     std::vector<std::string> names;
     for (Fault f : kAllFaults)
@@ -64,8 +54,8 @@ constexpr Member kMembers[] = {
     property<[](O o) { return config(o).reversed; }>("Reversed", kConst),
     property<[](O o) { return o.driver().online(); }>("Online", kChange, kTick),
     property<&ThrusterObject::ordered_value>("OrderedValue", kChange, kTick),
-    property<[](O o) { return o.driver().last_speed().value_or(kStopped); }>("OrderedSpeed", kChange, kTick),
-    property<[](O o) { return status<actual_speed>(o, kStopped); }>("ActualSpeed", kChange, kTick),
+    property<[](O o) { return o.driver().last_speed().value_or(kSpeedStop); }>("OrderedSpeed", kChange, kTick),
+    property<[](O o) { return status<actual_speed>(o, kSpeedStop); }>("ActualSpeed", kChange, kTick),
     property<[](O o) { return status<current_amps>(o, 0.0); }>("Current", kChange, kTick),
     property<[](O o) { return status<temperature_c>(o, 0.0); }>("Temperature", kChange, kTick),
     property<[](O o) { return status<fault_names>(o, {}); }>("Faults", kChange, kTick),

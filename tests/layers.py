@@ -13,7 +13,10 @@
 - no include cycle between files: a header and its source are one unit (x.hpp + x.cpp), and
   no chain of includes leads from a unit back to itself;
 - no product source file (all but bench/, tests/ and fuzz/) is over 600 lines;
-- CMake lists sources (no GLOB).
+- CMake lists sources (no GLOB);
+- the thruster controller variants are told apart under drivers/ alone (drivers/protocol's
+  VariantFormat table and codec): no product file above drivers/ tests a `Variant::` value or
+  reads a variant's own status fields (`.seabotix.`, `.legacy.`).
 Prints each violation; exit 1 when there is one."""
 import os
 import re
@@ -28,6 +31,7 @@ COMPOSITION_ROOT = "daemon/main.cpp"
 NOT_PRODUCT = ("bench", "tests", "fuzz")
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 SOURCE = (".cpp", ".hpp", ".h")
+VARIANT_TEST = re.compile(r"\bVariant::\w+|\.(?:seabotix|legacy)\.")
 
 
 def layer_of(rel):
@@ -60,6 +64,11 @@ for top in ["core", "drivers", "daemon", "dbus"] + TOP:
             text = open(path, encoding="utf-8", errors="replace").read()
             if layer.split("/")[0] not in NOT_PRODUCT and text.count("\n") > 600:
                 problems.append("%s: %d lines (at most 600)" % (rel, text.count("\n")))
+            if (layer in ORDER and ORDER.index(layer) > ORDER.index("drivers/devices")
+                    and rel != COMPOSITION_ROOT):
+                for m in VARIANT_TEST.finditer(text):
+                    problems.append("%s:%d: %s above drivers/: read ThrusterStatus's common fields"
+                                    % (rel, text.count("\n", 0, m.start()) + 1, m.group(0)))
             for inc in INCLUDE.findall(text):
                 if not os.path.exists(os.path.join(ROOT, inc)):
                     problems.append("%s: #include \"%s\" is not a path from the repository root" % (rel, inc))

@@ -100,8 +100,8 @@ PreflightRow PreflightChecks::thruster(std::size_t i, const ThrusterCounters& be
         return r;
     }
     r.observed = "answers as " + where(i) + ", no faults";
-    if (s.variant == Variant::SeaBotix) {
-        const unsigned temp = s.seabotix.temperature_c;
+    if (s.temperature_c) {
+        const unsigned temp = *s.temperature_c;
         r.observed += fmt(", %u C", temp);
         if (temp >= config_.failsafe.overtemp_clear_c) {
             r.advice = fmt("let it cool below %u C (failsafe.overtemp_clear_c) or check its temperature sensor",

@@ -39,11 +39,10 @@ const dive::Sample& DiveSampler::sample(uint32_t t_100us) {
                 t.flags |= dive::kCurrentKnown;
                 t.current_da = *st->current_deciamps;
             }
-            if (st->variant == Variant::SeaBotix) {
-                t.temperature_c = st->seabotix.temperature_c;
-                if (st->seabotix.speed_motor)
-                    t.speed = clamp16(*st->seabotix.speed_motor);
-            }
+            if (st->temperature_c)
+                t.temperature_c = *st->temperature_c;
+            if (st->speed_motor)
+                t.speed = clamp16(*st->speed_motor);
         }
         const ThrusterCounters& c = d.counters();
         t.nacks = static_cast<uint32_t>(c.nacks);

@@ -7,14 +7,14 @@
 namespace caracara {
 
 ProbeAnswer classify_probe_reply(uint8_t mt_write, std::span<const uint8_t> reply) {
-    for (Variant v : {Variant::SeaBotix, Variant::Legacy}) {
+    for (const VariantFormat& format : kVariantFormats) {
+        const Variant v = format.variant;
         if (reply.size() < status_length(v))
             continue;
         const DecodedStatus d = decode_status(v, mt_write, reply.first(status_length(v)));
         if (!d.ok())
             continue;
-        const uint8_t revision = v == Variant::SeaBotix ? d.status.seabotix.firmware_revision
-                                                        : d.status.legacy.revision_code;
+        const uint8_t revision = d.status.firmware_revision;
         return {v, revision};
     }
     return {};

@@ -184,14 +184,25 @@ DecodedStatus decode_status(Variant v, uint8_t mt_write, std::span<const uint8_t
         out.error = CodecError::BadChecksum;
         return out;
     }
-    if (v == Variant::SeaBotix) {
-        out.status.seabotix = decode_seabotix_fields(reply);
-        out.status.faults = out.status.seabotix.faults;
-        out.status.current_deciamps = out.status.seabotix.current_deciamps;
-    } else {
-        out.status.legacy = decode_legacy_fields(reply);
-        out.status.faults = out.status.legacy.faults;
-        out.status.current_deciamps = out.status.legacy.current_deciamps;
+    ThrusterStatus& st = out.status;
+    switch (v) {
+    case Variant::SeaBotix:
+        st.seabotix = decode_seabotix_fields(reply);
+        st.faults = st.seabotix.faults;
+        st.current_deciamps = st.seabotix.current_deciamps;
+        st.temperature_c = st.seabotix.temperature_c;
+        st.speed_motor = st.seabotix.speed_motor;
+        st.actual_speed = st.seabotix.speed;
+        st.firmware_revision = st.seabotix.firmware_revision;
+        break;
+    case Variant::Legacy:
+        st.legacy = decode_legacy_fields(reply);
+        st.faults = st.legacy.faults;
+        st.current_deciamps = st.legacy.current_deciamps;
+        if (st.legacy.max_power_meaning == MaxPowerMeaning::PowerSpeed)
+            st.actual_speed = st.legacy.max_power;
+        st.firmware_revision = st.legacy.revision_code;
+        break;
     }
     return out;
 }

@@ -26,9 +26,29 @@
 namespace caracara {
 
 
-// Status reply length in bytes, first byte and checksum included.
-constexpr std::size_t status_length(Variant v) { return v == Variant::SeaBotix ? 7 : 4; }
+// The controller variants, one row each: what a status reply carries. This table and the codec
+// below are the one place the variants are told apart; code above drivers/ reads the common
+// fields of ThrusterStatus (temperature_c, speed_motor, actual_speed, firmware_revision) and
+// never tests the variant (tests/layers.py checks).
+struct VariantFormat {
+    Variant variant;
+    std::size_t status_length;  // bytes, first byte and checksum included
+    bool reports_temperature;   // a TEMPERATURE byte (SeaBotix IDS 8.4.2)
+    bool reports_speed;         // a SPEED byte read back (SeaBotix IDS 8.4.2)
+};
+inline constexpr std::array<VariantFormat, 2> kVariantFormats{{
+    {Variant::SeaBotix, 7, true, true},  // [MT_read, STATUS, FAULT, CURRENT, SPEED, TEMPERATURE, CSUM]
+    {Variant::Legacy, 4, false, false},  // [MT_read, STATUS, MAX POWER, CSUM] (IDS 8.4.1)
+}};
+constexpr const VariantFormat& variant_format(Variant v) {
+    for (const VariantFormat& f : kVariantFormats)
+        if (f.variant == v)
+            return f;
+    return kVariantFormats[0];
+}
+constexpr std::size_t status_length(Variant v) { return variant_format(v).status_length; }
 inline constexpr std::size_t kMaxStatusLength = 7;
+static_assert(kVariantFormats[0].status_length <= kMaxStatusLength && kVariantFormats[1].status_length <= kMaxStatusLength);
 inline constexpr std::size_t kOrderLength = 3;  // bytes after the address byte
 
 
@@ -211,11 +231,16 @@ struct LegacyStatus {
     std::optional<int32_t> power_motor;       // when meaning == PowerSpeed and the byte is a valid SPEED
 };
 
-// A decoded status reply of either variant; only the member of `variant` is meaningful.
+// A decoded status reply of either variant; only the member of `variant` is meaningful. The
+// fields before it are common: what the daemon, the dive files and D-Bus read.
 struct ThrusterStatus {
     Variant variant = Variant::SeaBotix;
     FaultSet faults;                          // common to both variants
     std::optional<uint8_t> current_deciamps;  // when the reply carries a motor current
+    std::optional<uint8_t> temperature_c;     // when the reply carries a temperature
+    std::optional<int32_t> speed_motor;       // the SPEED read back as a motor value, when carried and valid
+    uint8_t actual_speed = kSpeedStop;        // SPEED byte, or a brushed legacy's power in SPEED units; else stop
+    uint8_t firmware_revision = 0;            // the STATUS byte's revision field
     SeaBotixStatus seabotix;
     LegacyStatus legacy;
 

@@ -195,6 +195,11 @@ TEST_CASE("SeaBotix status decodes every field") {
     CHECK(s.speed_motor == 87);
     CHECK(s.temperature_c == 25);
     CHECK_FALSE(d.status.motor_stopped_by_fault());
+    // The common fields, which everything above drivers/ reads.
+    CHECK(d.status.temperature_c == uint8_t{25});
+    CHECK(d.status.speed_motor == 87);
+    CHECK(d.status.actual_speed == 0x81);
+    CHECK(d.status.firmware_revision == 0);
 }
 
 TEST_CASE("SeaBotix status with a wrapping checksum and every field at its top") {
@@ -323,6 +328,12 @@ TEST_CASE("legacy status: software revisions and the meaning of MAX POWER") {
     CHECK(d.status.current_deciamps == uint8_t{12});
     CHECK_FALSE(d.status.legacy.power_motor.has_value());
     CHECK_FALSE(d.status.faults.any());
+    // Common fields: no temperature or SPEED in a legacy reply; MAX POWER is current here, so the
+    // speed shown is the stop byte; the revision is STATUS bits 5-7.
+    CHECK_FALSE(d.status.temperature_c.has_value());
+    CHECK_FALSE(d.status.speed_motor.has_value());
+    CHECK(d.status.actual_speed == kSpeedStop);
+    CHECK(d.status.firmware_revision == 1);
 
     // Legacy brushed (bit 6 -> code 2): MAX POWER is the power set, in SPEED units, 0xE6 = full.
     // CSUM: 85 + 64 + 230 = 379 = 0x17B -> 0x7B (wraps)
@@ -333,6 +344,8 @@ TEST_CASE("legacy status: software revisions and the meaning of MAX POWER") {
     CHECK(d.status.legacy.max_power_meaning == MaxPowerMeaning::PowerSpeed);
     CHECK(d.status.legacy.power_motor == 8850);
     CHECK_FALSE(d.status.current_deciamps.has_value());
+    CHECK(d.status.actual_speed == 0xE6);  // a brushed legacy's power, in SPEED units
+    CHECK(d.status.firmware_revision == 2);
 
     // Brushed revision 4 (bit 7 -> code 4), power 0x7E = one step reverse.
     // CSUM: 85 + 128 + 126 = 339 = 0x153 -> 0x53
@@ -413,6 +426,16 @@ TEST_CASE("status encoders produce what the decoder accepts") {
 
 // ---------------------------------------------------------------------------------------------
 // Names and variant semantics
+
+TEST_CASE("every variant has its row in the format table, and its status length there") {
+    REQUIRE(kVariantFormats.size() == EnumNames<Variant>::table.size());
+    for (const auto& [v, name] : EnumNames<Variant>::table) {
+        INFO(name);
+        CHECK(variant_format(v).variant == v);
+    }
+    CHECK(status_length(Variant::SeaBotix) == 7);  // SeaBotix IDS 8.4.2
+    CHECK(status_length(Variant::Legacy) == 4);    // SeaBotix IDS 8.4.1
+}
 
 TEST_CASE("variant names and fault semantics") {
     CHECK(variant_name(Variant::SeaBotix) == "seabotix");
