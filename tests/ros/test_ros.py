@@ -183,6 +183,18 @@ class Codec:
         self.p.stdout.close()
 
 
+_TYPE_HASHES = {}
+
+
+def type_hash(distro, type_):
+    """The type's RIHS01 hash as rosidl computes it from the distro's published definitions
+    (type_hash.mjs), not from caracara-ros."""
+    if (distro, type_) not in _TYPE_HASHES:
+        _TYPE_HASHES[distro, type_] = subprocess.run(["node", "type_hash.mjs", distro, type_], cwd=HERE, check=True,
+                                                     capture_output=True, text=True).stdout.strip()
+    return _TYPE_HASHES[distro, type_]
+
+
 def network_is_private():
     """Inside the namespace ros.cmake made: only the loopback interface, multicast on, routed."""
     links = subprocess.run(["ip", "-o", "link"], capture_output=True, text=True, check=True).stdout.splitlines()
@@ -336,15 +348,22 @@ class RosTestCase(VehicleTestCase):
         if code != 0:
             raise AssertionError("caracara-ros exited with %s on SIGTERM:\n%s" % (code, cls.rig.log("caracara-ros")))
 
-    def listen(self, seconds, topics=PUBLISHED, during=None):
-        """The peer's view for `seconds`: (samples by topic, decoded, with time), participants,
-        writers by topic, and every writer and reader discovered (a list). `during` is called every
-        20 ms while the peer listens."""
-        args = ["%s=%s" % (t, ty) for t, ty in topics.items()]
+    def listen(self, seconds, topics=PUBLISHED, during=None, distro=None, typehash=True):
+        """The peer's view for `seconds`: (samples by topic, decoded, with time and the bytes as they
+        came), participants, writers by topic, and every writer and reader discovered (a list).
+        `during` is called every 20 ms while the peer listens. distro: the peer built from that
+        distro's definitions (else the class's). typehash: its Range readers announce their type's
+        hash in USER_DATA as Iron's and later rmw do ("typehash=RIHS01_...;", Jazzy's with
+        variance), none for Humble's; False: none (a Humble peer, or a non-ROS reader, of Jazzy's type)."""
+        distro = distro or self.DISTRO
+        user_data = lambda t, ty: (  # noqa: E731
+            "=typehash=%s;" % type_hash(distro, ty) if typehash and distro != "humble" and ty == "sensor_msgs/Range" else "")
+        args = ["%s=%s%s" % (t, ty, user_data(t, ty)) for t, ty in topics.items()]
         # Into files, not pipes: nothing reads a pipe while `during` runs, and a full one would
         # stop the peer.
         with tempfile.TemporaryFile("w+") as out_f, tempfile.TemporaryFile("w+") as err_f:
-            p = subprocess.Popen([self.peer, "listen", str(seconds)] + args, stdout=out_f, stderr=err_f, text=True)
+            p = subprocess.Popen([build_peer(distro), "listen", str(seconds)] + args, stdout=out_f, stderr=err_f,
+                                 text=True)
             while p.poll() is None:
                 if during:
                     during()
@@ -357,8 +376,8 @@ class RosTestCase(VehicleTestCase):
         for line in out.splitlines():
             o = json.loads(line)
             if "topic" in o:
-                msg = self.codec.decode(topics[o["topic"]], o["cdr"], self.DISTRO)
-                samples.setdefault(o["topic"], []).append((o["t_ns"], msg))
+                msg = self.codec.decode(topics[o["topic"]], o["cdr"], distro)
+                samples.setdefault(o["topic"], []).append((o["t_ns"], msg, o["wire"]))
             elif "participant" in o:
                 participants.append(o)
             elif "writer" in o:
@@ -385,7 +404,7 @@ class RosTestCase(VehicleTestCase):
         self.assertEqual(w["type"], "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_")
         self.assertTrue(w["reliable"] and w["transient_local"] and w["xcdr1"], w)
         # caracara-ros's own (a test's peer may write one too): its gid begins with the GUID.
-        info = [m for _, m in samples["ros_discovery_info"] if bytes(m["gid"]["data"]).hex().startswith(prefix)][-1]
+        info = [m for _, m, _ in samples["ros_discovery_info"] if bytes(m["gid"]["data"]).hex().startswith(prefix)][-1]
         pad = "00" * (GID_BYTES[self.DISTRO] - 16)
         gid_hex = lambda g: bytes(g["data"]).hex()  # noqa: E731
         self.assertEqual(gid_hex(info["gid"]), guid + pad)
@@ -473,7 +492,7 @@ class RosTestCase(VehicleTestCase):
         self.assertGreater(len(attitude), 10)
         unjudged = {}
         for topic, msgs in samples.items():
-            for _, m in msgs:
+            for _, m, _ in msgs:
                 if topic == "rt/tf":
                     tf = m["transforms"][0]
                     self.assertEqual((tf["header"]["frame_id"], tf["child_frame_id"]), (world, body))
@@ -534,7 +553,7 @@ class RosTestCase(VehicleTestCase):
                 self.assertTrue(got, "nothing on " + topic)
                 start = got[0][0] + 2.5e9
                 startup_gap_ms = max((b[0] - a[0]) / 1e6 for a, b in zip(got, got[1:]) if a[0] < start)
-                got = [(t, m) for t, m in got if start <= t < start + ROS_SENSOR_RATE_WINDOW_S * 10 ** 9]
+                got = [(t, m) for t, m, _ in got if start <= t < start + ROS_SENSOR_RATE_WINDOW_S * 10 ** 9]
                 stamps = []
                 for t_ns, m in got:
                     stamp = stamp_of(topic, m)
@@ -600,7 +619,7 @@ class RosTestCase(VehicleTestCase):
         sign = -1 if convention == "enu" else 1
         for topic in ORIENTATION_TOPICS:
             # The turn's readings: not one from before the record began (check_orientation).
-            msgs = [m for _, m in samples[topic] if stamp_of(topic, m) + 50e6 >= attitude[0][0]]
+            msgs = [m for _, m, _ in samples[topic] if stamp_of(topic, m) + 50e6 >= attitude[0][0]]
             qs = [m["orientation"] if topic == "rt/caracara/imu" else m["transforms"][0]["transform"]["rotation"]
                   for m in msgs]
             yaws = unwrap([quaternion_yaw(q) for q in qs])
@@ -1006,13 +1025,17 @@ class JazzyRangeTest(RosTestCase):
         self.check_discovery_info(["rt/caracara/kill"])
 
 
-def distro_status(samples):
-    """The last /diagnostics' "caracara: ros distro" status, its values as a dict."""
+def status_named(samples, name):
+    """The last /diagnostics' status `name`, its values as a dict."""
     msgs = samples.get("rt/diagnostics")
     assert msgs, "no /diagnostics received"
-    st = [s for s in msgs[-1][1]["status"] if s["name"] == "caracara: ros distro"]
+    st = [s for s in msgs[-1][1]["status"] if s["name"] == name]
     assert len(st) == 1, [s["name"] for s in msgs[-1][1]["status"]]
     return {**st[0], "values": {kv["key"]: kv["value"] for kv in st[0]["values"]}}
+
+
+def distro_status(samples):
+    return status_named(samples, "caracara: ros distro")
 
 
 class AutoDistroTest(RosTestCase):
@@ -1066,6 +1089,53 @@ class AutoDistroTest(RosTestCase):
                 self.assertEqual((status["values"]["speaking"], status["values"]["humble peers"],
                                   status["values"]["jazzy peers"], status["level"]), ("jazzy", "1", "1", 1), status)
                 self.assertIn("set range_layout to choose", status["message"])
+
+
+class RangeSubscriberTest(RosTestCase):
+    """No range_layout, and no ROS 2 node about (the distro stays Humble's): each subscriber of
+    range/N gets the Range it asks for, told by the type hash in its reader's USER_DATA as Jazzy's
+    rmw announces it ("typehash=RIHS01_...;", here computed from Jazzy's published definitions by
+    rosidl's rule, type_hash.mjs), none from Humble. The bytes as they came are read by the
+    reference deserializer with the subscriber's definition and written back the same: a Humble
+    sample is 4 bytes short for Jazzy's, a Jazzy one leaves 4 over for Humble's. The journal and
+    /diagnostics ("caracara: ros range layout") say which and why."""
+    DISTRO = "humble"
+    LAYOUT_IN_CONFIG = False
+    TOPICS = {"rt/caracara/range/0": "sensor_msgs/Range", "rt/diagnostics": "diagnostic_msgs/DiagnosticArray"}
+
+    def judge_range(self, samples, distro):
+        got = samples.get("rt/caracara/range/0")
+        self.assertTrue(got, "no Range the peer built from %s's definitions could read" % distro)
+        wire = got[-1][2]
+        r = self.codec.decode("sensor_msgs/Range", wire, distro)
+        self.assertEqual(self.codec.encode("sensor_msgs/Range", r, distro), wire)
+        self.assertEqual("variance" in r, distro == "jazzy")
+        self.assertAlmostEqual(r["range"], int(self.rig.sim_teensy("Distances")[0]) / 1000, delta=0.002)
+
+    def subscriber(self, distro):
+        """A subscriber of range/0 (and /diagnostics) built from `distro`'s definitions for 4 s:
+        its samples and what caracara-ros's journal said meanwhile."""
+        log_start = len(self.rig.log("caracara-ros"))
+        samples = self.listen(4, self.TOPICS, distro=distro)[0]
+        return samples, self.rig.log("caracara-ros")[log_start:]
+
+    def test_each_subscriber_gets_the_range_it_asks_for(self):
+        samples, log = self.subscriber("jazzy")
+        self.assertRegex(log, r"Range subscriber [0-9a-f.]+ on /caracara/range/0 asks for jazzy: typehash %s: "
+                              r"Range with variance \(Jazzy's\)" % type_hash("jazzy", "sensor_msgs/Range"))
+        self.assertIn("Range in jazzy's layout: the Range subscribers' types: 1 subscriber, all asking for jazzy", log)
+        self.judge_range(samples, "jazzy")
+        status = status_named(samples, "caracara: ros range layout")
+        self.assertEqual((status["values"]["layout"], status["values"]["jazzy subscribers"], status["level"]),
+                         ("jazzy", "1", 0), status)
+        self.assertEqual(distro_status(samples)["values"]["speaking"], "humble")  # not from ros_discovery_info
+        samples, log = self.subscriber("humble")
+        self.assertRegex(log, r"Range subscriber [0-9a-f.]+ on /caracara/range/0 asks for humble: no typehash")
+        self.assertIn("Range in humble's layout: the Range subscribers' types: 1 subscriber, all asking for humble", log)
+        self.judge_range(samples, "humble")
+        status = status_named(samples, "caracara: ros range layout")
+        self.assertEqual((status["values"]["layout"], status["values"]["humble subscribers"],
+                          status["values"]["jazzy subscribers"], status["level"]), ("humble", "1", "0", 0), status)
 
 
 class NedFrdTest(RosTestCase):
@@ -1188,7 +1258,7 @@ class OneWriterTest(RosTestCase):
                 # On /diagnostics: the holder, the refusals counted and growing, message by message
                 # (a refusal is there within a second: the diagnostics come at 1 Hz), the last named.
                 counts = []
-                for t_ns, m in samples["rt/diagnostics"]:
+                for t_ns, m, _ in samples["rt/diagnostics"]:
                     st = commands_status_of(m)
                     self.assertEqual(st["values"]["holder"], first_gid)
                     self.assertEqual(st["level"], 1, "a recent refusal is a WARN")

@@ -66,6 +66,12 @@ std::string commands_refusal(const RosConfig& config, bool loopback);
 bool is_loopback(const std::string& interface);
 // Distance sensor i's mount: the config's, else range_i at the origin facing forward.
 SensorMount range_mount(const RosConfig& config, std::size_t i);
+// Every mount /tf_static carries, under the base frame itself (REP 103's body FLU, also with
+// frame_convention = "ned"): the IMU, then each distance sensor, the config's and up to `ranges`
+// the Teensy reports.
+std::vector<SensorMount> sensor_mounts(const RosConfig& config, std::size_t ranges);
+// A mount's rotation: URDF's rpy (fixed axes x, y, z) is the Z-Y-X Euler rotation yaw, pitch, roll.
+frames::Quaternion mount_rotation(const SensorMount& m);
 
 // The ROS topic name under the namespace ("state" -> "/caracara/state"; "/diagnostics" stays).
 std::string ros_topic(const RosConfig& config, const std::string& name);
