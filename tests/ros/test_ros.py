@@ -798,7 +798,7 @@ class BytesTest(unittest.TestCase):
 ROSBAG2_QOS_KEYS = {"history", "depth", "reliability", "durability", "deadline", "lifespan", "liveliness",
                     "liveliness_lease_duration", "avoid_ros_namespace_conventions"}
 RMW_KEEP_LAST, RMW_RELIABLE, RMW_TRANSIENT_LOCAL, RMW_VOLATILE, RMW_LIVELINESS_AUTOMATIC = 1, 1, 1, 2, 1
-LATCHED_TOPICS = ("/caracara/state", "/caracara/killed", "/caracara/kill_source")
+LATCHED_TOPICS = ("/caracara/state", "/caracara/killed", "/caracara/kill_source", "/tf_static")
 
 
 class DiveExportTest(unittest.TestCase):
@@ -839,6 +839,58 @@ class DiveExportTest(unittest.TestCase):
                                       "--out", out], capture_output=True, text=True)
             self.assertNotEqual(r.returncode, 0)
             self.assertIn("--distro takes humble or jazzy, not 'iron'", r.stderr)
+
+    def test_config_namespace_and_frames(self):
+        """--ros-config: the topics under the config's namespace, the frames its names in its
+        convention (NED here: _ned / _frd), each Range in its mount's frame, /tf_static the mounts,
+        as caracara-ros names them live; a bad config refused by name, no file written."""
+        npm_ci(HERE)
+        dives = os.path.join(SOURCE, "tests", "dives")
+        ctl = harness.command("caracaractl")
+        path = os.path.join(dives, sorted(n for n in os.listdir(dives) if n.endswith(".cdive"))[0])
+        with tempfile.TemporaryDirectory() as d:
+            conf, out = os.path.join(d, "ros.toml"), os.path.join(d, "dive.mcap")
+            with open(conf, "w") as f:
+                f.write('[ros]\nnamespace = "/fleet/auv2"\nworld_frame = "map"\nbase_frame = "hull"\n'
+                        'frame_convention = "ned"\nrange_max_m = 30.0\n[ros.imu]\nframe = "ahrs"\nrpy = [0, 0, 1.5]\n'
+                        '[[ros.range]]\nframe = "sonar_front"\nxyz = [0.4, 0, -0.1]\n')
+            r = subprocess.run(ctl + ["export", path, "--format", "mcap", "--encoding", "cdr", "--ros-config", conf,
+                                      "--out", out], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            check = subprocess.run(["node", "mcap_ros_check.mjs", out], cwd=HERE, capture_output=True, text=True)
+            self.assertEqual(check.returncode, 0, check.stderr)
+            bag = json.loads(check.stdout)
+            msgs = bag["messages"]
+            ranges = sorted(t for t in bag["topics"] if "/range/" in t)
+            self.assertTrue(ranges)
+            self.assertEqual(set(bag["topics"]), {"/fleet/auv2/" + t for t in (
+                "imu", "joint_states", "thrusters/ordered", "state", "killed", "kill_source")} |
+                {"/tf", "/tf_static", "/diagnostics"} | set(ranges))
+            self.assertEqual(ranges, ["/fleet/auv2/range/%d" % i for i in range(len(ranges))])
+            self.assertEqual({m["header"]["frame_id"] for m in msgs["/fleet/auv2/imu"]}, {"hull_frd"})
+            self.assertEqual({(t["header"]["frame_id"], t["child_frame_id"]) for m in msgs["/tf"] for t in m["transforms"]},
+                             {("map_ned", "hull_frd")})
+            self.assertEqual({m["header"]["frame_id"] for m in msgs["/fleet/auv2/joint_states"]}, {"hull"})
+            for i, topic in enumerate(ranges):
+                self.assertEqual({(m["header"]["frame_id"], m["max_range"]) for m in msgs[topic]},
+                                 {("sonar_front" if i == 0 else "range_%d" % i, 30.0)})
+            static = msgs["/tf_static"]
+            self.assertEqual(len(static), 1)
+            mounts = {t["child_frame_id"]: t for t in static[0]["transforms"]}
+            self.assertEqual(set(mounts), {"ahrs", "sonar_front"} | {"range_%d" % i for i in range(1, len(ranges))})
+            self.assertEqual({t["header"]["frame_id"] for t in mounts.values()}, {"hull"})
+            self.assertEqual(mounts["sonar_front"]["transform"]["translation"], {"x": 0.4, "y": 0, "z": -0.1})
+            q = mounts["ahrs"]["transform"]["rotation"]
+            self.assertAlmostEqual(quaternion_yaw(q), 1.5, places=9)
+            # A bad setting: refused by name, nothing written.
+            with open(conf, "w") as f:
+                f.write('[ros]\nbase_frame = "hull frame"\n')
+            os.unlink(out)
+            r = subprocess.run(ctl + ["export", path, "--format", "mcap", "--encoding", "cdr", "--ros-config", conf,
+                                      "--out", out], capture_output=True, text=True)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("ros.base_frame must be a frame name", r.stderr)
+            self.assertFalse(os.path.exists(out))
 
     def judge_replay(self, bag, distro):
         """What `ros2 bag play` offers each topic with, and what `ros2 bag info` names the distro."""

@@ -22,6 +22,9 @@ struct SensorMount {
     frames::Vec3 xyz, rpy;
 };
 
+// Where caracara-ros and caracaractl export read the settings unless told (a missing one: the defaults).
+inline constexpr const char* kDefaultConfigPath = "/etc/caracara/ros.toml";
+
 struct RosConfig {
     std::string ros_namespace = "/caracara";
     uint32_t domain_id = 0;           // ROS_DOMAIN_ID, else 0; the file's domain_id wins
