@@ -22,6 +22,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import unittest
 
@@ -163,13 +164,15 @@ class Codec:
     """cdr.mjs: @foxglove/rosmsg2-serialization, one request a line."""
 
     def __init__(self):
+        self.lock = threading.Lock()  # one request and its answer at a time, whichever thread asks
         self.p = subprocess.Popen(["node", "cdr.mjs"], cwd=HERE, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                   text=True)
 
     def ask(self, req):
-        self.p.stdin.write(json.dumps(req) + "\n")
-        self.p.stdin.flush()
-        return json.loads(self.p.stdout.readline(), parse_constant=lambda c: float(c))
+        with self.lock:
+            self.p.stdin.write(json.dumps(req) + "\n")
+            self.p.stdin.flush()
+            return json.loads(self.p.stdout.readline(), parse_constant=lambda c: float(c))
 
     def encode(self, type_, msg, distro="humble"):
         return self.ask({"op": "encode", "distro": distro, "type": type_, "msg": msg})["hex"]
@@ -1164,11 +1167,11 @@ class RangeSubscriberTest(RosTestCase):
         self.assertEqual("variance" in r, distro == "jazzy")
         self.assertAlmostEqual(r["range"], int(self.rig.sim_teensy("Distances")[0]) / 1000, delta=0.002)
 
-    def subscriber(self, distro):
-        """A subscriber of range/0 (and /diagnostics) built from `distro`'s definitions for 4 s:
-        its samples and what caracara-ros's journal said meanwhile."""
+    def subscriber(self, distro, seconds=4):
+        """A subscriber of range/0 (and /diagnostics) built from `distro`'s definitions for
+        `seconds`: its samples and what caracara-ros's journal said meanwhile."""
         log_start = len(self.rig.log("caracara-ros"))
-        samples = self.listen(4, self.TOPICS, distro=distro)[0]
+        samples = self.listen(seconds, self.TOPICS, distro=distro)[0]
         return samples, self.rig.log("caracara-ros")[log_start:]
 
     def test_each_subscriber_gets_the_range_it_asks_for(self):
@@ -1188,6 +1191,30 @@ class RangeSubscriberTest(RosTestCase):
         status = status_named(samples, "caracara: ros range layout")
         self.assertEqual((status["values"]["layout"], status["values"]["humble subscribers"],
                           status["values"]["jazzy subscribers"], status["level"]), ("humble", "1", "0", 0), status)
+
+    def test_subscribers_of_both_layouts(self):
+        """A Jazzy subscriber, then a Humble one beside it: one writer reaches both, so caracara-ros
+        keeps the layout it writes (a tie) and says in the journal and on /diagnostics (WARN) that
+        the other cannot read it; the Humble subscriber does get Jazzy's bytes, 4 over its type."""
+        log_start = len(self.rig.log("caracara-ros"))
+        jazzy = {}
+        t = threading.Thread(target=lambda: jazzy.update(self.listen(9, self.TOPICS, distro="jazzy")[0]))
+        t.start()
+        try:
+            poll(lambda: "Range in jazzy's layout" in self.rig.log("caracara-ros")[log_start:], 20,
+                 message="the Jazzy subscriber was not taken")
+            samples, log = self.subscriber("humble", seconds=3)
+        finally:
+            t.join(60)
+        self.assertIn("Range in jazzy's layout: Range subscribers asking for both (humble 1, jazzy 1): jazzy, written "
+                      "already; the others cannot read Range (set range_layout to choose)", log)
+        status = status_named(samples, "caracara: ros range layout")
+        self.assertEqual((status["values"]["layout"], status["values"]["humble subscribers"],
+                          status["values"]["jazzy subscribers"], status["level"]), ("jazzy", "1", "1", 1), status)
+        wire = samples["rt/caracara/range/0"][-1][2]
+        humble = self.codec.encode("sensor_msgs/Range", self.codec.decode("sensor_msgs/Range", wire, "humble"), "humble")
+        self.assertEqual(len(wire) - len(humble), 8, "not Jazzy's 4 bytes of variance over Humble's Range")
+        self.judge_range(jazzy, "jazzy")
 
 
 class NedFrdTest(RosTestCase):

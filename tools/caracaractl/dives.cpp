@@ -5,10 +5,9 @@
 #include "core/safety.hpp"
 #include "drivers/platform/dive_files.hpp"
 #include "drivers/protocol/seabotix.hpp"
+#include "tools/caracaractl/mcap_export.hpp"
 #include "tools/caracaractl/render.hpp"
 #include "tools/client/client.hpp"
-#include "tools/foxglove/dive_mcap.hpp"
-#include "tools/foxglove/dive_ros_mcap.hpp"
 #include "tools/foxglove/dive_summary.hpp"
 
 #include <cerrno>
@@ -282,39 +281,10 @@ int cmd_dives(const DiveOptions& o) {
     return kExitOk;
 }
 
-// The dive as MCAP on the live bridge's channels (JSON) or caracara-ros's topics (CDR), to --out
-// or to stdout when it is no terminal.
-int export_mcap(const dive::Dive& d, const DiveOptions& o) {
-    const std::string& out = o.out;
-    if (out.empty() && ::isatty(STDOUT_FILENO))
-        usage("MCAP is binary: give --out FILE or redirect the output");
-    // caracara-ros's settings, read as it reads them: --ros-config, else its default file if there.
-    caracara::ros::RosConfig config;
-    const std::string path = o.ros_config.value_or(caracara::ros::kDefaultConfigPath);
-    if (o.cdr && (o.ros_config || ::access(path.c_str(), F_OK) == 0))
-        if (const std::string e = caracara::ros::load_config(path, config); !e.empty())
-            throw Failure{kExitRefused, e};
-    const std::vector<uint8_t> bytes =
-        o.cdr ? caracara::foxglove::dive_to_ros_mcap(d, config, o.distro.value_or(caracara::ros::RangeLayout::Humble))
-              : caracara::foxglove::dive_to_mcap(d);
-    std::ofstream file;
-    if (!out.empty()) {
-        file.open(out, std::ios::binary | std::ios::trunc);
-        if (!file)
-            throw Failure{kExitRefused, "cannot write " + out + ": " + std::strerror(errno)};
-    }
-    std::ostream& s = out.empty() ? std::cout : file;
-    s.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    s.flush();
-    if (!s)
-        throw Failure{kExitRefused, "writing the MCAP file failed"};
-    return kExitOk;
-}
-
 int cmd_export(const DiveOptions& o) {
     const dive::Dive d = load(resolve(o), o.partial);
     if (o.mcap)
-        return export_mcap(d, o);
+        return export_mcap(d, {o.out, o.cdr, o.distro, o.ros_config});
     if (o.events)
         write_events(std::cout, d);
     else

@@ -29,7 +29,7 @@ struct RosConfig {
     std::string ros_namespace = "/caracara";
     uint32_t domain_id = 0;           // ROS_DOMAIN_ID, else 0; the file's domain_id wins
     RangeLayout range_layout = RangeLayout::Humble; // also ros_discovery_info's Gid: 24 bytes, Jazzy's 16
-    bool range_layout_given = false; // else the distro is the peers' (DistroDetector), Humble until one is seen
+    bool range_layout_given = false; // else the peers' distro (DistroDetector) and the Range subscribers' (RangeSubscribers)
     bool commands = false;            // Wrench and per-thruster commands; kill is always taken
     // An SROS2 enclave directory (keystore/enclaves/<path>): DDS Security on, "" = off.
     std::string security;
