@@ -3,8 +3,11 @@
 // (msg_to_idl.mjs), never from the project's IDL. Modes (samples travel as hex CDR,
 // encapsulation header included, so the test encodes and decodes them with
 // @foxglove/rosmsg2-serialization):
-//   peer listen SECONDS TOPIC=TYPE...   SECONDS once every reader matched a writer (10 s at most
-//                                       for that); one JSON line per sample {"topic","cdr","t_ns"}, per
+//   peer listen SECONDS TOPIC=TYPE[=USER_DATA]...   SECONDS once every reader matched a writer (10 s
+//                                       at most for that); USER_DATA the reader's (a ROS 2 reader's
+//                                       "typehash=RIHS01_...;"); one JSON line per sample
+//                                       {"topic","cdr","wire","t_ns"} (cdr: Fast CDR's bytes for what it
+//                                       read; wire: the bytes as they came), per
 //                                       discovered participant {"participant","guid","user_data"},
 //                                       writer {"writer","guid","type","reliable","transient_local","xcdr1"}
 //                                       and reader {"reader","guid"} (GUIDs as 32 hex digits)
@@ -72,21 +75,41 @@ using rtps::SerializedPayload_t;
 namespace {
 
 std::mutex out_mutex;
+// The bytes of the sample last deserialized on this thread, as they came: a take deserializes on
+// the taking thread, just before the sample is printed.
+thread_local std::vector<unsigned char> last_wire;
+
+// A generated type that keeps what it deserializes (how long it was: which layout was sent).
+template <typename Generated>
+class Wire : public Generated {
+public:
+#if __has_include(<fastdds/config.hpp>)
+    bool deserialize(eprosima::fastdds::rtps::SerializedPayload_t& p, void* data) override {
+        last_wire.assign(p.data, p.data + p.length);
+        return Generated::deserialize(p, data);
+    }
+#else
+    bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* p, void* data) override {
+        last_wire.assign(p->data, p->data + p->length);
+        return Generated::deserialize(p, data);
+    }
+#endif
+};
 
 TopicDataType* make_type(const std::string& t) {
     static const std::map<std::string, std::function<TopicDataType*()>> types = {
-        {"sensor_msgs/Imu", [] { return new sensor_msgs::msg::dds_::Imu_PubSubType(); }},
-        {"sensor_msgs/JointState", [] { return new sensor_msgs::msg::dds_::JointState_PubSubType(); }},
-        {"sensor_msgs/Range", [] { return new sensor_msgs::msg::dds_::Range_PubSubType(); }},
-        {"diagnostic_msgs/DiagnosticArray", [] { return new diagnostic_msgs::msg::dds_::DiagnosticArray_PubSubType(); }},
-        {"std_msgs/Bool", [] { return new std_msgs::msg::dds_::Bool_PubSubType(); }},
-        {"std_msgs/String", [] { return new std_msgs::msg::dds_::String_PubSubType(); }},
-        {"std_msgs/Empty", [] { return new std_msgs::msg::dds_::Empty_PubSubType(); }},
-        {"std_msgs/Float64MultiArray", [] { return new std_msgs::msg::dds_::Float64MultiArray_PubSubType(); }},
-        {"geometry_msgs/Wrench", [] { return new geometry_msgs::msg::dds_::Wrench_PubSubType(); }},
-        {"tf2_msgs/TFMessage", [] { return new tf2_msgs::msg::dds_::TFMessage_PubSubType(); }},
+        {"sensor_msgs/Imu", [] { return new Wire<sensor_msgs::msg::dds_::Imu_PubSubType>(); }},
+        {"sensor_msgs/JointState", [] { return new Wire<sensor_msgs::msg::dds_::JointState_PubSubType>(); }},
+        {"sensor_msgs/Range", [] { return new Wire<sensor_msgs::msg::dds_::Range_PubSubType>(); }},
+        {"diagnostic_msgs/DiagnosticArray", [] { return new Wire<diagnostic_msgs::msg::dds_::DiagnosticArray_PubSubType>(); }},
+        {"std_msgs/Bool", [] { return new Wire<std_msgs::msg::dds_::Bool_PubSubType>(); }},
+        {"std_msgs/String", [] { return new Wire<std_msgs::msg::dds_::String_PubSubType>(); }},
+        {"std_msgs/Empty", [] { return new Wire<std_msgs::msg::dds_::Empty_PubSubType>(); }},
+        {"std_msgs/Float64MultiArray", [] { return new Wire<std_msgs::msg::dds_::Float64MultiArray_PubSubType>(); }},
+        {"geometry_msgs/Wrench", [] { return new Wire<geometry_msgs::msg::dds_::Wrench_PubSubType>(); }},
+        {"tf2_msgs/TFMessage", [] { return new Wire<tf2_msgs::msg::dds_::TFMessage_PubSubType>(); }},
         {"rmw_dds_common/ParticipantEntitiesInfo",
-         [] { return new rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_PubSubType(); }},
+         [] { return new Wire<rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_PubSubType>(); }},
     };
     const auto it = types.find(t);
     if (it == types.end()) {
@@ -229,9 +252,12 @@ public:
             if (!info.valid_data)
                 continue;
             const std::string h = to_hex(type_, data);
+            SerializedPayload_t wire(static_cast<uint32_t>(last_wire.size()));
+            std::copy(last_wire.begin(), last_wire.end(), wire.data);
+            wire.length = static_cast<uint32_t>(last_wire.size());
             std::lock_guard l(out_mutex);
-            std::printf("{\"topic\":\"%s\",\"cdr\":\"%s\",\"t_ns\":%lld}\n", topic_.c_str(), h.c_str(),
-                        static_cast<long long>(now_ns()));
+            std::printf("{\"topic\":\"%s\",\"cdr\":\"%s\",\"wire\":\"%s\",\"t_ns\":%lld}\n", topic_.c_str(),
+                        h.c_str(), hex(wire).c_str(), static_cast<long long>(now_ns()));
             std::fflush(stdout);
         }
         type_.delete_data(data);
@@ -282,8 +308,8 @@ int main(int argc, char** argv) {
         std::vector<DataReader*> readers;
         for (int i = 3; i < argc; ++i) {
             const std::string a = argv[i];
-            const auto eq = a.find('=');
-            TypeSupport type(make_type(a.substr(eq + 1)));
+            const auto eq = a.find('='), eq2 = a.find('=', eq + 1);
+            TypeSupport type(make_type(a.substr(eq + 1, eq2 == std::string::npos ? eq2 : eq2 - eq - 1)));
             type.register_type(part);
             Topic* topic = part->create_topic(a.substr(0, eq), type.get_type_name(), TOPIC_QOS_DEFAULT);
             DataReaderQos rq = DATAREADER_QOS_DEFAULT;
@@ -301,6 +327,10 @@ int main(int argc, char** argv) {
                                  a.rfind("ros_discovery_info=", 0) == 0;
             if (!latched)
                 rq.durability().kind = VOLATILE_DURABILITY_QOS;
+            if (eq2 != std::string::npos) { // as rmw_dds_common puts a type hash there (Iron and later)
+                const std::string u = a.substr(eq2 + 1);
+                rq.user_data().data_vec(std::vector<rtps::octet>(u.begin(), u.end()));
+            }
             printers.push_back(std::make_unique<Printer>(a.substr(0, eq), type));
             readers.push_back(sub->create_datareader(topic, rq, printers.back().get()));
         }

@@ -22,6 +22,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import unittest
 
@@ -163,13 +164,15 @@ class Codec:
     """cdr.mjs: @foxglove/rosmsg2-serialization, one request a line."""
 
     def __init__(self):
+        self.lock = threading.Lock()  # one request and its answer at a time, whichever thread asks
         self.p = subprocess.Popen(["node", "cdr.mjs"], cwd=HERE, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                   text=True)
 
     def ask(self, req):
-        self.p.stdin.write(json.dumps(req) + "\n")
-        self.p.stdin.flush()
-        return json.loads(self.p.stdout.readline(), parse_constant=lambda c: float(c))
+        with self.lock:
+            self.p.stdin.write(json.dumps(req) + "\n")
+            self.p.stdin.flush()
+            return json.loads(self.p.stdout.readline(), parse_constant=lambda c: float(c))
 
     def encode(self, type_, msg, distro="humble"):
         return self.ask({"op": "encode", "distro": distro, "type": type_, "msg": msg})["hex"]
@@ -181,6 +184,18 @@ class Codec:
         self.p.stdin.close()
         self.p.wait(10)
         self.p.stdout.close()
+
+
+_TYPE_HASHES = {}
+
+
+def type_hash(distro, type_):
+    """The type's RIHS01 hash as rosidl computes it from the distro's published definitions
+    (type_hash.mjs), not from caracara-ros."""
+    if (distro, type_) not in _TYPE_HASHES:
+        _TYPE_HASHES[distro, type_] = subprocess.run(["node", "type_hash.mjs", distro, type_], cwd=HERE, check=True,
+                                                     capture_output=True, text=True).stdout.strip()
+    return _TYPE_HASHES[distro, type_]
 
 
 def network_is_private():
@@ -336,15 +351,22 @@ class RosTestCase(VehicleTestCase):
         if code != 0:
             raise AssertionError("caracara-ros exited with %s on SIGTERM:\n%s" % (code, cls.rig.log("caracara-ros")))
 
-    def listen(self, seconds, topics=PUBLISHED, during=None):
-        """The peer's view for `seconds`: (samples by topic, decoded, with time), participants,
-        writers by topic, and every writer and reader discovered (a list). `during` is called every
-        20 ms while the peer listens."""
-        args = ["%s=%s" % (t, ty) for t, ty in topics.items()]
+    def listen(self, seconds, topics=PUBLISHED, during=None, distro=None, typehash=True):
+        """The peer's view for `seconds`: (samples by topic, decoded, with time and the bytes as they
+        came), participants, writers by topic, and every writer and reader discovered (a list).
+        `during` is called every 20 ms while the peer listens. distro: the peer built from that
+        distro's definitions (else the class's). typehash: its Range readers announce their type's
+        hash in USER_DATA as Iron's and later rmw do ("typehash=RIHS01_...;", Jazzy's with
+        variance), none for Humble's; False: none (a Humble peer, or a non-ROS reader, of Jazzy's type)."""
+        distro = distro or self.DISTRO
+        user_data = lambda t, ty: (  # noqa: E731
+            "=typehash=%s;" % type_hash(distro, ty) if typehash and distro != "humble" and ty == "sensor_msgs/Range" else "")
+        args = ["%s=%s%s" % (t, ty, user_data(t, ty)) for t, ty in topics.items()]
         # Into files, not pipes: nothing reads a pipe while `during` runs, and a full one would
         # stop the peer.
         with tempfile.TemporaryFile("w+") as out_f, tempfile.TemporaryFile("w+") as err_f:
-            p = subprocess.Popen([self.peer, "listen", str(seconds)] + args, stdout=out_f, stderr=err_f, text=True)
+            p = subprocess.Popen([build_peer(distro), "listen", str(seconds)] + args, stdout=out_f, stderr=err_f,
+                                 text=True)
             while p.poll() is None:
                 if during:
                     during()
@@ -357,8 +379,8 @@ class RosTestCase(VehicleTestCase):
         for line in out.splitlines():
             o = json.loads(line)
             if "topic" in o:
-                msg = self.codec.decode(topics[o["topic"]], o["cdr"], self.DISTRO)
-                samples.setdefault(o["topic"], []).append((o["t_ns"], msg))
+                msg = self.codec.decode(topics[o["topic"]], o["cdr"], distro)
+                samples.setdefault(o["topic"], []).append((o["t_ns"], msg, o["wire"]))
             elif "participant" in o:
                 participants.append(o)
             elif "writer" in o:
@@ -385,7 +407,7 @@ class RosTestCase(VehicleTestCase):
         self.assertEqual(w["type"], "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_")
         self.assertTrue(w["reliable"] and w["transient_local"] and w["xcdr1"], w)
         # caracara-ros's own (a test's peer may write one too): its gid begins with the GUID.
-        info = [m for _, m in samples["ros_discovery_info"] if bytes(m["gid"]["data"]).hex().startswith(prefix)][-1]
+        info = [m for _, m, _ in samples["ros_discovery_info"] if bytes(m["gid"]["data"]).hex().startswith(prefix)][-1]
         pad = "00" * (GID_BYTES[self.DISTRO] - 16)
         gid_hex = lambda g: bytes(g["data"]).hex()  # noqa: E731
         self.assertEqual(gid_hex(info["gid"]), guid + pad)
@@ -473,7 +495,7 @@ class RosTestCase(VehicleTestCase):
         self.assertGreater(len(attitude), 10)
         unjudged = {}
         for topic, msgs in samples.items():
-            for _, m in msgs:
+            for _, m, _ in msgs:
                 if topic == "rt/tf":
                     tf = m["transforms"][0]
                     self.assertEqual((tf["header"]["frame_id"], tf["child_frame_id"]), (world, body))
@@ -534,7 +556,7 @@ class RosTestCase(VehicleTestCase):
                 self.assertTrue(got, "nothing on " + topic)
                 start = got[0][0] + 2.5e9
                 startup_gap_ms = max((b[0] - a[0]) / 1e6 for a, b in zip(got, got[1:]) if a[0] < start)
-                got = [(t, m) for t, m in got if start <= t < start + ROS_SENSOR_RATE_WINDOW_S * 10 ** 9]
+                got = [(t, m) for t, m, _ in got if start <= t < start + ROS_SENSOR_RATE_WINDOW_S * 10 ** 9]
                 stamps = []
                 for t_ns, m in got:
                     stamp = stamp_of(topic, m)
@@ -600,7 +622,7 @@ class RosTestCase(VehicleTestCase):
         sign = -1 if convention == "enu" else 1
         for topic in ORIENTATION_TOPICS:
             # The turn's readings: not one from before the record began (check_orientation).
-            msgs = [m for _, m in samples[topic] if stamp_of(topic, m) + 50e6 >= attitude[0][0]]
+            msgs = [m for _, m, _ in samples[topic] if stamp_of(topic, m) + 50e6 >= attitude[0][0]]
             qs = [m["orientation"] if topic == "rt/caracara/imu" else m["transforms"][0]["transform"]["rotation"]
                   for m in msgs]
             yaws = unwrap([quaternion_yaw(q) for q in qs])
@@ -779,7 +801,7 @@ class BytesTest(unittest.TestCase):
 ROSBAG2_QOS_KEYS = {"history", "depth", "reliability", "durability", "deadline", "lifespan", "liveliness",
                     "liveliness_lease_duration", "avoid_ros_namespace_conventions"}
 RMW_KEEP_LAST, RMW_RELIABLE, RMW_TRANSIENT_LOCAL, RMW_VOLATILE, RMW_LIVELINESS_AUTOMATIC = 1, 1, 1, 2, 1
-LATCHED_TOPICS = ("/caracara/state", "/caracara/killed", "/caracara/kill_source")
+LATCHED_TOPICS = ("/caracara/state", "/caracara/killed", "/caracara/kill_source", "/tf_static")
 
 
 class DiveExportTest(unittest.TestCase):
@@ -820,6 +842,58 @@ class DiveExportTest(unittest.TestCase):
                                       "--out", out], capture_output=True, text=True)
             self.assertNotEqual(r.returncode, 0)
             self.assertIn("--distro takes humble or jazzy, not 'iron'", r.stderr)
+
+    def test_config_namespace_and_frames(self):
+        """--ros-config: the topics under the config's namespace, the frames its names in its
+        convention (NED here: _ned / _frd), each Range in its mount's frame, /tf_static the mounts,
+        as caracara-ros names them live; a bad config refused by name, no file written."""
+        npm_ci(HERE)
+        dives = os.path.join(SOURCE, "tests", "dives")
+        ctl = harness.command("caracaractl")
+        path = os.path.join(dives, sorted(n for n in os.listdir(dives) if n.endswith(".cdive"))[0])
+        with tempfile.TemporaryDirectory() as d:
+            conf, out = os.path.join(d, "ros.toml"), os.path.join(d, "dive.mcap")
+            with open(conf, "w") as f:
+                f.write('[ros]\nnamespace = "/fleet/auv2"\nworld_frame = "map"\nbase_frame = "hull"\n'
+                        'frame_convention = "ned"\nrange_max_m = 30.0\n[ros.imu]\nframe = "ahrs"\nrpy = [0, 0, 1.5]\n'
+                        '[[ros.range]]\nframe = "sonar_front"\nxyz = [0.4, 0, -0.1]\n')
+            r = subprocess.run(ctl + ["export", path, "--format", "mcap", "--encoding", "cdr", "--ros-config", conf,
+                                      "--out", out], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            check = subprocess.run(["node", "mcap_ros_check.mjs", out], cwd=HERE, capture_output=True, text=True)
+            self.assertEqual(check.returncode, 0, check.stderr)
+            bag = json.loads(check.stdout)
+            msgs = bag["messages"]
+            ranges = sorted(t for t in bag["topics"] if "/range/" in t)
+            self.assertTrue(ranges)
+            self.assertEqual(set(bag["topics"]), {"/fleet/auv2/" + t for t in (
+                "imu", "joint_states", "thrusters/ordered", "state", "killed", "kill_source")} |
+                {"/tf", "/tf_static", "/diagnostics"} | set(ranges))
+            self.assertEqual(ranges, ["/fleet/auv2/range/%d" % i for i in range(len(ranges))])
+            self.assertEqual({m["header"]["frame_id"] for m in msgs["/fleet/auv2/imu"]}, {"hull_frd"})
+            self.assertEqual({(t["header"]["frame_id"], t["child_frame_id"]) for m in msgs["/tf"] for t in m["transforms"]},
+                             {("map_ned", "hull_frd")})
+            self.assertEqual({m["header"]["frame_id"] for m in msgs["/fleet/auv2/joint_states"]}, {"hull"})
+            for i, topic in enumerate(ranges):
+                self.assertEqual({(m["header"]["frame_id"], m["max_range"]) for m in msgs[topic]},
+                                 {("sonar_front" if i == 0 else "range_%d" % i, 30.0)})
+            static = msgs["/tf_static"]
+            self.assertEqual(len(static), 1)
+            mounts = {t["child_frame_id"]: t for t in static[0]["transforms"]}
+            self.assertEqual(set(mounts), {"ahrs", "sonar_front"} | {"range_%d" % i for i in range(1, len(ranges))})
+            self.assertEqual({t["header"]["frame_id"] for t in mounts.values()}, {"hull"})
+            self.assertEqual(mounts["sonar_front"]["transform"]["translation"], {"x": 0.4, "y": 0, "z": -0.1})
+            q = mounts["ahrs"]["transform"]["rotation"]
+            self.assertAlmostEqual(quaternion_yaw(q), 1.5, places=9)
+            # A bad setting: refused by name, nothing written.
+            with open(conf, "w") as f:
+                f.write('[ros]\nbase_frame = "hull frame"\n')
+            os.unlink(out)
+            r = subprocess.run(ctl + ["export", path, "--format", "mcap", "--encoding", "cdr", "--ros-config", conf,
+                                      "--out", out], capture_output=True, text=True)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn("ros.base_frame must be a frame name", r.stderr)
+            self.assertFalse(os.path.exists(out))
 
     def judge_replay(self, bag, distro):
         """What `ros2 bag play` offers each topic with, and what `ros2 bag info` names the distro."""
@@ -1006,13 +1080,17 @@ class JazzyRangeTest(RosTestCase):
         self.check_discovery_info(["rt/caracara/kill"])
 
 
-def distro_status(samples):
-    """The last /diagnostics' "caracara: ros distro" status, its values as a dict."""
+def status_named(samples, name):
+    """The last /diagnostics' status `name`, its values as a dict."""
     msgs = samples.get("rt/diagnostics")
     assert msgs, "no /diagnostics received"
-    st = [s for s in msgs[-1][1]["status"] if s["name"] == "caracara: ros distro"]
+    st = [s for s in msgs[-1][1]["status"] if s["name"] == name]
     assert len(st) == 1, [s["name"] for s in msgs[-1][1]["status"]]
     return {**st[0], "values": {kv["key"]: kv["value"] for kv in st[0]["values"]}}
+
+
+def distro_status(samples):
+    return status_named(samples, "caracara: ros distro")
 
 
 class AutoDistroTest(RosTestCase):
@@ -1066,6 +1144,77 @@ class AutoDistroTest(RosTestCase):
                 self.assertEqual((status["values"]["speaking"], status["values"]["humble peers"],
                                   status["values"]["jazzy peers"], status["level"]), ("jazzy", "1", "1", 1), status)
                 self.assertIn("set range_layout to choose", status["message"])
+
+
+class RangeSubscriberTest(RosTestCase):
+    """No range_layout, and no ROS 2 node about (the distro stays Humble's): each subscriber of
+    range/N gets the Range it asks for, told by the type hash in its reader's USER_DATA as Jazzy's
+    rmw announces it ("typehash=RIHS01_...;", here computed from Jazzy's published definitions by
+    rosidl's rule, type_hash.mjs), none from Humble. The bytes as they came are read by the
+    reference deserializer with the subscriber's definition and written back the same: a Humble
+    sample is 4 bytes short for Jazzy's, a Jazzy one leaves 4 over for Humble's. The journal and
+    /diagnostics ("caracara: ros range layout") say which and why."""
+    DISTRO = "humble"
+    LAYOUT_IN_CONFIG = False
+    TOPICS = {"rt/caracara/range/0": "sensor_msgs/Range", "rt/diagnostics": "diagnostic_msgs/DiagnosticArray"}
+
+    def judge_range(self, samples, distro):
+        got = samples.get("rt/caracara/range/0")
+        self.assertTrue(got, "no Range the peer built from %s's definitions could read" % distro)
+        wire = got[-1][2]
+        r = self.codec.decode("sensor_msgs/Range", wire, distro)
+        self.assertEqual(self.codec.encode("sensor_msgs/Range", r, distro), wire)
+        self.assertEqual("variance" in r, distro == "jazzy")
+        self.assertAlmostEqual(r["range"], int(self.rig.sim_teensy("Distances")[0]) / 1000, delta=0.002)
+
+    def subscriber(self, distro, seconds=4):
+        """A subscriber of range/0 (and /diagnostics) built from `distro`'s definitions for
+        `seconds`: its samples and what caracara-ros's journal said meanwhile."""
+        log_start = len(self.rig.log("caracara-ros"))
+        samples = self.listen(seconds, self.TOPICS, distro=distro)[0]
+        return samples, self.rig.log("caracara-ros")[log_start:]
+
+    def test_each_subscriber_gets_the_range_it_asks_for(self):
+        samples, log = self.subscriber("jazzy")
+        self.assertRegex(log, r"Range subscriber [0-9a-f.]+ on /caracara/range/0 asks for jazzy: typehash %s: "
+                              r"Range with variance \(Jazzy's\)" % type_hash("jazzy", "sensor_msgs/Range"))
+        self.assertIn("Range in jazzy's layout: the Range subscribers' types: 1 subscriber, all asking for jazzy", log)
+        self.judge_range(samples, "jazzy")
+        status = status_named(samples, "caracara: ros range layout")
+        self.assertEqual((status["values"]["layout"], status["values"]["jazzy subscribers"], status["level"]),
+                         ("jazzy", "1", 0), status)
+        self.assertEqual(distro_status(samples)["values"]["speaking"], "humble")  # not from ros_discovery_info
+        samples, log = self.subscriber("humble")
+        self.assertRegex(log, r"Range subscriber [0-9a-f.]+ on /caracara/range/0 asks for humble: no typehash")
+        self.assertIn("Range in humble's layout: the Range subscribers' types: 1 subscriber, all asking for humble", log)
+        self.judge_range(samples, "humble")
+        status = status_named(samples, "caracara: ros range layout")
+        self.assertEqual((status["values"]["layout"], status["values"]["humble subscribers"],
+                          status["values"]["jazzy subscribers"], status["level"]), ("humble", "1", "0", 0), status)
+
+    def test_subscribers_of_both_layouts(self):
+        """A Jazzy subscriber, then a Humble one beside it: one writer reaches both, so caracara-ros
+        keeps the layout it writes (a tie) and says in the journal and on /diagnostics (WARN) that
+        the other cannot read it; the Humble subscriber does get Jazzy's bytes, 4 over its type."""
+        log_start = len(self.rig.log("caracara-ros"))
+        jazzy = {}
+        t = threading.Thread(target=lambda: jazzy.update(self.listen(9, self.TOPICS, distro="jazzy")[0]))
+        t.start()
+        try:
+            poll(lambda: "Range in jazzy's layout" in self.rig.log("caracara-ros")[log_start:], 20,
+                 message="the Jazzy subscriber was not taken")
+            samples, log = self.subscriber("humble", seconds=3)
+        finally:
+            t.join(60)
+        self.assertIn("Range in jazzy's layout: Range subscribers asking for both (humble 1, jazzy 1): jazzy, written "
+                      "already; the others cannot read Range (set range_layout to choose)", log)
+        status = status_named(samples, "caracara: ros range layout")
+        self.assertEqual((status["values"]["layout"], status["values"]["humble subscribers"],
+                          status["values"]["jazzy subscribers"], status["level"]), ("jazzy", "1", "1", 1), status)
+        wire = samples["rt/caracara/range/0"][-1][2]
+        humble = self.codec.encode("sensor_msgs/Range", self.codec.decode("sensor_msgs/Range", wire, "humble"), "humble")
+        self.assertEqual(len(wire) - len(humble), 8, "not Jazzy's 4 bytes of variance over Humble's Range")
+        self.judge_range(jazzy, "jazzy")
 
 
 class NedFrdTest(RosTestCase):
@@ -1188,7 +1337,7 @@ class OneWriterTest(RosTestCase):
                 # On /diagnostics: the holder, the refusals counted and growing, message by message
                 # (a refusal is there within a second: the diagnostics come at 1 Hz), the last named.
                 counts = []
-                for t_ns, m in samples["rt/diagnostics"]:
+                for t_ns, m, _ in samples["rt/diagnostics"]:
                     st = commands_status_of(m)
                     self.assertEqual(st["values"]["holder"], first_gid)
                     self.assertEqual(st["level"], 1, "a recent refusal is a WARN")

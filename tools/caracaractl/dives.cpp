@@ -5,10 +5,9 @@
 #include "core/safety.hpp"
 #include "drivers/platform/dive_files.hpp"
 #include "drivers/protocol/seabotix.hpp"
+#include "tools/caracaractl/mcap_export.hpp"
 #include "tools/caracaractl/render.hpp"
 #include "tools/client/client.hpp"
-#include "tools/foxglove/dive_mcap.hpp"
-#include "tools/foxglove/dive_ros_mcap.hpp"
 #include "tools/foxglove/dive_summary.hpp"
 
 #include <cerrno>
@@ -46,6 +45,7 @@ struct DiveOptions {
     bool mcap = false;          // export --format mcap
     bool cdr = false;           // --encoding cdr: the ROS 2 topics for rosbag2 (docs/ros2.md)
     std::optional<caracara::ros::RangeLayout> distro; // --distro humble|jazzy: Range's layout, ROS_DISTRO
+    std::optional<std::string> ros_config; // --ros-config FILE: caracara-ros's settings (namespace, frames)
     bool detection = false;     // plot --detection: one direction detection run (plot_detection.py)
     std::string wire;           // plot --detection --wire FILE: the simulator's orders, time_ns,thruster,speed
     std::string run = "-1";     // plot --detection --run N: which run of the dive (-1 the last)
@@ -98,6 +98,8 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
             if (!o.distro)
                 usage("--distro takes humble or jazzy, not '" + d + "'");
         }
+        else if (a == "--ros-config" && name == "export")
+            o.ros_config = value("--ros-config");
         else if (a == "--partial" && name != "dives")
             o.partial = true;
         else if (a.starts_with("--"))
@@ -111,6 +113,8 @@ DiveOptions parse(const std::string& name, const std::vector<std::string>& args)
         usage("--encoding applies to --format mcap");
     if (name == "export" && o.distro && !o.cdr)
         usage("--distro applies to --format mcap --encoding cdr");
+    if (name == "export" && o.ros_config && !o.cdr)
+        usage("--ros-config applies to --format mcap --encoding cdr");
     if (name == "export" && !o.mcap && !o.out.empty())
         usage("--out applies to --format mcap");
     if (name == "plot" && !o.detection && (!o.wire.empty() || o.run != "-1"))
@@ -277,30 +281,10 @@ int cmd_dives(const DiveOptions& o) {
     return kExitOk;
 }
 
-// The dive as MCAP on the live bridge's channels (JSON) or caracara-ros's topics (CDR), to --out
-// or to stdout when it is no terminal.
-int export_mcap(const dive::Dive& d, const std::string& out, bool cdr, caracara::ros::RangeLayout distro) {
-    if (out.empty() && ::isatty(STDOUT_FILENO))
-        usage("MCAP is binary: give --out FILE or redirect the output");
-    const std::vector<uint8_t> bytes = cdr ? caracara::foxglove::dive_to_ros_mcap(d, distro) : caracara::foxglove::dive_to_mcap(d);
-    std::ofstream file;
-    if (!out.empty()) {
-        file.open(out, std::ios::binary | std::ios::trunc);
-        if (!file)
-            throw Failure{kExitRefused, "cannot write " + out + ": " + std::strerror(errno)};
-    }
-    std::ostream& s = out.empty() ? std::cout : file;
-    s.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    s.flush();
-    if (!s)
-        throw Failure{kExitRefused, "writing the MCAP file failed"};
-    return kExitOk;
-}
-
 int cmd_export(const DiveOptions& o) {
     const dive::Dive d = load(resolve(o), o.partial);
     if (o.mcap)
-        return export_mcap(d, o.out, o.cdr, o.distro.value_or(caracara::ros::RangeLayout::Humble));
+        return export_mcap(d, {o.out, o.cdr, o.distro, o.ros_config});
     if (o.events)
         write_events(std::cout, d);
     else
@@ -412,11 +396,14 @@ const char* dive_help() {
            "  export DIVE --format mcap [--out FILE] [--dir DIR] [--partial]\n"
            "                                   Write the dive as MCAP on the channels of\n"
            "                                   caracara-bridge, for Foxglove (docs/foxglove.md)\n"
-           "  export DIVE --format mcap --encoding cdr [--distro humble|jazzy] [--out FILE] [--dir DIR]\n"
-           "         [--partial]               Write it as caracara-ros's ROS 2 topics (CDR, ros2msg\n"
+           "  export DIVE --format mcap --encoding cdr [--distro humble|jazzy] [--ros-config FILE]\n"
+           "         [--out FILE] [--dir DIR] [--partial]\n"
+           "                                   Write it as caracara-ros's ROS 2 topics (CDR, ros2msg\n"
            "                                   schemas, each with the QoS caracara-ros offers) for\n"
            "                                   rosbag2: ros2 bag play (docs/ros2.md); --distro: Range's\n"
-           "                                   layout and the bag's ROS_DISTRO (default humble)\n"
+           "                                   layout and the bag's ROS_DISTRO (default humble);\n"
+           "                                   namespace and frames from caracara-ros's settings\n"
+           "                                   (--ros-config, default /etc/caracara/ros.toml if there)\n"
            "  DIVE is a path, a file name in DIR, or \"last\". A truncated or corrupt file is refused\n"
            "  (status 1, the problem and its byte offset named); --partial uses what came before it.\n";
 }

@@ -7,6 +7,7 @@
 #include "tools/foxglove/mcap_writer.hpp"
 #include "tools/ros/ros_conventions.hpp"
 
+#include <algorithm>
 #include <map>
 #include <string>
 
@@ -26,13 +27,13 @@ const std::string kVector3 = kSep + "MSG: geometry_msgs/Vector3\nfloat64 x\nfloa
 const std::string kQuaternion = kSep + "MSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w\n";
 
 struct Topic {
-    const char* name;
+    const char* name; // as ros_topic takes it: under the namespace unless it starts with "/"
     const char* type;
     std::string schema;
     bool latched = false; // transient-local, keep-last 1, as caracara-ros offers it
 };
 
-const Topic kImu{"/caracara/imu", "sensor_msgs/msg/Imu",
+const Topic kImu{"imu", "sensor_msgs/msg/Imu",
                  "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\nfloat64[9] orientation_covariance\n"
                  "geometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\n"
                  "geometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance\n" +
@@ -45,8 +46,8 @@ const Topic kTf{"/tf", "tf2_msgs/msg/TFMessage",
                     kVector3 + kQuaternion};
 const std::string kJointStateSchema =
     "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n" + kHeader;
-const Topic kJoints{"/caracara/joint_states", "sensor_msgs/msg/JointState", kJointStateSchema};
-const Topic kOrdered{"/caracara/thrusters/ordered", "sensor_msgs/msg/JointState", kJointStateSchema};
+const Topic kJoints{"joint_states", "sensor_msgs/msg/JointState", kJointStateSchema};
+const Topic kOrdered{"thrusters/ordered", "sensor_msgs/msg/JointState", kJointStateSchema};
 const std::string kRangeFields = "uint8 ULTRASOUND=0\nuint8 INFRARED=1\nstd_msgs/Header header\nuint8 radiation_type\n"
                                  "float32 field_of_view\nfloat32 min_range\nfloat32 max_range\nfloat32 range\n";
 const std::string kRangeSchema = kRangeFields + kHeader;
@@ -56,9 +57,10 @@ const Topic kDiagnostics{"/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
                              "MSG: diagnostic_msgs/DiagnosticStatus\nbyte OK=0\nbyte WARN=1\nbyte ERROR=2\nbyte STALE=3\n"
                              "byte level\nstring name\nstring message\nstring hardware_id\ndiagnostic_msgs/KeyValue[] values\n" +
                              kSep + "MSG: diagnostic_msgs/KeyValue\nstring key\nstring value\n"};
-const Topic kState{"/caracara/state", "std_msgs/msg/String", "string data\n", true};
-const Topic kKillSource{"/caracara/kill_source", "std_msgs/msg/String", "string data\n", true};
-const Topic kKilled{"/caracara/killed", "std_msgs/msg/Bool", "bool data\n", true};
+const Topic kState{"state", "std_msgs/msg/String", "string data\n", true};
+const Topic kKillSource{"kill_source", "std_msgs/msg/String", "string data\n", true};
+const Topic kKilled{"killed", "std_msgs/msg/Bool", "bool data\n", true};
+const Topic kTfStatic{"/tf_static", "tf2_msgs/msg/TFMessage", kTf.schema, true};
 
 // The QoS caracara-ros offers on a topic (tools/ros/dds_qos.cpp), as rosbag2 keeps it in a
 // channel's offered_qos_profiles: a YAML list of one profile, rosbag2_storage's field names and
@@ -77,13 +79,14 @@ const char* const kBusStates[] = {"ok", "recovering", "lost", "lost"};
 
 class RosBag {
 public:
-    explicit RosBag(ros::RangeLayout distro) : w_("ros2", "caracaractl export") {
+    RosBag(const ros::RosConfig& config, ros::RangeLayout distro) : config_(config), w_("ros2", "caracaractl export") {
         // rosbag2's record of the bag: `ros2 bag info` shows the distro.
         w_.add_metadata("rosbag2", {{"ROS_DISTRO", std::string(name_of(distro))}});
     }
 
     void put(const Topic& t, uint64_t ns, const CdrWriter& m) { put(t.name, t, ns, m); }
-    void put(const std::string& name, const Topic& t, uint64_t ns, const CdrWriter& m) {
+    void put(const std::string& topic, const Topic& t, uint64_t ns, const CdrWriter& m) {
+        const std::string name = ros::ros_topic(config_, topic);
         auto it = channels_.find(name);
         if (it == channels_.end()) {
             auto s = schemas_.find(t.type);
@@ -98,12 +101,14 @@ public:
     std::vector<uint8_t> finish() { return w_.finish(); }
 
 private:
+    const ros::RosConfig& config_;
     McapWriter w_;
     std::map<std::string, uint16_t> schemas_, channels_;
 };
 
-void joint_state(CdrWriter& m, uint64_t ns, const std::vector<double>& velocity, const std::vector<double>& effort) {
-    m.header(ns, ros::kDefaultBaseFrame);
+void joint_state(CdrWriter& m, uint64_t ns, const std::string& base_frame, const std::vector<double>& velocity,
+                 const std::vector<double>& effort) {
+    m.header(ns, base_frame);
     m.u32(ros::kThrusterJoints);
     for (unsigned i = 0; i < ros::kThrusterJoints; ++i)
         m.string(ros::thruster_joint_name(i));
@@ -157,8 +162,26 @@ void diagnostics(RosBag& bag, uint64_t ns, const dive::Sample& s, const std::str
 
 } // namespace
 
-std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d, ros::RangeLayout distro) {
-    RosBag bag(distro);
+// /tf_static as caracara-ros sends it at its start: every mount under the base frame itself.
+void static_frames(RosBag& bag, uint64_t ns, const ros::RosConfig& config, std::size_t ranges) {
+    const std::vector<ros::SensorMount> mounts = ros::sensor_mounts(config, ranges);
+    CdrWriter m;
+    m.u32(static_cast<uint32_t>(mounts.size()));
+    for (const ros::SensorMount& s : mounts) {
+        const frames::Quaternion q = ros::mount_rotation(s);
+        m.header(ns, config.base_frame);
+        m.string(s.frame);
+        for (const double v : {s.xyz.x, s.xyz.y, s.xyz.z, q.x, q.y, q.z, q.w})
+            m.f64(v);
+    }
+    bag.put(kTfStatic, ns, m);
+}
+
+std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d, const ros::RosConfig& config, ros::RangeLayout distro) {
+    RosBag bag(config, distro);
+    // The Imu's and /tf's frames in the config's convention, as caracara-ros names them.
+    const std::string world = ros::world_frame_id(config.world_frame, config.frame_convention),
+                      body = ros::body_frame_id(config.base_frame, config.frame_convention);
     const bool jazzy = distro == ros::RangeLayout::Jazzy;
     const uint64_t start_ns = d.header.start_unix_ms * 1'000'000u;
     auto at = [&](uint32_t t_100us) { return start_ns + uint64_t{t_100us} * 100'000u; };
@@ -172,6 +195,10 @@ std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d, ros::RangeLayout dist
         state_messages(bag, ns, state, source);
     };
     state_changed(start_ns);
+    std::size_t ranges = 0;
+    for (const dive::Sample& s : d.samples)
+        ranges = std::max(ranges, s.distances.size());
+    static_frames(bag, start_ns, config, ranges);
     std::size_t next_event = 0;
     auto events_until = [&](uint32_t t) {
         for (; next_event < d.events.size() && d.events[next_event].t_100us <= t; ++next_event) {
@@ -189,11 +216,11 @@ std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d, ros::RangeLayout dist
     for (const dive::Sample& s : d.samples) {
         events_until(s.t_100us);
         const uint64_t ns = at(s.t_100us);
-        // REP 103 / 145 as caracara-ros's defaults: base_link (FLU) in odom (ENU).
+        // REP 103 / 145 (or NED / FRD) as caracara-ros: the body frame in the world frame.
         const frames::Quaternion q =
-            frames::orientation({s.orientation[0], s.orientation[1], s.orientation[2]}, frames::WorldFrame::EnuFlu);
+            frames::orientation({s.orientation[0], s.orientation[1], s.orientation[2]}, config.frame_convention);
         CdrWriter imu;
-        imu.header(ns, ros::kDefaultBaseFrame);
+        imu.header(ns, body);
         for (const double v : {q.x, q.y, q.z, q.w})
             imu.f64(v);
         // REP 145, as caracara-ros: orientation covariance unknown (zeros); no angular velocity
@@ -213,13 +240,15 @@ std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d, ros::RangeLayout dist
         zero_vector();   // linear_acceleration
         covariance(-1);  // linear_acceleration_covariance
         bag.put(kImu, ns, imu);
-        CdrWriter tf;
-        tf.u32(1);
-        tf.header(ns, ros::kDefaultWorldFrame);
-        tf.string(ros::kDefaultBaseFrame);
-        for (const double v : {0.0, 0.0, 0.0, q.x, q.y, q.z, q.w})
-            tf.f64(v);
-        bag.put(kTf, ns, tf);
+        if (config.publish_odom_tf) { // else the vehicle's localization publishes it
+            CdrWriter tf;
+            tf.u32(1);
+            tf.header(ns, world);
+            tf.string(body);
+            for (const double v : {0.0, 0.0, 0.0, q.x, q.y, q.z, q.w})
+                tf.f64(v);
+            bag.put(kTf, ns, tf);
+        }
         std::vector<double> speed, current, ordered;
         for (unsigned i = 0; i < ros::kThrusterJoints; ++i) {
             const dive::ThrusterSample& t = s.thrusters[i];
@@ -228,19 +257,19 @@ std::vector<uint8_t> dive_to_ros_mcap(const dive::Dive& d, ros::RangeLayout dist
             ordered.push_back(ros::motor_fraction(s.applied[i]));
         }
         CdrWriter joints, orders;
-        joint_state(joints, ns, speed, current);
-        joint_state(orders, ns, ordered, {});
+        joint_state(joints, ns, config.base_frame, speed, current);
+        joint_state(orders, ns, config.base_frame, ordered, {});
         bag.put(kJoints, ns, joints);
         bag.put(kOrdered, ns, orders);
         for (std::size_t i = 0; i < s.distances.size(); ++i) {
             CdrWriter r;
-            r.header(ns, ros::range_frame(i));
+            r.header(ns, ros::range_mount(config, i).frame);
             r.u8(0); // ULTRASOUND: the Teensy does not say which kind of sensor it reads
-            for (const float v : {0.0f, 0.0f, 65.535f, ros::range_metres(s.distances[i])})
+            for (const float v : {config.range_fov_rad, config.range_min_m, config.range_max_m, ros::range_metres(s.distances[i])})
                 r.f32(v);
             if (jazzy)
                 r.f32(0.0f); // variance: unknown
-            bag.put("/caracara/range/" + std::to_string(i),
+            bag.put("range/" + std::to_string(i),
                     Topic{"", "sensor_msgs/msg/Range", jazzy ? kJazzyRangeSchema : kRangeSchema}, ns, r);
         }
         if (!diagnostics_written || ns >= diagnostics_ns + kDiagnosticsPeriodNs) {

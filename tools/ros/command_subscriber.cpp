@@ -3,6 +3,7 @@
 #include "core/clock.hpp"
 #include "core/frames.hpp"
 #include "core/motor.hpp"
+#include "tools/ros/gid_text.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -47,19 +48,6 @@ std::string wrench_axes_note() {
                         (sign < 0 ? "-" : "") + kFields[k];
         }
     return note;
-}
-
-// A DDS GUID as ROS 2 prints a GID (rclpy's TopicEndpointInfo: each byte as two hex digits,
-// dotted), zero-padded to the distro's Gid: Humble's 24 bytes, 16 since Iron.
-std::string gid_text(const dds_guid_t& g, RangeLayout distro) {
-    std::string s;
-    char b[4];
-    const std::size_t size = distro == RangeLayout::Humble ? 24 : 16;
-    for (std::size_t i = 0; i < size; ++i) {
-        std::snprintf(b, sizeof b, "%02x", i < sizeof g.v ? g.v[i] : 0u);
-        s += (i ? "." : "") + std::string(b);
-    }
-    return s;
 }
 
 } // namespace

@@ -3,7 +3,7 @@
 // cache reads to list nodes (`ros2 node list`, `ros2 node info`). Written again whenever a
 // reader or writer is added; reliable, transient-local, keep-last 1 as rmw_cyclonedds_cpp's own
 // (a late ROS 2 tool gets the current one). The Gid is Humble's 24 bytes or Jazzy's 16, picked
-// by the config's range_layout like sensor_msgs/Range.
+// by the distro spoken (SpokenDistro: the config's range_layout, else the peers').
 #pragma once
 
 #include "tools/ros/ros_config.hpp"

@@ -15,7 +15,7 @@
 
 namespace {
 
-constexpr const char* kDefaultConfig = "/etc/caracara/ros.toml";
+constexpr const char* kDefaultConfig = caracara::ros::kDefaultConfigPath;
 
 void help() {
     std::cout << "caracara-ros [OPTIONS...]\n\n"

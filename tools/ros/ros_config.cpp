@@ -119,6 +119,15 @@ SensorMount range_mount(const RosConfig& c, std::size_t i) {
     return i < c.ranges.size() ? c.ranges[i] : SensorMount{range_frame(i), {}, {}};
 }
 
+std::vector<SensorMount> sensor_mounts(const RosConfig& c, std::size_t ranges) {
+    std::vector<SensorMount> mounts{c.imu};
+    for (std::size_t i = 0; i < std::max(c.ranges.size(), ranges); ++i)
+        mounts.push_back(range_mount(c, i));
+    return mounts;
+}
+
+frames::Quaternion mount_rotation(const SensorMount& m) { return frames::from_euler_zyx(m.rpy.z, m.rpy.y, m.rpy.x); }
+
 std::string load_config(const std::string& path, RosConfig& c) {
     std::ifstream in(path, std::ios::binary);
     if (!in)

@@ -22,11 +22,14 @@ struct SensorMount {
     frames::Vec3 xyz, rpy;
 };
 
+// Where caracara-ros and caracaractl export read the settings unless told (a missing one: the defaults).
+inline constexpr const char* kDefaultConfigPath = "/etc/caracara/ros.toml";
+
 struct RosConfig {
     std::string ros_namespace = "/caracara";
     uint32_t domain_id = 0;           // ROS_DOMAIN_ID, else 0; the file's domain_id wins
     RangeLayout range_layout = RangeLayout::Humble; // also ros_discovery_info's Gid: 24 bytes, Jazzy's 16
-    bool range_layout_given = false; // else the distro is the peers' (DistroDetector), Humble until one is seen
+    bool range_layout_given = false; // else the peers' distro (DistroDetector) and the Range subscribers' (RangeSubscribers)
     bool commands = false;            // Wrench and per-thruster commands; kill is always taken
     // An SROS2 enclave directory (keystore/enclaves/<path>): DDS Security on, "" = off.
     std::string security;
@@ -66,6 +69,12 @@ std::string commands_refusal(const RosConfig& config, bool loopback);
 bool is_loopback(const std::string& interface);
 // Distance sensor i's mount: the config's, else range_i at the origin facing forward.
 SensorMount range_mount(const RosConfig& config, std::size_t i);
+// Every mount /tf_static carries, under the base frame itself (REP 103's body FLU, also with
+// frame_convention = "ned"): the IMU, then each distance sensor, the config's and up to `ranges`
+// the Teensy reports.
+std::vector<SensorMount> sensor_mounts(const RosConfig& config, std::size_t ranges);
+// A mount's rotation: URDF's rpy (fixed axes x, y, z) is the Z-Y-X Euler rotation yaw, pitch, roll.
+frames::Quaternion mount_rotation(const SensorMount& m);
 
 // The ROS topic name under the namespace ("state" -> "/caracara/state"; "/diagnostics" stays).
 std::string ros_topic(const RosConfig& config, const std::string& name);

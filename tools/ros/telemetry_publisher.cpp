@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <ros_msgs.h>
 #include <ctime>
+#include <utility>
 
 namespace caracara::ros {
 
@@ -62,6 +63,7 @@ TelemetryPublisher::TelemetryPublisher(sd_event* event, DdsParticipant& dds, con
                                        CommandRecord& commands, SpokenDistro& distro)
     : event_(event), dds_(dds), config_(config), commands_(commands), distro_(distro),
       detector_(config.range_layout_given ? nullptr : std::make_unique<DistroDetector>(dds.handle())),
+      range_subscribers_(dds.handle(), config, distro),
       world_frame_(world_frame_id(config.world_frame, config.frame_convention)),
       body_frame_(body_frame_id(config.base_frame, config.frame_convention)),
       sensor_period_us_(static_cast<uint64_t>(1e6 / config.sensor_rate_hz)),
@@ -249,6 +251,8 @@ int TelemetryPublisher::on_sensor_tick(sd_event_source* s, uint64_t usec, void* 
     sd_event_source_set_enabled(s, SD_EVENT_ON);
     if (self->detector_ && self->detector_->update())
         self->choose_distro();
+    if (self->range_subscribers_.update()) // a Range subscriber came or left, or the layout changed
+        self->mark(kDiagnostics | kRanges);
     if (!self->client_ || !self->orientation_read_at_.tv_sec)
         return 0; // nothing read yet
     // An offline Teensy's last attitude is no reading: the Imu and /tf stop, as a driver's do
@@ -327,10 +331,15 @@ void TelemetryPublisher::write_joints() {
 }
 
 void TelemetryPublisher::write_ranges() {
+    if (ranges_layout_ != range_subscribers_.layout()) { // Range's layout changed: its writers made anew
+        for (const dds_entity_t w : std::exchange(ranges_, {}))
+            dds_.delete_writer(w);
+        ranges_layout_ = range_subscribers_.layout();
+    }
     const Value& d = get(props(caracara::dbus::kTeensyPath, caracara::dbus::kTeensyIface), "Distances");
     const bool more = d.items.size() > ranges_.size();
     for (std::size_t i = ranges_.size(); i < d.items.size(); ++i)
-        ranges_.push_back(dds_.writer(distro_.layout == RangeLayout::Jazzy ? &jazzy_range_ : &sensor_msgs_msg_dds__Range__desc,
+        ranges_.push_back(dds_.writer(range_subscribers_.layout() == RangeLayout::Jazzy ? &jazzy_range_ : &sensor_msgs_msg_dds__Range__desc,
                                       ros_topic(config_, "range/" + std::to_string(i)), Profile::Default));
     if (more && d.items.size() > config_.ranges.size())
         write_static_frames(); // a sensor the config does not list: its frame, at the origin
@@ -338,7 +347,7 @@ void TelemetryPublisher::write_ranges() {
         const std::string frame = range_mount(config_, i).frame;
         const float metres = range_metres(static_cast<uint32_t>(d.items[i].unsigned_integer()));
         // radiation_type ULTRASOUND (0): the Teensy does not say which kind of sensor it reads.
-        if (distro_.layout == RangeLayout::Jazzy) {
+        if (range_subscribers_.layout() == RangeLayout::Jazzy) {
             jazzy_sensor_msgs_msg_dds__Range_ r{header(frame, teensy_read_at_), 0, config_.range_fov_rad, config_.range_min_m,
                                                 config_.range_max_m, metres, 0.0f};
             dds_write(ranges_[i], &r);
@@ -372,33 +381,17 @@ void TelemetryPublisher::choose_distro() {
     std::fprintf(stderr, "caracara-ros: speaking %s: %s\n", std::string(name_of(distro_.layout)).c_str(),
                  distro_.why.c_str());
     mark(kDiagnostics);
-    if (distro_.layout == before)
-        return;
-    // ros_discovery_info's Gid and Range's layout from now on: the Range writers made anew.
-    dds_.discovery_info().set_layout(distro_.layout);
-    for (const dds_entity_t w : ranges_)
-        dds_.delete_writer(w);
-    ranges_.clear();
-    mark(kRanges);
+    if (distro_.layout != before) // ros_discovery_info's Gid; Range's layout follows in range_subscribers_
+        dds_.discovery_info().set_layout(distro_.layout);
 }
 
 void TelemetryPublisher::write_static_frames() {
-    // The IMU and every distance sensor, the config's and the Teensy's (the more of the two).
-    std::vector<SensorMount> mounts{config_.imu};
-    for (std::size_t i = 0; i < std::max(config_.ranges.size(), ranges_.size()); ++i)
-        mounts.push_back(range_mount(config_, i));
+    const std::vector<SensorMount> mounts = sensor_mounts(config_, ranges_.size());
     std::vector<geometry_msgs_msg_dds__TransformStamped_> ts;
     const timespec now = realtime_now();
     for (const SensorMount& m : mounts) {
-        // URDF's rpy (fixed axes x, y, z) is the Z-Y-X Euler rotation yaw, pitch, roll.
-        const frames::Quaternion q = frames::from_euler_zyx(m.rpy.z, m.rpy.y, m.rpy.x);
-        geometry_msgs_msg_dds__TransformStamped_ t{};
-        // In REP 103's body FLU, under the base frame itself (not its _frd twin in NED).
-        t.header = header(config_.base_frame, now);
-        t.child_frame_id = c_str(m.frame);
-        t.transform.translation = {m.xyz.x, m.xyz.y, m.xyz.z};
-        t.transform.rotation = {q.x, q.y, q.z, q.w};
-        ts.push_back(t);
+        const frames::Quaternion q = mount_rotation(m);
+        ts.push_back({header(config_.base_frame, now), c_str(m.frame), {{m.xyz.x, m.xyz.y, m.xyz.z}, {q.x, q.y, q.z, q.w}}});
     }
     // The headers and child frames point into `mounts`, alive until the write returns.
     tf2_msgs_msg_dds__TFMessage_ tf{};
@@ -426,6 +419,7 @@ std::vector<uint8_t> TelemetryPublisher::levels() const {
     out.push_back(last && monotonic_ns() < last + kRefusalWarnNs ? 1 : 0);
     // The distro: WARN while peers of both are about (some of them cannot read what is sent).
     out.push_back(detector_ && detector_->peers(RangeLayout::Humble) && detector_->peers(RangeLayout::Jazzy) ? 1 : 0);
+    out.push_back(range_subscribers_.warn() ? 1 : 0); // a Range subscriber cannot read what is written
     return out;
 }
 
@@ -495,6 +489,9 @@ void TelemetryPublisher::write_diagnostics() {
                   "caracara-ros",
                   {{"speaking", std::string(name_of(distro_.layout))}, {"why", distro_.why},
                    {"humble peers", peers(RangeLayout::Humble)}, {"jazzy peers", peers(RangeLayout::Jazzy)}}});
+    st.push_back({lv[kThrusters + 6], "caracara: ros range layout",
+                  std::string(name_of(range_subscribers_.layout())) + ": " + range_subscribers_.why(), "caracara-ros",
+                  range_subscribers_.values()});
     std::vector<std::vector<diagnostic_msgs_msg_dds__KeyValue_>> kvs(st.size());
     std::vector<diagnostic_msgs_msg_dds__DiagnosticStatus_> out;
     for (std::size_t i = 0; i < st.size(); ++i) {

@@ -13,6 +13,7 @@
 #include "tools/ros/command_record.hpp"
 #include "tools/ros/dds_participant.hpp"
 #include "tools/ros/distro_detector.hpp"
+#include "tools/ros/range_subscribers.hpp"
 #include "tools/ros/spoken_distro.hpp"
 
 #include <array>
@@ -68,6 +69,7 @@ private:
     CommandRecord& commands_;
     SpokenDistro& distro_;
     std::unique_ptr<DistroDetector> detector_; // none when the config names the distro
+    RangeSubscribers range_subscribers_; // the Range layout written, and why
     // The Imu's and /tf's frame names in the config's convention (headers point into them).
     const std::string world_frame_, body_frame_;
     std::unique_ptr<client::Client> client_;
@@ -91,6 +93,7 @@ private:
 
     dds_entity_t imu_, tf_ = 0, tf_static_, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
     std::vector<dds_entity_t> ranges_;
+    RangeLayout ranges_layout_{}; // the layout of ranges_' writers
     dds_topic_descriptor_t jazzy_range_;
 };
 
