@@ -9,6 +9,7 @@
 #include "drivers/devices/final_stop.hpp"
 #include "drivers/platform/hardware.hpp"
 #include "drivers/platform/io_error.hpp"
+#include "drivers/sdbus/program_args.hpp"
 #include "drivers/sdbus/sdbus.hpp"
 
 #include <csignal>
@@ -68,33 +69,13 @@ int main(int argc, char** argv) {
     bool check_only = false;
     bool zero_only = false;
 
-    for (int i = 1; i < argc; ++i) {
-        std::string a = argv[i];
-        auto value = [&](const std::string& name) -> std::string {
-            const std::string prefix = name + "=";
-            if (a.rfind(prefix, 0) == 0)
-                return a.substr(prefix.size());
-            if (i + 1 >= argc) {
-                std::fprintf(stderr, "caracarad: %s needs a value\n", name.c_str());
-                std::exit(2);
-            }
-            return argv[++i];
-        };
-        auto is = [&](const char* name) { return a == name || a.rfind(std::string(name) + "=", 0) == 0; };
-        if (is("--config")) config_path = value("--config");
-        else if (is("--hardware")) hardware = value("--hardware");
-        else if (a == "--system") bus_choice = {dbus::BusChoice::Kind::System, {}};
-        else if (a == "--user") bus_choice = {dbus::BusChoice::Kind::User, {}};
-        else if (is("--bus-address")) bus_choice = {dbus::BusChoice::Kind::Address, value("--bus-address")};
-        else if (a == "--check-config") check_only = true;
-        else if (a == "--zero-thrusters") zero_only = true;
-        else if (a == "-h" || a == "--help") { usage(stdout); return 0; }
-        else if (a == "--version") { std::printf("caracarad %s\n", CARACARA_VERSION); return 0; }
-        else {
-            std::fprintf(stderr, "caracarad: unknown option '%s'\n", a.c_str());
-            usage(stderr);
-            return 2;
-        }
+    dbus::ProgramArgs args("caracarad", CARACARA_VERSION, argc, argv, [] { usage(stdout); });
+    while (args.next(bus_choice)) {
+        if (args.is("--config")) config_path = args.value();
+        else if (args.is("--hardware")) hardware = args.value();
+        else if (args.flag("--check-config")) check_only = true;
+        else if (args.flag("--zero-thrusters")) zero_only = true;
+        else args.unknown();
     }
 
     // An explicitly named file must exist; the default path may be absent (built-in defaults).
@@ -127,21 +108,11 @@ int main(int argc, char** argv) {
     if (zero_only)
         return zero_thrusters(*cr.config, hw);
 
-    sd_event* ev_raw = nullptr;
-    if (int r = sd_event_default(&ev_raw); r < 0) {
+    dbus::EventPtr event;
+    if (int r = open_event_loop(event, {SIGTERM, SIGINT, SIGHUP}, on_signal); r < 0) {
         log_error("sd_event_default: %s", errno_name(-r).c_str());
         return 1;
     }
-    dbus::EventPtr event(ev_raw);
-    sigset_t ss;
-    sigemptyset(&ss);
-    sigaddset(&ss, SIGTERM);
-    sigaddset(&ss, SIGINT);
-    sigaddset(&ss, SIGHUP);
-    sigprocmask(SIG_BLOCK, &ss, nullptr);
-    sd_event_add_signal(event.get(), nullptr, SIGTERM, on_signal, nullptr);
-    sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
-    sd_event_add_signal(event.get(), nullptr, SIGHUP, on_signal, nullptr);
     // A closed log pipe (caracarad | head) is an EPIPE, not the end of the daemon; systemd's
     // IgnoreSIGPIPE= does the same for the service. Terminal stop signals (Ctrl-Z, a background
     // daemon writing to its terminal) would freeze it with the thrusters running.

@@ -3,6 +3,7 @@
 #include "core/dive_format.hpp"
 #include "drivers/platform/dive_files.hpp"
 #include "drivers/platform/io_error.hpp"
+#include "drivers/sdbus/program_args.hpp"
 #include "drivers/sdbus/sdbus.hpp"
 #include "sim/device_server.hpp"
 #include "sim/dive_replay.hpp"
@@ -81,34 +82,18 @@ int main(int argc, char** argv) {
     long physics_hz = 100;
     std::string replay_path;
 
-    for (int i = 1; i < argc; ++i) {
-        std::string a = argv[i];
-        auto value = [&](const char* name) -> std::string {
-            if (i + 1 >= argc) {
-                std::fprintf(stderr, "caracara-sim: %s needs a value\n", name);
-                std::exit(2);
-            }
-            return argv[++i];
-        };
-        if (a == "--socket") { socket_path = value("--socket"); socket_given = true; }
-        else if (a == "--kernel-bridge") kernel_bridge = value("--kernel-bridge");
-        else if (a == "--config") config_path = value("--config");
-        else if (a == "--config-if-exists") { config_path = value("--config-if-exists"); config_optional = true; }
-        else if (a == "--system") bus_choice = {dbus::BusChoice::Kind::System, {}};
-        else if (a == "--user") bus_choice = {dbus::BusChoice::Kind::User, {}};
-        else if (a == "--bus-address") bus_choice = {dbus::BusChoice::Kind::Address, value("--bus-address")};
-        else if (a == "--no-dbus") use_dbus = false;
-        else if (a == "--replay") replay_path = value("--replay");
-        else if (a == "--realistic-timing") realistic = 1;
-        else if (a == "--clock-hz") clock_hz = std::strtol(value("--clock-hz").c_str(), nullptr, 10);
-        else if (a == "--physics-hz") physics_hz = std::strtol(value("--physics-hz").c_str(), nullptr, 10);
-        else if (a == "-h" || a == "--help") { usage(stdout); return 0; }
-        else if (a == "--version") { std::printf("caracara-sim %s\n", CARACARA_VERSION); return 0; }
-        else {
-            std::fprintf(stderr, "caracara-sim: unknown option '%s'\n", a.c_str());
-            usage(stderr);
-            return 2;
-        }
+    dbus::ProgramArgs args("caracara-sim", CARACARA_VERSION, argc, argv, [] { usage(stdout); });
+    while (args.next(bus_choice)) {
+        if (args.is("--socket")) { socket_path = args.value(); socket_given = true; }
+        else if (args.is("--kernel-bridge")) kernel_bridge = args.value();
+        else if (args.is("--config")) config_path = args.value();
+        else if (args.is("--config-if-exists")) { config_path = args.value(); config_optional = true; }
+        else if (args.flag("--no-dbus")) use_dbus = false;
+        else if (args.is("--replay")) replay_path = args.value();
+        else if (args.flag("--realistic-timing")) realistic = 1;
+        else if (args.is("--clock-hz")) clock_hz = std::strtol(args.value().c_str(), nullptr, 10);
+        else if (args.is("--physics-hz")) physics_hz = std::strtol(args.value().c_str(), nullptr, 10);
+        else args.unknown();
     }
     if (physics_hz < 1 || physics_hz > 10000) {
         std::fprintf(stderr, "caracara-sim: --physics-hz must be 1..10000\n");
@@ -152,19 +137,11 @@ int main(int argc, char** argv) {
         vehicle.add_stepped(replay.get());
     }
 
-    sd_event* ev_raw = nullptr;
-    if (int r = sd_event_default(&ev_raw); r < 0) {
+    dbus::EventPtr event;
+    if (int r = open_event_loop(event, {SIGTERM, SIGINT}); r < 0) {
         std::fprintf(stderr, "caracara-sim: sd_event: %s\n", errno_name(-r).c_str());
         return 1;
     }
-    dbus::EventPtr event(ev_raw);
-    sigset_t ss;
-    sigemptyset(&ss);
-    sigaddset(&ss, SIGTERM);
-    sigaddset(&ss, SIGINT);
-    sigprocmask(SIG_BLOCK, &ss, nullptr);
-    sd_event_add_signal(event.get(), nullptr, SIGTERM, nullptr, nullptr);
-    sd_event_add_signal(event.get(), nullptr, SIGINT, nullptr, nullptr);
 
     DeviceServer server(event.get(), vehicle);
     if (!kernel_bridge.empty() && !socket_given)

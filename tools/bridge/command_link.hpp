@@ -1,13 +1,14 @@
-// One pilot's own connection to caracarad: each WebSocket client gets one, so the daemon's
+// One pilot's own connection to caracarad (client::PilotConnection, driven from the bridge's
+// io_context): each WebSocket client gets one, so the daemon's
 // per-client rules hold per pilot (its thrust goes to zero when this connection closes; the
 // command timeout, which is the vehicle's, zeroes it when commands stop; a motor test stops when
 // its keep-alives stop or this connection closes). Commands are sent asynchronously and in order; a refusal comes back with
 // the daemon's error name, and a reply that carries something (command_spec's reply) as JSON.
 #pragma once
 
-#include "drivers/sdbus/sdbus.hpp"
 #include "tools/bridge/bus_watch.hpp"
 #include "tools/bridge/command.hpp"
+#include "tools/client/pilot_connection.hpp"
 
 #include <boost/asio/io_context.hpp>
 #include <functional>
@@ -32,13 +33,12 @@ public:
     // killed vehicle refuses with nothing to stop).
     void send(const Command& c, bool quiet = false);
     // The connection's unique bus name (the daemon's Controller when this client commands).
-    std::string unique_name() const;
+    std::string unique_name() const { return connection_.unique_name(); }
 
 private:
-    struct Pending;
-    static int on_reply(sd_bus_message* m, void* userdata, sd_bus_error* error);
+    void replied(const CommandSpec& spec, bool quiet, const client::PilotConnection::Reply& reply);
 
-    caracara::dbus::BusPtr bus_;
+    client::PilotConnection connection_;
     std::unique_ptr<BusWatch> watch_;
     Refused on_refused_;
     Answered on_answered_;

@@ -1,6 +1,7 @@
 // caracara-bridge: the vehicle live in Foxglove. Serves the Foxglove WebSocket protocol v1 on
 // a Unix socket (default /run/caracara-bridge/bridge.sock, reached with ssh -L) or, when asked,
 // on TCP with a token; a client of caracarad's D-Bus API and of nothing else (docs/foxglove.md).
+#include "drivers/sdbus/program_args.hpp"
 #include "tools/bridge/bridge_server.hpp"
 
 #include <boost/asio/signal_set.hpp>
@@ -40,10 +41,6 @@ void help() {
                  "  --version                  Show the version\n";
 }
 
-int usage(const std::string& m) {
-    std::cerr << "caracara-bridge: " << m << "\nTry 'caracara-bridge --help'.\n";
-    return 2;
-}
 
 } // namespace
 
@@ -54,17 +51,10 @@ int main(int argc, char** argv) {
     session.dives_dir = kDefaultDives;
     std::string token_file;
     std::vector<std::string> allowed_origins;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-        if (a == "-h" || a == "--help") {
-            help();
-            return 0;
-        } else if (a == "--version") {
-            std::cout << "caracara-bridge " << CARACARA_VERSION << '\n';
-            return 0;
-        } else if (a == "--listen") {
-            const std::string l = value();
+    caracara::dbus::ProgramArgs args("caracara-bridge", CARACARA_VERSION, argc, argv, help);
+    while (args.next(session.bus)) {
+        if (args.is("--listen")) {
+            const std::string l = args.value();
             if (l.starts_with("unix:") && l.size() > 5) {
                 listen.unix_path = l.substr(5);
             } else if (l.starts_with("tcp:") && l.rfind(':') > 4) {
@@ -74,55 +64,43 @@ int main(int argc, char** argv) {
                 const std::string port = l.substr(colon + 1);
                 const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), listen.tcp_port);
                 if (ec != std::errc() || end != port.data() + port.size() || listen.tcp_port == 0)
-                    return usage("bad TCP port in '" + l + "'");
+                    args.usage_error("bad TCP port in '" + l + "'");
             } else {
-                return usage("--listen takes unix:PATH or tcp:ADDRESS:PORT, not '" + l + "'");
+                args.usage_error("--listen takes unix:PATH or tcp:ADDRESS:PORT, not '" + l + "'");
             }
-        } else if (a == "--cockpit-dir") {
-            session.cockpit_dir = value();
-            if (session.cockpit_dir.empty())
-                return usage("--cockpit-dir needs a directory");
-        } else if (a == "--dives-dir") {
-            session.dives_dir = value();
-            if (session.dives_dir.empty())
-                return usage("--dives-dir needs a directory");
-        } else if (a == "--token-file") {
-            token_file = value();
-        } else if (a == "--allow-origin") {
-            const std::string o = value();
+        } else if (args.is("--cockpit-dir")) {
+            session.cockpit_dir = args.value();
+        } else if (args.is("--dives-dir")) {
+            session.dives_dir = args.value();
+        } else if (args.is("--token-file")) {
+            token_file = args.value();
+        } else if (args.is("--allow-origin")) {
+            const std::string o = args.value();
             if (!caracara::bridge::OriginCheck::normalize(o))
-                return usage("--allow-origin takes an origin, scheme://host[:port] with no path (e.g. "
-                             "https://app.foxglove.dev), not '" + o + "'");
+                args.usage_error("--allow-origin takes an origin, scheme://host[:port] with no path (e.g. "
+                                 "https://app.foxglove.dev), not '" + o + "'");
             allowed_origins.push_back(o);
-        } else if (a == "--max-clients") {
-            const std::string n = value();
+        } else if (args.is("--max-clients")) {
+            const std::string n = args.value();
             const auto [end, ec] = std::from_chars(n.data(), n.data() + n.size(), listen.max_clients);
             if (ec != std::errc() || end != n.data() + n.size() || listen.max_clients == 0)
-                return usage("--max-clients needs a positive number");
-        } else if (a == "--system") {
-            session.bus = {caracara::dbus::BusChoice::Kind::System, {}};
-        } else if (a == "--user") {
-            session.bus = {caracara::dbus::BusChoice::Kind::User, {}};
-        } else if (a == "--bus-address") {
-            session.bus = {caracara::dbus::BusChoice::Kind::Address, value()};
-            if (session.bus.address.empty())
-                return usage("--bus-address needs an address");
+                args.usage_error("--max-clients needs a positive number");
         } else {
-            return usage("unknown option '" + a + "'");
+            args.unknown();
         }
     }
     if (!listen.tcp_host.empty()) {
         // TCP reaches beyond the SSH login: never without a token.
         if (token_file.empty())
-            return usage("--listen tcp: needs --token-file");
+            args.usage_error("--listen tcp: needs --token-file");
         std::ifstream f(token_file);
         std::getline(f, session.token);
         if (!f && session.token.empty())
-            return usage("cannot read the token from " + token_file);
+            args.usage_error("cannot read the token from " + token_file);
         if (session.token.size() < 16)
-            return usage("the token in " + token_file + " is shorter than 16 characters");
+            args.usage_error("the token in " + token_file + " is shorter than 16 characters");
     } else if (!token_file.empty()) {
-        return usage("--token-file applies to --listen tcp: only");
+        args.usage_error("--token-file applies to --listen tcp: only");
     }
     session.origins = caracara::bridge::OriginCheck(allowed_origins, !session.token.empty());
     for (const std::string& o : session.origins.allowed())

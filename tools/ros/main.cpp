@@ -1,6 +1,7 @@
 // caracara-ros: the vehicle as ROS 2 topics over DDS (Cyclone DDS), without ROS on the vehicle.
 // One DDS participant named like a ROS 2 node's; a client of caracarad's D-Bus API and of nothing
 // else (docs/ros2.md).
+#include "drivers/sdbus/program_args.hpp"
 #include "tools/ros/command_subscriber.hpp"
 #include "tools/ros/spoken_distro.hpp"
 #include "tools/ros/telemetry_publisher.hpp"
@@ -29,14 +30,6 @@ void help() {
                  "ROS_DOMAIN_ID picks the DDS domain unless the config names one.\n";
 }
 
-int usage(const std::string& m) {
-    std::cerr << "caracara-ros: " << m << "\nTry 'caracara-ros --help'.\n";
-    return 2;
-}
-
-int on_signal(sd_event_source* s, const signalfd_siginfo*, void*) {
-    return sd_event_exit(sd_event_source_get_event(s), 0);
-}
 
 // Kill() on the reading connection, sent at once. Without one (caracarad restarting, the
 // connection being made again) on a connection of its own, so a kill is never dropped.
@@ -69,33 +62,20 @@ int main(int argc, char** argv) {
         config.domain_id = static_cast<uint32_t>(std::strtoul(d, nullptr, 10));
     std::string config_path = kDefaultConfig;
     bool config_given = false, commands_flag = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto value = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-        if (a == "-h" || a == "--help") {
-            help();
-            return 0;
-        } else if (a == "--version") {
-            std::cout << "caracara-ros " << CARACARA_VERSION << '\n';
-            return 0;
-        } else if (a == "--config") {
-            config_path = value();
+    caracara::dbus::ProgramArgs args("caracara-ros", CARACARA_VERSION, argc, argv, help);
+    while (args.next(config.bus)) {
+        if (args.is("--config")) {
+            config_path = args.value();
             config_given = true;
-        } else if (a == "--commands") {
+        } else if (args.flag("--commands")) {
             commands_flag = true;
-        } else if (a == "--system") {
-            config.bus = {};
-        } else if (a == "--user") {
-            config.bus.kind = caracara::dbus::BusChoice::Kind::User;
-        } else if (a == "--bus-address") {
-            config.bus = {caracara::dbus::BusChoice::Kind::Address, value()};
         } else {
-            return usage("unknown argument " + a);
+            args.unknown();
         }
     }
     if (config_given || access(config_path.c_str(), F_OK) == 0)
         if (const std::string e = caracara::ros::load_config(config_path, config); !e.empty())
-            return usage(e);
+            args.usage_error(e);
     config.commands = config.commands || commands_flag;
     if (const std::string e = caracara::ros::commands_refusal(config, caracara::ros::is_loopback(config.interface));
         !e.empty()) {
@@ -103,17 +83,9 @@ int main(int argc, char** argv) {
         return 2;
     }
 
-    sd_event* raw = nullptr;
-    if (sd_event_default(&raw) < 0)
+    caracara::EventPtr event;
+    if (caracara::open_event_loop(event, {SIGTERM, SIGINT}) < 0)
         return 1;
-    caracara::EventPtr event(raw);
-    sigset_t set;
-    sigemptyset(&set);
-    sigaddset(&set, SIGTERM);
-    sigaddset(&set, SIGINT);
-    sigprocmask(SIG_BLOCK, &set, nullptr);
-    sd_event_add_signal(event.get(), nullptr, SIGTERM, on_signal, nullptr);
-    sd_event_add_signal(event.get(), nullptr, SIGINT, on_signal, nullptr);
     try {
         caracara::ros::DdsParticipant dds(config);
         caracara::ros::CommandRecord record; // the writers' holder and refusals, on /diagnostics

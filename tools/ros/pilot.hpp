@@ -1,11 +1,12 @@
-// One remote DDS writer's own connection to caracarad: each writer of a command topic is a
+// One remote DDS writer's own connection to caracarad (client::PilotConnection, attached to
+// caracara-ros's sd-event loop): each writer of a command topic is a
 // pilot, so the daemon's per-client rules hold per writer (its thrust goes to zero when this
 // connection closes; the command timeout, which is the vehicle's, zeroes it when it stops
 // sending). Calls are sent asynchronously and in order; a refusal is logged with the daemon's
 // error name and counted in the CommandRecord (/diagnostics).
 #pragma once
 
-#include "drivers/sdbus/sdbus.hpp"
+#include "tools/client/pilot_connection.hpp"
 #include "tools/ros/command_record.hpp"
 
 #include <array>
@@ -30,14 +31,11 @@ public:
     void set_thrust(const std::vector<int32_t>& values);
 
 private:
-    static int on_motion_reply(sd_bus_message* m, void* userdata, sd_bus_error* error);
-    static int on_thrust_reply(sd_bus_message* m, void* userdata, sd_bus_error* error);
-    void replied(sd_bus_message* m, const std::string& writer);
-    void send(caracara::dbus::MessagePtr call, const char* what, sd_bus_message_handler_t reply);
+    void replied(const client::PilotConnection::Reply& reply, const std::string& writer, const char* what);
 
     std::string writer_, motion_writer_;
     CommandRecord& record_;
-    caracara::dbus::BusPtr bus_;
+    client::PilotConnection connection_;
 };
 
 } // namespace caracara::ros
