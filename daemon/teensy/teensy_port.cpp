@@ -70,12 +70,8 @@ Result TeensyPort::set_speed(int left, int right, std::string_view client, Compl
     // client under the command timeout (stopping is always allowed).
     const bool moving = left != 0 || right != 0;
     if (moving) {
-        if (Result r = gate_.state_error(); !r.ok())
-            return r;
-        // Range first: a refused command changes nothing, not even who commands.
-        if (auto e = teensy::encode_set_speed(left, right).error; e != teensy::TeensyError::None)
-            return teensy::result_of(e, "Set Speed");
-        if (Result r = gate_.accept_command(client); !r.ok())
+        const Result range = teensy::result_of(teensy::encode_set_speed(left, right).error, "Set Speed");
+        if (Result r = gate_.accept_command(client, range); !r.ok())
             return r;
     }
     TeensyLink& link = connection_.link();

@@ -7,13 +7,13 @@
 namespace caracara {
 
 Result TeensyTurn::start(double radians, bool absolute, std::string_view client, Completion done) {
-    if (Result r = gate_.state_error(); !r.ok())
-        return r;
+    // A turn runs only while the vehicle may move (a kill, a power-off or the command timeout
+    // ends it): a second one is Busy whatever the state.
     if (done_)
         return {Status::Busy, "a turn is already running"};
-    if (!std::isfinite(radians))
-        return {Status::InvalidValue, "the angle must be a finite number of radians"};
-    if (Result r = gate_.accept_command(client); !r.ok())
+    const Result range = std::isfinite(radians) ? Result{}
+                                                : Result{Status::InvalidValue, "the angle must be a finite number of radians"};
+    if (Result r = gate_.accept_command(client, range); !r.ok())
         return r;
     done_ = std::move(done);
     connection_.telemetry().turning = true;

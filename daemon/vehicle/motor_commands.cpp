@@ -1,18 +1,16 @@
 #include "daemon/vehicle/motor_commands.hpp"
 
-#include "core/status_of.hpp"
-
 #include "daemon/loop/log.hpp"
 
 #include <string>
 
 namespace caracara {
 
-MotorCommands::MotorCommands(const DaemonConfig& config, const SafetyMachine& safety, CommandGate& gate,
+MotorCommands::MotorCommands(const DaemonConfig& config, const SafetyMachine& safety, CommandAcceptance& acceptance,
                              SafetyActuator& actuator, VehicleEvents& events)
     : config_(config),
       safety_(safety),
-      gate_(gate),
+      acceptance_(acceptance),
       actuator_(actuator),
       events_(events),
       demand_(config.control.budget_policy, *find_profile(config, config.control.profile)) {}
@@ -24,14 +22,11 @@ void MotorCommands::hand_down() {
     actuator_.hand_down(orders);
 }
 
-Result MotorCommands::accept(const MotorValues& wanted, bool mix_saturated, std::string_view client) {
-    const BudgetResult b = demand_.evaluate(wanted);
-    if (!b.ok())
-        return {status_of(b.error), b.message};
-    if (Result r = gate_.accept_command(client); !r.ok())
-        return r;
+Result MotorCommands::take(const MotorVerdict& v) {
+    if (!v.ok())
+        return v.result;
     // A stream re-sending the same command changes nothing worth announcing.
-    const bool changed = demand_.take(wanted, b, mix_saturated);
+    const bool changed = demand_.take(v.wanted, v.budget, v.mix_saturated);
     hand_down();
     events_.changed(changed ? kChangeMotors : 0u);
     return {};
@@ -53,23 +48,15 @@ Result MotorCommands::set_profile(std::string_view name) {
 }
 
 Result MotorCommands::set_thrust(std::span<const int32_t> values, std::string_view client) {
-    if (values.size() != kMotorCount)
-        return {Status::InvalidLength, "SetThrust needs exactly 8 motor values, got " + std::to_string(values.size())};
-    MotorValues m{};
-    for (size_t i = 0; i < kMotorCount; ++i) {
-        if (values[i] < -kMotorMax || values[i] > kMotorMax)
-            return {Status::OutOfRange, "motor " + std::to_string(i) + ": " + std::to_string(values[i]) +
-                                            " is outside -8850..8850"};
-        m[i] = values[i];
-    }
-    return accept(m, false, client);
+    return take(acceptance_.thrust(values, demand_, client));
 }
 
 Result MotorCommands::set_motion(const AxisDemand& demand, std::string_view client) {
-    MixResult mr = mix(demand, config_.mixing);
-    if (mr.error != MixError::None)
-        return {status_of(mr.error), mr.message};
-    return accept(mr.motors, mr.saturated, client);
+    return take(acceptance_.motion(demand, demand_, client));
+}
+
+Result MotorCommands::drive(const MotorValues& values, std::string_view client) {
+    return take(acceptance_.motors(values, demand_, client));
 }
 
 void MotorCommands::exclude(const std::array<bool, kMotorCount>& excluded) {
@@ -78,13 +65,6 @@ void MotorCommands::exclude(const std::array<bool, kMotorCount>& excluded) {
     events_.changed(changed ? kChangeMotors : 0u);
 }
 
-Result MotorCommands::surface(const AxisDemand& ascent) {
-    MixResult mr = mix(ascent, config_.mixing);
-    if (mr.error != MixError::None)
-        return {status_of(mr.error), mr.message};
-    Result r = accept(mr.motors, mr.saturated, kFailsafeClient);
-    surfacing_ = r.ok();
-    return r;
-}
+Result MotorCommands::surface(const AxisDemand& ascent) { return take(acceptance_.ascent(ascent, demand_)); }
 
 } // namespace caracara

@@ -1,6 +1,6 @@
 // The motor commands (SetThrust, SetMotion, SetProfile, and the failsafes' exclusion and
-// ascent): checked, scaled by the profile and held to the budget (MotorDemand), taken as the
-// command standing now once the vehicle's state allows (CommandGate, the safety machine), and
+// ascent): accepted or refused by the CommandAcceptance (state, length, range, budget), then
+// scaled by the profile and held to the budget (MotorDemand) as the command standing now, and
 // handed down to the thrusters through the SafetyActuator. Owned by Vehicle.
 #pragma once
 
@@ -10,8 +10,8 @@
 #include "core/safety.hpp"
 #include "core/status.hpp"
 #include "daemon/safety/safety_actuator.hpp"
-#include "daemon/interfaces/command_gate.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
+#include "daemon/vehicle/command_acceptance.hpp"
 
 #include <array>
 #include <cstdint>
@@ -22,26 +22,21 @@ namespace caracara {
 
 class MotorCommands final {
 public:
-    static constexpr std::string_view kFailsafeClient = "failsafe"; // who drives an ascent
-
-    // `gate`: the vehicle, where a command is accepted (CommandGate::accept_command).
-    MotorCommands(const DaemonConfig& config, const SafetyMachine& safety, CommandGate& gate,
+    // `acceptance`: where each command is accepted or refused.
+    MotorCommands(const DaemonConfig& config, const SafetyMachine& safety, CommandAcceptance& acceptance,
                   SafetyActuator& actuator, VehicleEvents& events);
 
     Result set_thrust(std::span<const int32_t> values, std::string_view client);
     Result set_motion(const AxisDemand& demand, std::string_view client);
     // Selects a thrust profile by name; the current command goes out again under it at once.
     Result set_profile(std::string_view name);
-    // Through the budget, then accepted (CommandGate::accept_command); then handed down.
-    Result accept(const MotorValues& wanted, bool mix_saturated, std::string_view client);
+    // Eight motor values already in their shape (a packet's, a motor test's, a pulse).
+    Result drive(const MotorValues& values, std::string_view client);
     // These thrusters to zero and out of the budget's count; the standing command goes on.
     void exclude(const std::array<bool, kMotorCount>& excluded);
-    // The ascent, through the mixing and the budget, as client kFailsafeClient (called again
-    // to keep it past the command timeout); every other motion command gets Surfacing until
-    // a kill ends it (end_surfacing).
+    // The ascent (CommandAcceptance::ascent: every other motion command gets Surfacing until a
+    // kill ends it).
     Result surface(const AxisDemand& ascent);
-    bool surfacing() const { return surfacing_; }
-    void end_surfacing() { surfacing_ = false; }
     void clear() { demand_.clear(); }
 
     // What thruster i is to be ordered now: its applied value while the vehicle may drive.
@@ -49,16 +44,17 @@ public:
     const MotorDemand& demand() const { return demand_; }
 
 private:
+    // An accepted command becomes the one standing now, and goes down.
+    Result take(const MotorVerdict& v);
     // Hands the orders standing now down (DemandListener::demand_changed).
     void hand_down();
 
     const DaemonConfig& config_;
     const SafetyMachine& safety_;
-    CommandGate& gate_;
+    CommandAcceptance& acceptance_;
     SafetyActuator& actuator_;
     VehicleEvents& events_;
     MotorDemand demand_;
-    bool surfacing_ = false;
 };
 
 } // namespace caracara

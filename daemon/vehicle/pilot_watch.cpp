@@ -7,21 +7,6 @@
 
 namespace caracara {
 
-Result PilotWatch::accept_command(std::string_view client) {
-    if (motors_.surfacing() && client != MotorCommands::kFailsafeClient)
-        return {Status::Surfacing, "a failsafe is surfacing the vehicle; Kill stops it"};
-    if (Result r = condition_.state_error(); !r.ok())
-        return r;
-    const std::string previous = safety_.commanding_client();
-    if (!safety_.accept_command(monotonic_ns(), client).ok())
-        return condition_.state_error();
-    deadline_.arm(safety_.next_deadline());
-    if (previous != safety_.commanding_client())
-        events_.changed(kChangeController);
-    tell_failsafes(); // a pilot again: pilot-lost ends
-    return {};
-}
-
 void PilotWatch::tell_failsafes() {
     if (safety_.pilot_lost() == told_lost_)
         return;

@@ -17,10 +17,10 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       actuator_(bus, lines, teensy),
       safety_(safety_config(config), false, monotonic_ns()),
       deadline_([this] { tick(monotonic_ns()); }),
-      motors_(config, safety_, *this, actuator_, events),
       condition_(safety_, bus, lines, failsafes),
-      pilots_(config.failsafe, safety_, motors_, condition_, deadline_, events, failsafes,
-              [this](const SafetyAction& a) { handle(a); }) {}
+      pilots_(config.failsafe, safety_, failsafes, [this](const SafetyAction& a) { handle(a); }),
+      acceptance_(config.mixing, safety_, condition_, deadline_, events, pilots_),
+      motors_(config, safety_, acceptance_, actuator_, events) {}
 
 void Vehicle::handle(const SafetyAction& a, const Result* kill) {
     uint32_t changes = 0;
@@ -29,7 +29,7 @@ void Vehicle::handle(const SafetyAction& a, const Result* kill) {
         changes |= kChangeMotors | kChangeController;
     }
     if (safety_.kill_output_asserted())
-        motors_.end_surfacing(); // a kill ends an ascent at once
+        acceptance_.end_surfacing(); // a kill ends an ascent at once
     // Not re-entered halfway: a line lost inside it is decided by the failsafes after it.
     const bool outer = !acting_;
     acting_ = true;

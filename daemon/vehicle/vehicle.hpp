@@ -1,7 +1,8 @@
 // The vehicle as callers see it: the safety state machine, the commands (thrust, motion,
 // kill, clear, power-off) and who is commanding; the legacy packet is read by its
 // PacketHandler, which asks the Vehicle for each of these. The motor commands and their
-// values (requested, applied, the budget) are its MotorCommands' job; what the safety machine
+// values (requested, applied, the budget) are its MotorCommands' job, whether one is accepted its
+// CommandAcceptance's (also the CommandGate the Teensy's wheels and turns ask); what the safety machine
 // decides is carried out by its SafetyActuator (on the bus, the safety lines and the Teensy);
 // the end of arming and the command timeout come from its DeadlineTimer; who commands and
 // who left, its PilotWatch.
@@ -21,6 +22,7 @@
 #include "daemon/teensy/teensy_port.hpp"
 #include "daemon/interfaces/command_gate.hpp"
 #include "daemon/interfaces/demand_listener.hpp"
+#include "daemon/vehicle/command_acceptance.hpp"
 #include "daemon/vehicle/motor_commands.hpp"
 #include "daemon/vehicle/pilot_watch.hpp"
 #include "daemon/vehicle/vehicle_condition.hpp"
@@ -55,7 +57,7 @@ public:
     Result clear_packet_kill() { return clear(); }
     Result power_off(std::string_view confirmation);
     // A packet's motor values, as SetThrust's.
-    Result drive(const MotorValues& values, std::string_view client) { return motors_.accept(values, false, client); }
+    Result drive(const MotorValues& values, std::string_view client) { return motors_.drive(values, client); }
     // The calls that stop the thrusters hand their result to `done` once the zero orders they
     // put on the bus are on the wire (the bus worker's thread): a caller that gets it knows
     // the thrusters were told zero. The loop does not wait for them; the kill output was
@@ -74,9 +76,13 @@ public:
     void tick(uint64_t now_ns) { handle(safety_.tick(now_ns)); }
 
     void kill_switch_read(bool set) override;
-    Result state_error() const override { return condition_.state_error(); }
-    bool powered_off() const override { return safety_.state() == SafetyState::PoweredOff; }
-    Result accept_command(std::string_view client) override { return pilots_.accept_command(client); }
+    // CommandGate, answered by its CommandAcceptance (the Teensy is made before the Vehicle).
+    Result state_error() const override { return acceptance_.state_error(); }
+    bool powered_off() const override { return acceptance_.powered_off(); }
+    Result accept_command(std::string_view client, const Result& range) override {
+        return acceptance_.accept_command(client, range);
+    }
+    CommandAcceptance& acceptance() { return acceptance_; }
     // Inside a safety sequence being carried out (SafetyActuator::carry_out): the failsafes
     // decide a condition pushed meanwhile once it is done, not halfway through it.
     bool acting() const { return acting_; }
@@ -98,10 +104,9 @@ public:
     const ThrustProfile& profile() const { return motors_.demand().profile(); }
 
     // Failsafes (daemon/failsafe_monitor decides, the Vehicle carries out).
-    static constexpr std::string_view kFailsafeClient = MotorCommands::kFailsafeClient;
     void exclude(const std::array<bool, kMotorCount>& excluded) { motors_.exclude(excluded); }
     Result surface(const AxisDemand& ascent) { return motors_.surface(ascent); }
-    bool surfacing() const { return motors_.surfacing(); }
+    bool surfacing() const { return acceptance_.surfacing(); }
 
 private:
     Result clear();
@@ -117,9 +122,10 @@ private:
     SafetyMachine safety_;
     DeadlineTimer deadline_;
 
-    MotorCommands motors_;
     VehicleCondition condition_;
     PilotWatch pilots_;
+    CommandAcceptance acceptance_;
+    MotorCommands motors_;
     bool acting_ = false;
 };
 

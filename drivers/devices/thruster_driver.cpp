@@ -1,5 +1,6 @@
 #include "drivers/devices/thruster_driver.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <stdexcept>
@@ -55,16 +56,14 @@ IoError ThrusterDriver::select_mux() {
     return e;
 }
 
-IoError ThrusterDriver::send_order(int32_t motor_value) {
-    // Range first: negating an out-of-range value (INT32_MIN) would be undefined.
-    if (motor_value < -kMotorMax || motor_value > kMotorMax) {
-        ++counters_.rejected_orders;
-        return IoError::Other;
-    }
+IoError ThrusterDriver::send_order(int32_t value) {
+    // Commands are accepted or refused above (daemon/vehicle/command_acceptance); here only the
+    // wire is protected: held to its range, and never INT32_MIN negated (undefined).
+    const int32_t motor_value = std::clamp(value, -kMotorMax, kMotorMax);
     const int32_t wire_value = cfg_.reversed ? -motor_value : motor_value;
     const auto speed = motor_to_speed(wire_value);
     const auto order = speed ? encode_order(cfg_.mt, *speed, cfg_.info) : std::nullopt;
-    if (!order) {  // unreachable after the range check and config validation; refuse anyway
+    if (!order) {  // unreachable after the clamp and config validation; refuse anyway
         ++counters_.rejected_orders;
         return IoError::Other;
     }

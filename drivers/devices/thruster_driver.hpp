@@ -24,7 +24,7 @@ namespace caracara {
 struct ThrusterCounters {
     uint64_t orders_sent = 0;      // orders the thruster ACKed
     uint64_t order_failures = 0;   // orders not delivered (mux or thruster transfer failed)
-    uint64_t rejected_orders = 0;  // motor values outside -8850..8850: refused, nothing sent
+    uint64_t rejected_orders = 0;  // orders the codec refused (never, after the clamp and config validation)
     uint64_t status_reads = 0;     // status replies that decoded cleanly
     uint64_t status_failures = 0;  // status reads that failed (transfer or bad reply)
     uint64_t nacks = 0;            // IoError::Nack, from the thruster or its mux
@@ -43,10 +43,10 @@ public:
     // Registers the thruster's mux, if any, with `mux`. `bus` and `mux` must outlive the driver.
     ThrusterDriver(I2cDev& bus, MuxTracker& mux, ThrusterConfig cfg);
 
-    // Orders `motor_value` (-8850..+8850; negated first when cfg.reversed): selects the mux
-    // channel if needed, then ONE I2C_RDWR with one write message [SPEED, INFO, CSUM] to
-    // addr7. An out-of-range value is refused with IoError::Other and nothing is sent.
-    IoError send_order(int32_t motor_value);
+    // Orders `value` (held to -8850..+8850, the wire's range; negated then when cfg.reversed):
+    // selects the mux channel if needed, then ONE I2C_RDWR with one write message [SPEED, INFO,
+    // CSUM] to addr7. Refusing a command is the daemon's CommandAcceptance's, not the driver's.
+    IoError send_order(int32_t value);
     // ONE I2C_RDWR with one read message of status_length(variant) bytes, decoded. A reply
     // with a wrong first byte or checksum is discarded, counted, and gives IoError::BadReply;
     // last_status() keeps the last good one.

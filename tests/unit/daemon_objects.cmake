@@ -8,3 +8,5 @@ caracara_unit_test(test_thruster_bus SOURCES unit/test_thruster_bus.cpp LIBS dae
 caracara_unit_test(test_teensy_worker SOURCES unit/test_teensy_worker.cpp LIBS daemon_fakes)
 caracara_unit_test(test_preflight SOURCES unit/test_preflight.cpp LIBS daemon_fakes)
 caracara_unit_test(test_failsafe_table SOURCES unit/test_failsafe_table.cpp LIBS daemon_fakes)
+# CommandAcceptance: every command in every state, accepted or its named error, in order.
+caracara_unit_test(test_command_acceptance SOURCES unit/test_command_acceptance.cpp LIBS daemon_fakes)
