@@ -6,15 +6,6 @@
 
 namespace caracara {
 
-std::string_view verdict_name(DirectionVerdict v) {
-    switch (v) {
-    case DirectionVerdict::Ok: return "ok";
-    case DirectionVerdict::Reversed: return "reversed";
-    case DirectionVerdict::Inconclusive: break;
-    }
-    return "inconclusive";
-}
-
 DirectionJudgement judge_direction(const MixMatrix& mixing, std::size_t motor, int32_t pulse_value,
                                    const std::array<double, 3>& change, double threshold_rad) {
     DirectionJudgement j;

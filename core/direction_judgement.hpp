@@ -4,6 +4,7 @@
 // Pure: the daemon (daemon/commissioning/direction_detection) pulses and measures.
 #pragma once
 
+#include "core/enum_names.hpp"
 #include "core/mixing.hpp"
 #include "core/thruster_config.hpp"
 
@@ -16,7 +17,15 @@
 namespace caracara {
 
 enum class DirectionVerdict : uint8_t { Ok, Reversed, Inconclusive };
-std::string_view verdict_name(DirectionVerdict v); // "ok", "reversed", "inconclusive"
+template <>
+struct EnumNames<DirectionVerdict> {
+    static constexpr std::array<EnumName<DirectionVerdict>, 3> table{{
+        {DirectionVerdict::Ok, "ok"},
+        {DirectionVerdict::Reversed, "reversed"},
+        {DirectionVerdict::Inconclusive, "inconclusive"},
+    }};
+};
+inline std::string_view verdict_name(DirectionVerdict v) { return name_of(v); }
 
 struct DirectionJudgement {
     DirectionVerdict verdict = DirectionVerdict::Inconclusive;

@@ -77,9 +77,8 @@ std::string VehicleDaemon::start() {
     // The loop: the kill switch's edge, the kill output, every tick.
     schedule.realtime(rt.loop_priority);
     if (rt.enabled && !schedule.refused())
-        log_notice("realtime: %s, loop at %u, bus worker at %u, Teensy worker at %u, dive writer at the normal policy",
-                   rt.policy == SchedPolicy::Fifo ? "SCHED_FIFO" : "SCHED_RR", rt.loop_priority, rt.bus_priority,
-                   rt.teensy_priority);
+        log_notice("realtime: policy %s, loop at %u, bus worker at %u, Teensy worker at %u, dive writer at the normal policy",
+                   std::string(name_of(rt.policy)).c_str(), rt.loop_priority, rt.bus_priority, rt.teensy_priority);
     if (std::string e = loop_.start(); !e.empty())
         return e;
     if (std::string e = failsafes_.start(); !e.empty())

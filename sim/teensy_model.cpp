@@ -48,18 +48,10 @@ constexpr std::size_t kMaxLoggedUnknownBytes = 64;
 } // namespace
 
 std::string_view teensy_command_name(uint8_t command) {
-    switch (command) {
-    case teensy::kConfirm: return "Confirm";
-    case teensy::kSetSpeed: return "SetSpeed";
-    case teensy::kTurn: return "Turn";
-    case teensy::kTurnTo: return "TurnTo";
-    case teensy::kStop: return "Stop";
-    case teensy::kServo: return "Servo";
-    case teensy::kGetDistance: return "GetDistance";
-    case teensy::kGetOrientation: return "GetOrientation";
-    case teensy::kSetLeds: return "SetLeds";
-    default: return "Unknown";
-    }
+    const auto& table = EnumNames<TeensyCommand>::table;
+    if (command < static_cast<uint8_t>(table.front().value) || command > static_cast<uint8_t>(table.back().value))
+        return "Unknown";
+    return name_of(static_cast<TeensyCommand>(command));
 }
 
 TeensyModel::TeensyModel(TeensyConfig cfg, AttitudeSource attitude)

@@ -61,16 +61,29 @@
 
 namespace caracara::sim {
 
+// The firmware's commands, by their id on the wire (named in the frame log: teensy_command_name).
+enum class TeensyCommand : uint8_t {
+    Confirm = 0x01,
+    SetSpeed,
+    Turn,
+    TurnTo,
+    Stop,
+    Servo,
+    GetDistance,
+    GetOrientation,
+    SetLeds,
+};
+
 namespace teensy {
-inline constexpr uint8_t kConfirm = 0x01;
-inline constexpr uint8_t kSetSpeed = 0x02;
-inline constexpr uint8_t kTurn = 0x03;
-inline constexpr uint8_t kTurnTo = 0x04;
-inline constexpr uint8_t kStop = 0x05;
-inline constexpr uint8_t kServo = 0x06;
-inline constexpr uint8_t kGetDistance = 0x07;
-inline constexpr uint8_t kGetOrientation = 0x08;
-inline constexpr uint8_t kSetLeds = 0x09;
+inline constexpr uint8_t kConfirm = static_cast<uint8_t>(TeensyCommand::Confirm);
+inline constexpr uint8_t kSetSpeed = static_cast<uint8_t>(TeensyCommand::SetSpeed);
+inline constexpr uint8_t kTurn = static_cast<uint8_t>(TeensyCommand::Turn);
+inline constexpr uint8_t kTurnTo = static_cast<uint8_t>(TeensyCommand::TurnTo);
+inline constexpr uint8_t kStop = static_cast<uint8_t>(TeensyCommand::Stop);
+inline constexpr uint8_t kServo = static_cast<uint8_t>(TeensyCommand::Servo);
+inline constexpr uint8_t kGetDistance = static_cast<uint8_t>(TeensyCommand::GetDistance);
+inline constexpr uint8_t kGetOrientation = static_cast<uint8_t>(TeensyCommand::GetOrientation);
+inline constexpr uint8_t kSetLeds = static_cast<uint8_t>(TeensyCommand::SetLeds);
 
 inline constexpr uint8_t kAckBusy = 0xFF;       // in the ack slot
 inline constexpr uint8_t kAckNone = 0x00;       // invalid argument / unknown command / not listening
@@ -81,9 +94,24 @@ inline constexpr std::size_t kMaxServoDegrees = 180;
 
 enum class TeensyTaskState : uint8_t { Idle, Running, FinishedAwaitingAck };
 
+// The command's name, "Unknown" for an id the firmware does not know.
 std::string_view teensy_command_name(uint8_t command);
 } // namespace caracara::sim
 namespace caracara {
+template <>
+struct EnumNames<sim::TeensyCommand> {
+    static constexpr std::array<EnumName<sim::TeensyCommand>, 9> table{{
+        {sim::TeensyCommand::Confirm, "Confirm"},
+        {sim::TeensyCommand::SetSpeed, "SetSpeed"},
+        {sim::TeensyCommand::Turn, "Turn"},
+        {sim::TeensyCommand::TurnTo, "TurnTo"},
+        {sim::TeensyCommand::Stop, "Stop"},
+        {sim::TeensyCommand::Servo, "Servo"},
+        {sim::TeensyCommand::GetDistance, "GetDistance"},
+        {sim::TeensyCommand::GetOrientation, "GetOrientation"},
+        {sim::TeensyCommand::SetLeds, "SetLeds"},
+    }};
+};
 template <>
 struct EnumNames<sim::TeensyTaskState> {
     static constexpr std::array<EnumName<sim::TeensyTaskState>, 3> table{{

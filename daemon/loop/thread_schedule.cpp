@@ -24,8 +24,6 @@ namespace caracara {
 
 namespace {
 
-const char* policy_name(SchedPolicy p) { return p == SchedPolicy::Fifo ? "SCHED_FIFO" : "SCHED_RR"; }
-
 // Locked memory is resident: each thread's whole stack counts. The workers and the dive writer
 // touch 8-16 KiB of theirs (smaps of an unlocked daemon at 50 Hz with a command stream, whose
 // untouched stack pages stay out); 128 KiB leaves them eight times that.
@@ -66,9 +64,10 @@ void ThreadSchedule::realtime(uint32_t priority) {
         refused_ = true;
         rlimit rl{};
         getrlimit(RLIMIT_RTPRIO, &rl);
-        log_warning("realtime: the kernel refused %s priority %u (%s; RLIMIT_RTPRIO %lld: caracarad.service's "
+        // The policy as [realtime] policy spells it: one name for it wherever a user reads it.
+        log_warning("realtime: the kernel refused policy %s at priority %u (%s; RLIMIT_RTPRIO %lld: caracarad.service's "
                     "LimitRTPRIO=, or a container without CAP_SYS_NICE); every thread runs at the normal policy",
-                    policy_name(settings_.policy), priority, errno_name(r).c_str(),
+                    std::string(name_of(settings_.policy)).c_str(), priority, errno_name(r).c_str(),
                     rl.rlim_cur == RLIM_INFINITY ? -1LL : static_cast<long long>(rl.rlim_cur));
         normal();
     }

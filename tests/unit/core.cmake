@@ -14,3 +14,5 @@ caracara_unit_test(test_direction_judgement SOURCES unit/test_direction_judgemen
 caracara_unit_test(test_bus_scan_report SOURCES unit/test_bus_scan_report.cpp LIBS caracara_devices)
 # Every enum's names (core/enum_names.hpp), wherever the enum lives.
 caracara_unit_test(test_enum_names SOURCES unit/test_enum_names.cpp LIBS caracara_daemon caracara_simcore)
+# It reads the sources for every EnumNames table, so that none is left out of its list.
+target_compile_definitions(test_enum_names PRIVATE CARACARA_SOURCE_DIR="${CMAKE_SOURCE_DIR}")

@@ -1,10 +1,12 @@
 // Every enum's names (core/enum_names.hpp): each value the enum declares has one name, each name
 // reads back to its value, no two values share a name. The enum's own values are found by the
 // compiler (an enumerator prints by name in __PRETTY_FUNCTION__, any other value as a cast), so a
-// value added to an enum without a name in its table fails here.
+// value added to an enum without a name in its table fails here; and every table in the sources
+// is found by reading them, so a table added without being listed here fails too.
 #include "core/budget.hpp"
 #include "core/bus_scan_report.hpp"
 #include "core/config.hpp"
+#include "core/direction_judgement.hpp"
 #include "core/dive_format.hpp"
 #include "core/failsafe.hpp"
 #include "core/frames.hpp"
@@ -15,6 +17,7 @@
 #include "core/status.hpp"
 #include "core/thruster_config.hpp"
 #include "daemon/bus/bus_monitor.hpp"
+#include "daemon/teensy/teensy_link_watch.hpp"
 #include "drivers/platform/io_error.hpp"
 #include "drivers/protocol/seabotix.hpp"
 #include "drivers/protocol/teensy_codec.hpp"
@@ -23,8 +26,15 @@
 #include "sim/teensy_model.hpp"
 #include "tests/catch.hpp"
 #include "tools/bridge/pilot_seat.hpp"
+#include "tools/ros/command_refusal.hpp"
+#include "tools/ros/ros_conventions.hpp"
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
 #include <set>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -75,6 +85,73 @@ void check_names(const char* what) {
     CHECK_FALSE(parse_name<E>("no-such-name").has_value());
 }
 
+// Every EnumNames table, by the enum's name as its specialisation spells it.
+struct Table {
+    std::string name;
+    void (*check)(const char*);
+};
+#define CARACARA_TABLE(E) Table{#E, &check_names<E>}
+const std::vector<Table> kTables{
+    CARACARA_TABLE(BudgetError),
+    CARACARA_TABLE(BudgetPolicy),
+    CARACARA_TABLE(ScanVerdict),
+    CARACARA_TABLE(DirectionVerdict),
+    CARACARA_TABLE(dive::EventKind),
+    CARACARA_TABLE(dive::ReadError),
+    CARACARA_TABLE(FailsafeAction),
+    CARACARA_TABLE(FailsafeCondition),
+    CARACARA_TABLE(MixError),
+    CARACARA_TABLE(frames::PilotAxis),
+    CARACARA_TABLE(frames::WorldFrame),
+    CARACARA_TABLE(PacketError),
+    CARACARA_TABLE(PreflightItem),
+    CARACARA_TABLE(SafetyState),
+    CARACARA_TABLE(KillSource),
+    CARACARA_TABLE(SafetyError),
+    CARACARA_TABLE(Status),
+    CARACARA_TABLE(Variant),
+    CARACARA_TABLE(BusState),
+    CARACARA_TABLE(TeensyLoss),
+    CARACARA_TABLE(SchedPolicy),
+    CARACARA_TABLE(IoError),
+    CARACARA_TABLE(CodecError),
+    CARACARA_TABLE(Fault),
+    CARACARA_TABLE(LegacySoftware),
+    CARACARA_TABLE(MaxPowerMeaning),
+    CARACARA_TABLE(teensy::TeensyError),
+    CARACARA_TABLE(sim::I2cBusModel::Hang),
+    CARACARA_TABLE(sim::TeensyCommand),
+    CARACARA_TABLE(sim::TeensyFrameOutcome),
+    CARACARA_TABLE(sim::TeensyTaskState),
+    CARACARA_TABLE(bridge::SeatAction),
+    CARACARA_TABLE(bridge::SeatChange),
+    CARACARA_TABLE(ros::CommandRefusal),
+    CARACARA_TABLE(ros::RangeLayout),
+};
+#undef CARACARA_TABLE
+
+// Every `struct EnumNames<E>` specialisation in the sources, by E as written there.
+std::multiset<std::string> tables_in_sources() {
+    namespace fs = std::filesystem;
+    const std::regex specialisation(R"(struct\s+EnumNames\s*<\s*([A-Za-z_][\w:]*)\s*>)");
+    std::multiset<std::string> found;
+    for (const char* top : {"core", "drivers", "daemon", "dbus", "sim", "tools", "bench", "fuzz"}) {
+        const fs::path dir = fs::path(CARACARA_SOURCE_DIR) / top;
+        if (!fs::exists(dir))
+            continue;
+        for (const fs::directory_entry& e : fs::recursive_directory_iterator(dir)) {
+            const std::string ext = e.path().extension().string();
+            if (!e.is_regular_file() || (ext != ".hpp" && ext != ".h" && ext != ".cpp"))
+                continue;
+            std::ifstream in(e.path());
+            const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+            for (std::sregex_iterator m(text.begin(), text.end(), specialisation), end; m != end; ++m)
+                found.insert((*m)[1].str());
+        }
+    }
+    return found;
+}
+
 } // namespace
 
 TEST_CASE("the compiler tells an enumerator from another value") {
@@ -86,36 +163,25 @@ TEST_CASE("the compiler tells an enumerator from another value") {
 }
 
 TEST_CASE("every enum's values have one name each, and each name reads back") {
-    check_names<BudgetError>("BudgetError");
-    check_names<BudgetPolicy>("BudgetPolicy");
-    check_names<ScanVerdict>("ScanVerdict");
-    check_names<dive::EventKind>("dive::EventKind");
-    check_names<dive::ReadError>("dive::ReadError");
-    check_names<FailsafeAction>("FailsafeAction");
-    check_names<FailsafeCondition>("FailsafeCondition");
-    check_names<MixError>("MixError");
-    check_names<frames::PilotAxis>("frames::PilotAxis");
-    check_names<frames::WorldFrame>("frames::WorldFrame");
-    check_names<PacketError>("PacketError");
-    check_names<PreflightItem>("PreflightItem");
-    check_names<SafetyState>("SafetyState");
-    check_names<KillSource>("KillSource");
-    check_names<SafetyError>("SafetyError");
-    check_names<Status>("Status");
-    check_names<Variant>("Variant");
-    check_names<BusState>("BusState");
-    check_names<SchedPolicy>("SchedPolicy");
-    check_names<IoError>("IoError");
-    check_names<CodecError>("CodecError");
-    check_names<Fault>("Fault");
-    check_names<LegacySoftware>("LegacySoftware");
-    check_names<MaxPowerMeaning>("MaxPowerMeaning");
-    check_names<teensy::TeensyError>("teensy::TeensyError");
-    check_names<sim::I2cBusModel::Hang>("sim::I2cBusModel::Hang");
-    check_names<sim::TeensyFrameOutcome>("sim::TeensyFrameOutcome");
-    check_names<sim::TeensyTaskState>("sim::TeensyTaskState");
-    check_names<bridge::SeatAction>("bridge::SeatAction");
-    check_names<bridge::SeatChange>("bridge::SeatChange");
+    for (const Table& t : kTables)
+        t.check(t.name.c_str());
+}
+
+TEST_CASE("every table in the sources is checked here, and each only once") {
+    const std::multiset<std::string> in_sources = tables_in_sources();
+    REQUIRE(in_sources.count("Status") == 1); // the sources were found and read
+    std::multiset<std::string> listed;
+    for (const Table& t : kTables)
+        listed.insert(t.name);
+    for (const std::string& name : in_sources) {
+        INFO("EnumNames<" + name + "> is in the sources: add it to kTables");
+        CHECK(listed.count(name) == 1);
+        CHECK(in_sources.count(name) == 1);
+    }
+    for (const std::string& name : listed) {
+        INFO(name + " is listed but no EnumNames<" + name + "> is in the sources (spelled as there?)");
+        CHECK(in_sources.count(name) == 1);
+    }
 }
 
 TEST_CASE("names that are a contract keep their spelling") {
