@@ -18,17 +18,20 @@ MotorValues MotorTest::values() const {
 }
 
 Result MotorTest::run(int32_t thruster, int32_t value, std::string_view client) {
-    if (thruster < 0 || thruster >= static_cast<int32_t>(kMotorCount))
-        return {Status::OutOfRange, "thruster " + std::to_string(thruster) + " is outside 0..7"};
     const int32_t limit = config_.commissioning.motor_test_limit;
-    if (value < -limit || value > limit)
-        return {Status::OutOfRange, "motor test value " + std::to_string(value) + " is outside -" +
-                                        std::to_string(limit) + ".." + std::to_string(limit) +
-                                        " (commissioning.motor_test_limit)"};
+    Result range;
     MotorValues m{};
-    m[static_cast<size_t>(thruster)] = value;
-    // The same path as SetThrust: budget, state (armed only), commanding client, the wire.
-    if (Result r = vehicle_.drive(m, client); !r.ok())
+    if (thruster < 0 || thruster >= static_cast<int32_t>(kMotorCount))
+        range = {Status::OutOfRange, "thruster " + std::to_string(thruster) + " is outside 0..7"};
+    else if (value < -limit || value > limit)
+        range = {Status::OutOfRange, "motor test value " + std::to_string(value) + " is outside -" +
+                                         std::to_string(limit) + ".." + std::to_string(limit) +
+                                         " (commissioning.motor_test_limit)"};
+    else
+        m[static_cast<size_t>(thruster)] = value;
+    // The same path as SetThrust (CommandAcceptance): state (armed only), this range, the budget;
+    // then the commanding client, the wire.
+    if (Result r = vehicle_.drive(m, client, range); !r.ok())
         return r;
     events_.motor_test(thruster, value);
     if (!running_ || thruster != thruster_ || client != client_)

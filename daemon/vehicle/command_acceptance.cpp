@@ -44,9 +44,12 @@ MotorVerdict CommandAcceptance::motion(const AxisDemand& axes, const MotorDemand
     return within_range_and_budget(mr.motors, mr.saturated, demand, client);
 }
 
-MotorVerdict CommandAcceptance::motors(const MotorValues& values, const MotorDemand& demand, std::string_view client) {
+MotorVerdict CommandAcceptance::motors(const MotorValues& values, const MotorDemand& demand, std::string_view client,
+                                       const Result& range) {
     if (Result r = state(client); !r.ok())
         return refused(std::move(r));
+    if (!range.ok())
+        return refused(range);
     return within_range_and_budget(values, false, demand, client);
 }
 

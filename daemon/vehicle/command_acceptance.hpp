@@ -5,9 +5,10 @@
 //   1. the vehicle's state: Surfacing while a failsafe's ascent runs (but for the ascent
 //      itself), else VehicleCondition::state_error (BusLost, Arming, Killed, PoweredOff);
 //   2. the length: InvalidLength (SetThrust's eight values);
-//   3. the range: OutOfRange (a motor outside -8850..8850, a mixed demand outside -1..1),
-//      InvalidValue (a demand that is not a finite number), or the caller's own verdict (the
-//      Teensy's codec: wheel speeds, a turn's angle);
+//   3. the range: the caller's own verdict first (the motor test's thruster and limit, the
+//      Teensy's codec: wheel speeds, a turn's angle), then OutOfRange (a motor outside
+//      -8850..8850, a mixed demand outside -1..1) or InvalidValue (a demand that is not a
+//      finite number);
 //   4. the budget: OverBudget (core/budget under the thrust profile, policy "reject").
 // An accepted command makes its client the commanding client with the safety machine, restarts
 // the command timeout, announces a new controller and ends pilot-lost (PilotWatch). What the
@@ -54,8 +55,10 @@ public:
     // Each budgets under `demand` (its profile, policy and exclusions) without changing it.
     MotorVerdict thrust(std::span<const int32_t> values, const MotorDemand& demand, std::string_view client);
     MotorVerdict motion(const AxisDemand& axes, const MotorDemand& demand, std::string_view client);
-    // Eight motor values already in their shape (a packet's, a motor test's, a pulse).
-    MotorVerdict motors(const MotorValues& values, const MotorDemand& demand, std::string_view client);
+    // Eight motor values already in their shape (a packet's, a motor test's, a pulse), with the
+    // caller's own verdict on its arguments (`range`: the motor test's thruster and limit).
+    MotorVerdict motors(const MotorValues& values, const MotorDemand& demand, std::string_view client,
+                        const Result& range = {});
     // The failsafe's ascent, as client kFailsafeClient (again to keep it past the command
     // timeout); once accepted, every other client gets Surfacing until a kill ends it.
     MotorVerdict ascent(const AxisDemand& axes, const MotorDemand& demand);

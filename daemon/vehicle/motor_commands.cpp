@@ -55,8 +55,8 @@ Result MotorCommands::set_motion(const AxisDemand& demand, std::string_view clie
     return take(acceptance_.motion(demand, demand_, client));
 }
 
-Result MotorCommands::drive(const MotorValues& values, std::string_view client) {
-    return take(acceptance_.motors(values, demand_, client));
+Result MotorCommands::drive(const MotorValues& values, std::string_view client, const Result& range) {
+    return take(acceptance_.motors(values, demand_, client, range));
 }
 
 void MotorCommands::exclude(const std::array<bool, kMotorCount>& excluded) {

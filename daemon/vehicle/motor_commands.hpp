@@ -30,8 +30,9 @@ public:
     Result set_motion(const AxisDemand& demand, std::string_view client);
     // Selects a thrust profile by name; the current command goes out again under it at once.
     Result set_profile(std::string_view name);
-    // Eight motor values already in their shape (a packet's, a motor test's, a pulse).
-    Result drive(const MotorValues& values, std::string_view client);
+    // Eight motor values already in their shape (a packet's, a motor test's, a pulse), with the
+    // caller's verdict on its own arguments (CommandAcceptance::motors).
+    Result drive(const MotorValues& values, std::string_view client, const Result& range = {});
     // These thrusters to zero and out of the budget's count; the standing command goes on.
     void exclude(const std::array<bool, kMotorCount>& excluded);
     // The ascent (CommandAcceptance::ascent: every other motion command gets Surfacing until a

@@ -56,8 +56,11 @@ public:
     // A packet's "all clear" (killState 0): clears a kill only the packet made.
     Result clear_packet_kill() { return clear(); }
     Result power_off(std::string_view confirmation);
-    // A packet's motor values, as SetThrust's.
-    Result drive(const MotorValues& values, std::string_view client) { return motors_.drive(values, client); }
+    // A packet's motor values, as SetThrust's; `range`: the caller's verdict on its own
+    // arguments (the motor test's), decided after the state (CommandAcceptance).
+    Result drive(const MotorValues& values, std::string_view client, const Result& range = {}) {
+        return motors_.drive(values, client, range);
+    }
     // The calls that stop the thrusters hand their result to `done` once the zero orders they
     // put on the bus are on the wire (the bus worker's thread): a caller that gets it knows
     // the thrusters were told zero. The loop does not wait for them; the kill output was

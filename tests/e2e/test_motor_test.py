@@ -95,6 +95,8 @@ class MotorTestTest(VehicleTestCase):
         rig = self.rig
         rig.vcall("Kill")
         self.assertDBusError(ERR + "Killed", self.motor_test, 0, 500)
+        # The state is decided first: a bad thruster on a killed vehicle is told it is killed.
+        self.assertDBusError(ERR + "Killed", self.motor_test, 8, 500)
         rig.wait_orders_refreshed()
         self.assertEqual(rig.sim_speeds(), [ZERO] * MOTORS)
         rig.vcall("ClearKill")

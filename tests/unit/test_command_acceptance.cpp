@@ -42,9 +42,10 @@ Command motion(AxisDemand axes, bool reject = false) {
     };
 }
 
-Command motors(MotorValues values) {
-    return [values](CommandAcceptance& a, const MotorDemand& scale, const MotorDemand&) {
-        return a.motors(values, scale, kPilot).result;
+// `range`: the caller's own verdict on its arguments (the motor test's thruster and limit).
+Command motors(MotorValues values, Result range = {}) {
+    return [values, range](CommandAcceptance& a, const MotorDemand& scale, const MotorDemand&) {
+        return a.motors(values, scale, kPilot, range).result;
     };
 }
 
@@ -63,6 +64,7 @@ struct Row {
 const std::vector<int32_t> kGood{1000, -1000, 500, 0, 0, 0, 0, -500};
 const std::vector<int32_t> kFull(8, kMotorMax); // over every budget row: 8 running, limit 4200
 const Result kWheelsTooFast{Status::OutOfRange, "Set Speed: wheel speed out of range"};
+const Result kNoSuchThruster{Status::OutOfRange, "thruster 8 is outside 0..7"};
 
 std::vector<int32_t> with(std::vector<int32_t> v, std::size_t i, int32_t value) {
     v[i] = value;
@@ -107,6 +109,7 @@ TEST_CASE("each command in each state: accepted, or its named error in the order
         {"a packet's motors, surfacing", Given::Surfacing, motors({100, 0, 0, 0, 0, 0, 0, 0}), Status::Surfacing},
         {"over the budget (reject), killed", Given::Killed, thrust(kFull, true), Status::Killed},
         {"the wheels too fast, killed", Given::Killed, teensy_command(kWheelsTooFast), Status::Killed},
+        {"a motor test of thruster 8, arming", Given::Arming, motors({}, kNoSuchThruster), Status::Arming},
         {"the wheels, surfacing", Given::Surfacing, teensy_command({}), Status::Surfacing},
         // 2. The length.
         {"7 values", Given::Ready, thrust(std::vector<int32_t>(7, 100)), Status::InvalidLength},
@@ -124,6 +127,7 @@ TEST_CASE("each command in each state: accepted, or its named error in the order
         {"SetMotion -1.0001", Given::Ready, motion({0, 0, 0, 0, -1.0001, 0}), Status::OutOfRange},
         {"a packet's motor at 9000", Given::Ready, motors({9000, 0, 0, 0, 0, 0, 0, 0}), Status::OutOfRange},
         {"the wheels too fast", Given::Ready, teensy_command(kWheelsTooFast), Status::OutOfRange},
+        {"a motor test of thruster 8", Given::Ready, motors({}, kNoSuchThruster), Status::OutOfRange},
         {"a turn by NaN", Given::Ready, teensy_command({Status::InvalidValue, "not a finite angle"}), Status::InvalidValue},
         // 4. The budget.
         {"SetThrust over the budget (reject)", Given::Ready, thrust(kFull, true), Status::OverBudget},
