@@ -26,19 +26,17 @@
 namespace caracara {
 
 
-// The controller variants, one row each: what a status reply carries. This table and the codec
-// below are the one place the variants are told apart; code above drivers/ reads the common
-// fields of ThrusterStatus (temperature_c, speed_motor, actual_speed, firmware_revision) and
-// never tests the variant (tests/layers.py checks).
+// The controller variants, one row each: the length of a status reply. This table and the codec
+// below (decode_status, which says what each reply carries) are the one place the variants are
+// told apart; code above drivers/ reads the common fields of ThrusterStatus (temperature_c,
+// speed_motor, actual_speed, firmware_revision) and never tests the variant (tests/layers.py checks).
 struct VariantFormat {
     Variant variant;
     std::size_t status_length;  // bytes, first byte and checksum included
-    bool reports_temperature;   // a TEMPERATURE byte (SeaBotix IDS 8.4.2)
-    bool reports_speed;         // a SPEED byte read back (SeaBotix IDS 8.4.2)
 };
 inline constexpr std::array<VariantFormat, 2> kVariantFormats{{
-    {Variant::SeaBotix, 7, true, true},  // [MT_read, STATUS, FAULT, CURRENT, SPEED, TEMPERATURE, CSUM]
-    {Variant::Legacy, 4, false, false},  // [MT_read, STATUS, MAX POWER, CSUM] (IDS 8.4.1)
+    {Variant::SeaBotix, 7},  // [MT_read, STATUS, FAULT, CURRENT, SPEED, TEMPERATURE, CSUM] (IDS 8.4.2)
+    {Variant::Legacy, 4},    // [MT_read, STATUS, MAX POWER, CSUM] (IDS 8.4.1)
 }};
 constexpr const VariantFormat& variant_format(Variant v) {
     for (const VariantFormat& f : kVariantFormats)

@@ -3,6 +3,7 @@
 #include "dbus/vehicle_names.hpp"
 
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 
 namespace caracara::client {
@@ -45,18 +46,18 @@ void PilotConnection::call(const char* member, const Append& append, OnReply on_
         r = sd_bus_message_set_auto_start(call.get(), 0);
     if (r >= 0 && append)
         r = append(call.get());
-    auto* callback = new OnReply(std::move(on_reply));
+    auto callback = std::make_unique<OnReply>(std::move(on_reply));
     sd_bus_slot* slot = nullptr;
     if (r >= 0)
-        r = sd_bus_call_async(bus_.get(), &slot, call.get(), replied, callback, static_cast<uint64_t>(timeout.count()));
+        r = sd_bus_call_async(bus_.get(), &slot, call.get(), replied, callback.get(),
+                              static_cast<uint64_t>(timeout.count()));
     if (r < 0) {
-        const OnReply failed(std::move(*callback));
-        delete callback;
-        failed({nullptr, kSendFailed, std::strerror(-r)});
+        (*callback)({nullptr, kSendFailed, std::strerror(-r)});
         return;
     }
     // The slot floats (the bus owns it: freed after the reply or with the connection) and frees
     // the callback with it; the reference sd_bus_call_async gave is dropped.
+    callback.release();
     sd_bus_slot_set_destroy_callback(slot, [](void* p) { delete static_cast<OnReply*>(p); });
     sd_bus_slot_set_floating(slot, 1);
     sd_bus_slot_unref(slot);
