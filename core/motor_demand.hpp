@@ -45,6 +45,7 @@ private:
     BudgetPolicy policy_;
     const ThrustProfile* profile_;
     MotorValues requested_{};
+    // Kept: where the order is decided (profile, budget, exclusions); MotorValues reads it, the loop takes it.
     MotorValues applied_{};
     int32_t limit_ = 0;
     bool saturated_ = false;

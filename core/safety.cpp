@@ -16,16 +16,13 @@ SafetyMachine::SafetyMachine(SafetyConfig config, bool kill_switch_set, uint64_t
         enter_killed(KillSource::Start, now, "started killed; ClearKill arms the vehicle");
 }
 
-void SafetyMachine::drop_commands() {
-    command_active_ = false;
-    client_.clear();
-}
+void SafetyMachine::drop_commands() { commands_.drop(); }
 
 void SafetyMachine::enter_killed(KillSource source, uint64_t now, std::string_view reason) {
     state_ = SafetyState::Killed;
-    kill_source_ = source;
-    kill_reason_ = reason.empty() ? std::string(kill_source_name(source)) : std::string(reason);
-    killed_at_ = now;
+    kill_.source = source;
+    kill_.reason = reason.empty() ? std::string(kill_source_name(source)) : std::string(reason);
+    kill_.at = now;
     drop_commands();
     pilots_.clear(); // nothing left to lose
 }
@@ -35,12 +32,12 @@ SafetyAction SafetyMachine::kill(KillSource source, uint64_t now, std::string_vi
         source = KillSource::Bus;  // a kill without a named source is still a kill
     if (state_ == SafetyState::PoweredOff)
         return SafetyAction::zeroing("powered off", false);
-    if (state_ == SafetyState::Killed && kill_source_ != KillSource::Start)
-        return SafetyAction::zeroing("already killed (" + std::string(kill_source_name(kill_source_)) + ")", false);
+    if (state_ == SafetyState::Killed && kill_.source != KillSource::Start)
+        return SafetyAction::zeroing("already killed (" + std::string(kill_source_name(kill_.source)) + ")", false);
     // A start kill is the weakest source: any real kill names itself in its place (a switch
     // set at start reads "switch", and ClearKill then asks for it to be released).
     enter_killed(source, now, reason);
-    return SafetyAction::zeroing("killed (" + std::string(kill_source_name(source)) + "): " + kill_reason_, true);
+    return SafetyAction::zeroing("killed (" + std::string(kill_source_name(source)) + "): " + kill_.reason, true);
 }
 
 SafetyAction SafetyMachine::clear_kill(uint64_t now) {
@@ -51,8 +48,8 @@ SafetyAction SafetyMachine::clear_kill(uint64_t now) {
     if (switch_set_)
         return SafetyAction::refused(SafetyError::KillSwitchSet, "the kill switch is set: release it first");
     state_ = SafetyState::Arming;
-    kill_source_ = KillSource::None;
-    kill_reason_.clear();
+    kill_.source = KillSource::None;
+    kill_.reason.clear();
     arming_started_ = now;
     drop_commands();
     pilots_.clear(); // armed again: pilots are those who command from now on
@@ -87,9 +84,9 @@ SafetyAction SafetyMachine::tick(uint64_t now) {
         a.message = "armed, ready";
         return a;
     }
-    if (state_ == SafetyState::Ready && command_active_ &&
-        elapsed(last_command_, now) >= config_.command_timeout_ns) {
-        a = SafetyAction::zeroing("no command for " + std::to_string(elapsed(last_command_, now) / 1'000'000) +
+    if (state_ == SafetyState::Ready && commands_.active() &&
+        elapsed(commands_.last_command_at(), now) >= config_.command_timeout_ns) {
+        a = SafetyAction::zeroing("no command for " + std::to_string(elapsed(commands_.last_command_at(), now) / 1'000'000) +
                                       " ms (timeout " + std::to_string(config_.command_timeout_ns / 1'000'000) + " ms)",
                                   false);
         a.command_stale = true;
@@ -104,7 +101,7 @@ SafetyAction SafetyMachine::accept_command(uint64_t now, std::string_view client
         return SafetyAction::refused(SafetyError::PoweredOff, "powered off");
     case SafetyState::Killed:
         return SafetyAction::refused(SafetyError::NotReady, "killed (" +
-                                                                std::string(kill_source_name(kill_source_)) +
+                                                                std::string(kill_source_name(kill_.source)) +
                                                                 "): clear the kill first");
     case SafetyState::Arming:
         return SafetyAction::refused(SafetyError::NotReady,
@@ -112,9 +109,7 @@ SafetyAction SafetyMachine::accept_command(uint64_t now, std::string_view client
     case SafetyState::Ready:
         break;
     }
-    command_active_ = true;
-    last_command_ = now;
-    client_ = std::string(client);
+    commands_.accepted(client, now);
     pilots_.commanded(client);
     return {};
 }
@@ -122,7 +117,7 @@ SafetyAction SafetyMachine::accept_command(uint64_t now, std::string_view client
 SafetyAction SafetyMachine::client_left(std::string_view client, uint64_t now) {
     (void)now;
     pilots_.left(client);
-    if (!command_active_ || client != client_)
+    if (!commands_.active() || client != commands_.client())
         return {};
     drop_commands();
     return SafetyAction::zeroing("commanding client " + std::string(client) + " left", false);
@@ -138,8 +133,8 @@ uint64_t SafetyMachine::arming_remaining_ns(uint64_t now) const {
 uint64_t SafetyMachine::next_deadline() const {
     if (state_ == SafetyState::Arming)
         return arming_started_ + config_.arming_delay_ns;
-    if (state_ == SafetyState::Ready && command_active_)
-        return last_command_ + config_.command_timeout_ns;
+    if (state_ == SafetyState::Ready && commands_.active())
+        return commands_.last_command_at() + config_.command_timeout_ns;
     return kNoDeadline;
 }
 

@@ -16,6 +16,8 @@
 // An escalated fault (e.g. a failed I2C bus recovery) is a kill with source Fault.
 #pragma once
 
+#include "core/command_stream.hpp"
+#include "core/kill_record.hpp"
 #include "core/pilot_roster.hpp"
 #include "core/safety_action.hpp"
 #include "core/safety_config.hpp"
@@ -64,21 +66,20 @@ public:
     const PilotRoster& pilots() const { return pilots_; }
 
     SafetyState state() const { return state_; }
-    KillSource kill_source() const { return kill_source_; }
-    const std::string& kill_reason() const { return kill_reason_; }
-    uint64_t killed_at() const { return killed_at_; }
+    // The latched kill: source, reason, time.
+    const KillRecord& kill_record() const { return kill_; }
     bool kill_switch_set() const { return switch_set_; }
     // Commands may drive the thrusters (state Ready); otherwise the output is zero.
     bool may_drive() const { return state_ == SafetyState::Ready; }
     // Ready and a command stream is live (not stale, client present).
-    bool command_active() const { return may_drive() && command_active_; }
+    bool command_active() const { return may_drive() && commands_.active(); }
     // The kill output de-energizes the thrusters while killed or powered off. It is
     // released on entering Arming so the controllers power up and settle at zero order.
     bool kill_output_asserted() const {
         return state_ == SafetyState::Killed || state_ == SafetyState::PoweredOff;
     }
-    const std::string& commanding_client() const { return client_; }
-    uint64_t last_command_at() const { return last_command_; }
+    // The command stream: its commanding client and its last command's time.
+    const CommandStream& commands() const { return commands_; }
     uint64_t arming_remaining_ns(uint64_t now) const;
     // The next time tick() has work (end of arming, watchdog expiry), or kNoDeadline.
     uint64_t next_deadline() const;
@@ -90,14 +91,10 @@ private:
 
     SafetyConfig config_;
     SafetyState state_ = SafetyState::Arming;
-    KillSource kill_source_ = KillSource::None;
-    std::string kill_reason_;
-    uint64_t killed_at_ = 0;
+    KillRecord kill_;
     bool switch_set_ = false;
     uint64_t arming_started_ = 0;
-    bool command_active_ = false;
-    uint64_t last_command_ = 0;
-    std::string client_;
+    CommandStream commands_;
     PilotRoster pilots_; // since the vehicle was last armed
 };
 

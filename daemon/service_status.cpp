@@ -5,8 +5,8 @@
 namespace caracara {
 
 void ServiceStatus::publish() const {
-    const std::string state(vehicle_.state_name());
-    const std::string ks(vehicle_.kill_source_name());
+    const std::string state(vehicle_.readings().state_name());
+    const std::string ks(vehicle_.readings().kill_source_name());
     // The faults someone must act on show on `systemctl status`'s Status: line.
     std::string faults;
     for (size_t i = 0; i < bus_.size(); ++i)
@@ -15,10 +15,10 @@ void ServiceStatus::publish() const {
                 faults += "; thruster " + std::to_string(i) + " " + std::string(fault_name(f));
     if (const std::string fs = failsafes_ ? failsafes_() : std::string(); !fs.empty())
         faults += "; FAILSAFE " + fs;
-    if (vehicle_.surfacing())
+    if (vehicle_.readings().surfacing())
         faults += "; SURFACING";
     sd_notifyf(0, "STATUS=%s%s%s; profile %s; I2C bus %s; %zu thrusters%s", state.c_str(), ks.empty() ? "" : " by ",
-               ks.c_str(), vehicle_.profile().name.c_str(), std::string(bus_state_name(bus_.monitor().telemetry().state)).c_str(),
+               ks.c_str(), vehicle_.readings().profile().name.c_str(), std::string(bus_state_name(bus_.monitor().telemetry().state)).c_str(),
                bus_.size(), faults.c_str());
 }
 
@@ -46,7 +46,7 @@ int ServiceStatus::on_watchdog(sd_event_source* s, uint64_t usec, void* userdata
 }
 
 void ServiceStatus::ready(const char* bus_name) const {
-    sd_notifyf(0, "READY=1\nSTATUS=Thrusters zeroed; %s; serving %s", std::string(vehicle_.state_name()).c_str(),
+    sd_notifyf(0, "READY=1\nSTATUS=Thrusters zeroed; %s; serving %s", std::string(vehicle_.readings().state_name()).c_str(),
                bus_name);
 }
 

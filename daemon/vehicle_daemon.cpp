@@ -50,8 +50,8 @@ std::string VehicleDaemon::start() {
         return e;
     // Zero before anything else: a previous instance may have died with orders standing.
     bus_.zero_all();
-    bus_.wait_idle();
-    if (std::string e = lines_.open(vehicle_.kill_output_asserted(), &vehicle_); !e.empty())
+    bus_.worker().wait_idle();
+    if (std::string e = lines_.open(vehicle_.readings().kill_output_asserted(), &vehicle_); !e.empty())
         return e;
     if (int r = teensy_.open(); r < 0 && !config_.spi.fitted)
         log_warning("Teensy SPI %s unavailable (%s); continuing without it", config_.spi.device.c_str(),
@@ -94,7 +94,7 @@ std::string VehicleDaemon::start() {
 }
 
 void VehicleDaemon::attach_emergency_stop(EmergencyStop& stop) {
-    bus_.set_crash_gate(&stop.bus_gate());
+    bus_.worker().set_gate(&stop.bus_gate());
     lines_.set_kill_output_watcher(&stop);
     recovery_.set_node_holder(&stop);
 }
@@ -119,7 +119,7 @@ void VehicleDaemon::shutdown() {
     recovery_.stop();
     lines_.close();
     bus_.zero_all();
-    bus_.wait_idle();
+    bus_.worker().wait_idle();
     bus_.stop();
     teensy_.stop_motion();
     teensy_.close();

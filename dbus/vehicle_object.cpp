@@ -37,14 +37,14 @@ int m_set_thrust(sd_bus_message* m, void* userdata, sd_bus_error*) {
     size_t n = 0;
     if (int r = sd_bus_message_read_array(m, 'i', &p, &n); r < 0)
         return r;
-    return reply(m, vehicle(userdata).set_thrust({static_cast<const int32_t*>(p), n / sizeof(int32_t)}, sender(m)));
+    return reply(m, vehicle(userdata).motors().set_thrust({static_cast<const int32_t*>(p), n / sizeof(int32_t)}, sender(m)));
 }
 
 int m_set_motion(sd_bus_message* m, void* userdata, sd_bus_error*) {
     AxisDemand d{};
     if (int r = sd_bus_message_read(m, "dddddd", &d[0], &d[1], &d[2], &d[3], &d[4], &d[5]); r < 0)
         return r;
-    return reply(m, vehicle(userdata).set_motion(d, sender(m)));
+    return reply(m, vehicle(userdata).motors().set_motion(d, sender(m)));
 }
 
 int m_apply_packet(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -99,7 +99,7 @@ int m_set_profile(sd_bus_message* m, void* userdata, sd_bus_error*) {
     const char* name = nullptr;
     if (int r = sd_bus_message_read(m, "s", &name); r < 0)
         return r;
-    return reply(m, vehicle(userdata).set_profile(name));
+    return reply(m, vehicle(userdata).motors().set_profile(name));
 }
 
 int m_motor_test(sd_bus_message* m, void* userdata, sd_bus_error*) {
@@ -145,18 +145,18 @@ constexpr Member kMembers[] = {
     member(SD_BUS_METHOD_WITH_ARGS("SetLeds", SD_BUS_ARGS("y", red, "y", green, "y", blue), SD_BUS_NO_RESULT, m_set_leds,
                                    kUnpriv)),
     member(SD_BUS_METHOD_WITH_ARGS("SetProfile", SD_BUS_ARGS("s", name), SD_BUS_NO_RESULT, m_set_profile, kUnpriv)),
-    property<[](D d) { return d.vehicle.state_name(); }>("State", kChange, kChangeState),
-    property<[](D d) { return d.vehicle.kill_source_name(); }>("KillSource", kChange, kChangeState),
-    property<[](D d) -> const auto& { return d.vehicle.motor_values(); }>("MotorValues", kChange, kChangeMotors),
-    property<[](D d) -> const auto& { return d.vehicle.requested_values(); }>("RequestedValues", kChange, kChangeMotors),
-    property<[](D d) { return d.vehicle.budget_limit(); }>("BudgetLimit", kChange, kChangeMotors),
-    property<[](D d) { return d.vehicle.saturated(); }>("Saturated", kChange, kChangeMotors),
+    property<[](D d) { return d.vehicle.readings().state_name(); }>("State", kChange, kChangeState),
+    property<[](D d) { return d.vehicle.readings().kill_source_name(); }>("KillSource", kChange, kChangeState),
+    property<[](D d) -> const auto& { return d.vehicle.readings().motor_values(); }>("MotorValues", kChange, kChangeMotors),
+    property<[](D d) -> const auto& { return d.vehicle.readings().requested_values(); }>("RequestedValues", kChange, kChangeMotors),
+    property<[](D d) { return d.vehicle.readings().budget_limit(); }>("BudgetLimit", kChange, kChangeMotors),
+    property<[](D d) { return d.vehicle.readings().saturated(); }>("Saturated", kChange, kChangeMotors),
     property<[](D d) { return policy_name(control(d).budget_policy); }>("BudgetPolicy", kConst),
-    property<[](D d) -> const auto& { return d.vehicle.profile().name; }>("Profile", kChange, kChangeProfile),
-    property<[](D d) { return d.vehicle.profile().factor; }>("ProfileFactor", kChange, kChangeProfile),
+    property<[](D d) -> const auto& { return d.vehicle.readings().profile().name; }>("Profile", kChange, kChangeProfile),
+    property<[](D d) { return d.vehicle.readings().profile().factor; }>("ProfileFactor", kChange, kChangeProfile),
     property<[](D d) { auto l = d.teensy.leds(); return std::tuple{l[0], l[1], l[2]}; }>("Leds", kChange, kChangeLeds),
-    property<[](D d) { return d.vehicle.command_age_ms(); }>("CommandAgeMs", kChange, kTelemetryTick),
-    property<[](D d) -> const auto& { return d.vehicle.controller_client(); }>("Controller", kChange, kChangeController),
+    property<[](D d) { return d.vehicle.readings().command_age_ms(); }>("CommandAgeMs", kChange, kTelemetryTick),
+    property<[](D d) -> const auto& { return d.vehicle.readings().controller_client(); }>("Controller", kChange, kChangeController),
     property<[](D d) { return std::tuple{d.motor_test.active_thruster(), d.motor_test.value()}; }>(
         "MotorTest", kChange, kChangeMotors | kChangeController | kChangeState),
     property<[](D d) { return d.motor_test.limit(); }>("MotorTestLimit", kConst),

@@ -41,9 +41,9 @@ void ThrusterBus::zero_all(ZeroOrder where) {
     }
     // While recovering, the adapter is closed or about to be: the zeros go out when it is
     // back (BusRecovery::finish), not as failures that would hold the bus clear up.
-    if (recovering() && where == ZeroOrder::First && prober_)
+    if (monitor_.recovering() && where == ZeroOrder::First && prober_)
         prober_->dropped();
-    if (recovering())
+    if (monitor_.recovering())
         return;
     if (where == ZeroOrder::First) {
         worker_.submit_first(std::span<const BusJob>(zeros).first(n));
@@ -76,7 +76,7 @@ void ThrusterBus::when_idle(std::function<void()> fn) {
 }
 
 void ThrusterBus::update_wake_at_once() {
-    const bool at_once = !results_at_tick_ || !when_idle_.empty() || recovering();
+    const bool at_once = !results_at_tick_ || !when_idle_.empty() || monitor_.recovering();
     if (at_once != wake_at_once_)
         worker_.set_wake_at_once(at_once);
     wake_at_once_ = at_once;

@@ -41,20 +41,8 @@ public:
     // One step of a bus scan, run on the worker's thread behind every order (BusProber);
     // `prober` hears of it on the loop thread, at once.
     void submit_probe(BusProber& prober, uint32_t step);
-    // The transfers handed over in between wake the worker once (see BusWorker).
-    void hold_wakeups() { worker_.hold_wakeups(); }
-    void release_wakeups() { worker_.release_wakeups(); }
     // Zero to every thruster, back to back: nothing may come between a kill and its zeros.
     void zero_all(ZeroOrder where = ZeroOrder::First);
-    // Before a kill's kill output: no non-zero order handed over earlier goes out after it.
-    void hold_orders() { worker_.hold_orders(); }
-    // The emergency stop's gate: see BusTransfer::set_gate.
-    void set_crash_gate(BusGate* gate) { worker_.set_gate(gate); }
-    // Blocks until the worker is idle: at start-up and shutdown, where the zeros must be on the
-    // wire before the daemon goes on.
-    void wait_idle() { worker_.wait_idle(); }
-    // No transfer queued or on the wire.
-    bool idle() const { return worker_.idle(); }
     // Runs `fn` once the transfers handed over so far are done (at once when idle).
     void when_idle(std::function<void()> fn);
     // At its tick: the loop takes the results of its routine transfers at its tick (collect()) rather
@@ -64,13 +52,17 @@ public:
         results_at_tick_ = at_tick;
         update_wake_at_once();
     }
-    void collect() { worker_.collect(); }
-    // The transfers handed over so far come back at once, whatever set_results_at_tick says (see BusWorker).
-    void wake_when_done() { worker_.wake_when_done(); }
+    // The worker's own controls: how the transfers handed over wake it and come back
+    // (hold_wakeups/release_wakeups, collect, wake_when_done), a kill holding older orders back
+    // (hold_orders), the emergency stop's gate (set_gate), and whether it is idle (idle,
+    // wait_idle at start-up and shutdown, where the zeros must be on the wire first). Orders,
+    // status reads and probes go through the ThrusterBus, which keeps what was ordered.
+    BusWorker& worker() { return worker_; }
+    const BusWorker& worker() const { return worker_; }
 
-    // The adapter closed for a bus recovery (its queued work dropped) and open again.
+    // The adapter closed for a bus recovery (its queued work dropped) and open again; whether
+    // it is, is its BusMonitor's (monitor().recovering()).
     void set_recovering(bool r);
-    bool recovering() const { return monitor_.recovering(); }
     MuxTracker& mux() { return mux_; }
     // The adapter, for the worker's thread only (a probe step).
     I2cDev& i2c() { return i2c_; }
@@ -96,6 +88,7 @@ private:
     MuxTracker mux_;
     std::vector<std::unique_ptr<ThrusterDriver>> thrusters_;
     BusWorker worker_;
+    // Kept: the order last handed to the worker (OrderedValue; one a kill's zeros dropped is due again).
     std::vector<int32_t> ordered_;
     std::function<void(const BusJob&)> on_done_;
     std::vector<std::function<void()>> when_idle_;

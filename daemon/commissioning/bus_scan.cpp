@@ -18,18 +18,18 @@ void BusScan::run(Completion done) {
         done({Status::Busy, "a bus scan is running"});
         return;
     }
-    const SafetyState state = vehicle_.safety().state();
+    const SafetyState state = vehicle_.readings().safety().state();
     if (state == SafetyState::PoweredOff) {
         done({Status::PoweredOff, "powered off"});
         return;
     }
     if (state != SafetyState::Killed) {
-        done({Status::NotKilled, "the vehicle is " + std::string(vehicle_.state_name()) +
+        done({Status::NotKilled, "the vehicle is " + std::string(vehicle_.readings().state_name()) +
                                      ": a bus scan runs only while killed (Kill first), so no order can "
                                      "reach a thruster found where the configuration does not expect it"});
         return;
     }
-    if (bus_.recovering()) {
+    if (bus_.monitor().recovering()) {
         done({Status::BusLost, "the I2C bus is being recovered: scan once it is back"});
         return;
     }
@@ -47,7 +47,7 @@ void BusScan::next(uint32_t step) {
 void BusScan::dropped() {
     if (!running())
         return;
-    end(bus_.recovering() ? Result{Status::BusLost, "the I2C bus failed during the scan and is being recovered: scan once it is back"}
+    end(bus_.monitor().recovering() ? Result{Status::BusLost, "the I2C bus failed during the scan and is being recovered: scan once it is back"}
                           : Result{Status::Killed, "a kill during the scan ended it: scan again"});
 }
 
@@ -78,7 +78,7 @@ void BusScan::probed(const BusJobDone& d) {
         end({Status::Hardware, "the bus was taken for the emergency stop"});
         return;
     }
-    if (vehicle_.safety().state() != SafetyState::Killed) {
+    if (vehicle_.readings().safety().state() != SafetyState::Killed) {
         end({Status::NotKilled, "the vehicle left \"killed\" during the scan (ClearKill?): it ended; Kill and scan again"});
         return;
     }

@@ -50,7 +50,7 @@ void DirectionDetection::run(std::string_view client, Completion done) {
         return;
     }
     // The caller becomes the commanding client with all thrusters at zero.
-    if (Result r = vehicle_.drive(MotorValues{}, client); !r.ok()) {
+    if (Result r = vehicle_.motors().drive(MotorValues{}, client); !r.ok()) {
         done(r);
         return;
     }
@@ -70,7 +70,7 @@ void DirectionDetection::next_step(uint64_t now) { timer_.arm(now + kStepNs); }
 Result DirectionDetection::abort_reason() const {
     if (Result r = vehicle_.state_error(); !r.ok())
         return r;
-    if (vehicle_.controller_client() != client_)
+    if (vehicle_.readings().controller_client() != client_)
         return {Status::Busy, "another command took over the thrusters (or the caller left)"};
     if (!failsafes_.active().empty())
         return {Status::FailsafeActive, "a failsafe is active"};
@@ -80,11 +80,11 @@ Result DirectionDetection::abort_reason() const {
 }
 
 void DirectionDetection::end(Result r) {
-    const bool ours = vehicle_.may_drive() && vehicle_.controller_client() == client_;
+    const bool ours = vehicle_.readings().may_drive() && vehicle_.readings().controller_client() == client_;
     phase_ = Phase::Idle;
     timer_.arm(DeadlineTimer::kNever);
     if (ours)
-        (void)vehicle_.drive(MotorValues{}, client_);
+        (void)vehicle_.motors().drive(MotorValues{}, client_);
     if (r.ok())
         log_notice("direction detection done");
     else
@@ -118,7 +118,7 @@ void DirectionDetection::settle_step(uint64_t now) {
     const uint64_t window = uint64_t(c.detect_settle_ms) * kMs;
     // The zeros re-sent, as the pulse is, so the command timeout does not take the caller's
     // place as the commanding client between pulses.
-    if (Result r = vehicle_.drive(MotorValues{}, client_); !r.ok()) {
+    if (Result r = vehicle_.motors().drive(MotorValues{}, client_); !r.ok()) {
         end(r);
         return;
     }
@@ -134,7 +134,7 @@ void DirectionDetection::settle_step(uint64_t now) {
         samples_.clear();
         phase_ = Phase::Pulse;
         phase_start_ns_ = now;
-        if (Result r = vehicle_.drive(pulse_values(), client_); !r.ok())
+        if (Result r = vehicle_.motors().drive(pulse_values(), client_); !r.ok())
             end(r);
         return;
     }
@@ -148,11 +148,11 @@ void DirectionDetection::pulse_step(uint64_t now) {
     const uint64_t length = uint64_t(c.detect_pulse_ms) * kMs;
     if (now - phase_start_ns_ < length) {
         // Re-sent each step so the command timeout does not stop the pulse early.
-        if (Result r = vehicle_.drive(pulse_values(), client_); !r.ok())
+        if (Result r = vehicle_.motors().drive(pulse_values(), client_); !r.ok())
             end(r);
         return;
     }
-    if (Result r = vehicle_.drive(MotorValues{}, client_); !r.ok()) {
+    if (Result r = vehicle_.motors().drive(MotorValues{}, client_); !r.ok()) {
         end(r);
         return;
     }

@@ -31,7 +31,7 @@ Result MotorTest::run(int32_t thruster, int32_t value, std::string_view client) 
         m[static_cast<size_t>(thruster)] = value;
     // The same path as SetThrust (CommandAcceptance): state (armed only), this range, the budget;
     // then the commanding client, the wire.
-    if (Result r = vehicle_.drive(m, client, range); !r.ok())
+    if (Result r = vehicle_.motors().drive(m, client, range); !r.ok())
         return r;
     events_.motor_test(thruster, value);
     if (!running_ || thruster != thruster_ || client != client_)
@@ -45,8 +45,8 @@ Result MotorTest::run(int32_t thruster, int32_t value, std::string_view client) 
 }
 
 int32_t MotorTest::active_thruster() const {
-    if (!running_ || !vehicle_.may_drive() || vehicle_.controller_client() != client_ ||
-        vehicle_.requested_values() != values())
+    if (!running_ || !vehicle_.readings().may_drive() || vehicle_.readings().controller_client() != client_ ||
+        vehicle_.readings().requested_values() != values())
         return -1;
     return thruster_;
 }
@@ -57,7 +57,7 @@ void MotorTest::expired() {
     if (active_thruster() >= 0) {
         log_notice("motor test: no repeat from %s within %u ms, thruster %d to zero", client_.c_str(),
                    config_.commissioning.motor_test_keepalive_ms, thruster_);
-        (void)vehicle_.drive(MotorValues{}, client_);
+        (void)vehicle_.motors().drive(MotorValues{}, client_);
     }
     running_ = false;
 }

@@ -66,10 +66,10 @@ void BusWorkDispatch::pause() {
 int BusWorkDispatch::on_work(sd_event_source*, void* userdata) {
     auto* self = static_cast<BusWorkDispatch*>(userdata);
     // The transfers of this pass wake the bus worker once, at its end (whichever way it ends).
-    self->bus_.hold_wakeups();
+    self->bus_.worker().hold_wakeups();
     struct Release {
         ThrusterBus& bus;
-        ~Release() { bus.release_wakeups(); }
+        ~Release() { bus.worker().release_wakeups(); }
     } release{self->bus_};
     // The cycle's transfers are handed to the bus worker as one batch (orders first; see
     // BusWorker::submit); the Teensy's slots run here meanwhile. The end of the batch
@@ -80,7 +80,7 @@ int BusWorkDispatch::on_work(sd_event_source*, void* userdata) {
             continue;
         if (w == Work::Waiting) {
             if (self->command_out_) {
-                self->bus_.wake_when_done(); // a command's orders: its properties follow the wire at once
+                self->bus_.worker().wake_when_done(); // a command's orders: its properties follow the wire at once
                 self->command_handed_over_();
             }
             self->command_out_ = false;
@@ -136,7 +136,7 @@ BusWorkDispatch::Work BusWorkDispatch::work_one() {
     case OrderSchedule::Kind::None: break;
     }
     // The cycle ends once its transfers are done too.
-    return bus_.idle() ? Work::None : Work::Waiting;
+    return bus_.worker().idle() ? Work::None : Work::Waiting;
 }
 
 void BusWorkDispatch::demand_changed(const MotorValues& orders) {

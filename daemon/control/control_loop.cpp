@@ -67,7 +67,7 @@ int ControlLoop::on_tick(sd_event_source* s, uint64_t usec, void* userdata) {
 void ControlLoop::end_cycle() {
     in_cycle_ = false;
     last_cycle_ns_ = monotonic_ns();
-    const bool flat_out = settings_.loop_rate_hz == 0 && !bus_.recovering();
+    const bool flat_out = settings_.loop_rate_hz == 0 && !bus_.monitor().recovering();
     if (flat_out || cycle_overrun_)
         work_.step_aside(); // resumed() starts the next cycle
     else
@@ -82,7 +82,7 @@ void ControlLoop::orders_out(bool in_flight) {
 }
 
 void ControlLoop::bus_done(const BusJob& job) {
-    if (!started_ || !bus_.idle())
+    if (!started_ || !bus_.worker().idle())
         return; // more of a kill's zeros to come
     orders_out(false);
     if (in_cycle_ && work_.nothing_due())
@@ -104,7 +104,7 @@ void ControlLoop::resumed() {
 
 void ControlLoop::cycle() {
     // The last cycle's results, taken here rather than at a wake-up of their own (may close it).
-    bus_.collect();
+    bus_.worker().collect();
     orders_out(false); // at the latest: a dropped order (a recovery) never comes back as done
     const uint64_t t = monotonic_ns();
     lines_.poll(); // a backstop for a lost edge event

@@ -5,7 +5,7 @@ namespace caracara {
 OrderSchedule::Kind StandingOrders::hand_over_next() {
     // While the bus is closed for recovery nothing is due on it: the recovery re-sends every
     // order when it is back (resend), and the next cycle marks the rest again.
-    const bool bus_usable = !bus_.recovering();
+    const bool bus_usable = !bus_.monitor().recovering();
     if (!bus_usable)
         schedule_.drop_bus_work();
     const OrderSchedule::Item item = schedule_.next(bus_usable);
@@ -32,12 +32,12 @@ void StandingOrders::zero_all(ZeroOrder where) {
     // `busctl call` moves the thrusters for a moment, whether or not its disconnect arrives
     // before the loop sent the orders.
     if (where == ZeroOrder::Behind)
-        for (size_t i = 0; !bus_.recovering() && schedule_.pop_order(i);)
+        for (size_t i = 0; !bus_.monitor().recovering() && schedule_.pop_order(i);)
             bus_.send_order(i, orders_[i]);
     orders_.fill(0);
     schedule_.drop_orders();
     bus_.zero_all(where);
-    bus_.wake_when_done();
+    bus_.worker().wake_when_done();
 }
 
 void StandingOrders::resend() {

@@ -31,7 +31,8 @@ public:
 private:
     ThrusterBus& bus_;
     OrderSchedule schedule_;
-    MotorValues orders_{}; // what each thruster is to be ordered
+    // Kept: each thruster's order while it waits for a slot, re-sent each tick and after a recovery.
+    MotorValues orders_{};
 };
 
 } // namespace caracara

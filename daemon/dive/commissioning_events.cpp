@@ -66,7 +66,7 @@ void CommissioningEvents::test_now(int32_t thruster, int32_t value) {
     if (test_thruster_ >= 0 && thruster >= 0 && thruster != test_thruster_)
         emit(dive::EventKind::MotorTest, test_thruster_, 0, 0);
     if (thruster >= 0)
-        emit(dive::EventKind::MotorTest, thruster, dive::kOn, value, {}, vehicle_.controller_client());
+        emit(dive::EventKind::MotorTest, thruster, dive::kOn, value, {}, vehicle_.readings().controller_client());
     else
         emit(dive::EventKind::MotorTest, test_thruster_, 0, 0);
     test_thruster_ = thruster;
@@ -91,7 +91,7 @@ void CommissioningEvents::detection_events() {
         detecting_ = true;
         judged_ = 0;
         // The caller is the commanding client from the run's start.
-        emit(dive::EventKind::Detection, 0, dive::kOn, 0, {}, vehicle_.controller_client());
+        emit(dive::EventKind::Detection, 0, dive::kOn, 0, {}, vehicle_.readings().controller_client());
     }
     if (!detecting_)
         return;
@@ -111,7 +111,7 @@ void CommissioningEvents::detection_events() {
         pulsing_ = pulsing;
         // The value the detection orders (requested: the budget may scale what is applied).
         emit(dive::EventKind::DetectionPulse, pulsing, dive::kOn,
-             vehicle_.requested_values()[static_cast<std::size_t>(pulsing)]);
+             vehicle_.readings().requested_values()[static_cast<std::size_t>(pulsing)]);
     }
     if (!running)
         detection_end();

@@ -32,7 +32,7 @@ DiveRecorder::DiveRecorder(const DaemonConfig& config, const Vehicle& vehicle, c
 
 void DiveRecorder::start() {
     started_ = true;
-    const SafetyState s = vehicle_.safety().state();
+    const SafetyState s = vehicle_.readings().safety().state();
     if (s == SafetyState::Arming || s == SafetyState::Ready)
         begin(monotonic_ns(), "start");
 }
@@ -58,7 +58,7 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
     h.start_unix_ms = wall;
     h.start_mono_ns = now_ns;
     h.loop_rate_hz = config_.control.loop_rate_hz;
-    h.profile = vehicle_.profile().name;
+    h.profile = vehicle_.readings().profile().name;
     h.reason = reason;
     writer_.open(dive_file_name(wall), dive::encode_header(h));
     for (std::size_t i = 0; i < faults_.size() && i < bus_.size(); ++i)
@@ -67,7 +67,7 @@ void DiveRecorder::begin(uint64_t now_ns, const char* reason) {
     // The state it starts in, with who asked for it.
     dive::Event e;
     e.kind = dive::EventKind::State;
-    e.state = static_cast<uint8_t>(vehicle_.safety().state());
+    e.state = static_cast<uint8_t>(vehicle_.readings().safety().state());
     e.client = events_.caller();
     e.text = reason;
     add_event(std::move(e), now_ns);
@@ -97,7 +97,7 @@ void DiveRecorder::vehicle_changed(uint32_t changes) {
     if (!started_)
         return;
     const uint64_t now = monotonic_ns();
-    const SafetyState s = vehicle_.safety().state();
+    const SafetyState s = vehicle_.readings().safety().state();
     const bool driving = s == SafetyState::Arming || s == SafetyState::Ready;
     if ((changes & kChangeState) && !recording_ && driving) {
         begin(now, "clear-kill");
@@ -109,8 +109,8 @@ void DiveRecorder::vehicle_changed(uint32_t changes) {
         dive::Event e;
         e.kind = dive::EventKind::State;
         e.state = static_cast<uint8_t>(s);
-        e.kill_source = static_cast<uint8_t>(s == SafetyState::Killed ? vehicle_.safety().kill_source() : KillSource::None);
-        e.text = s == SafetyState::Killed ? vehicle_.safety().kill_reason() : std::string();
+        e.kill_source = static_cast<uint8_t>(s == SafetyState::Killed ? vehicle_.readings().safety().kill_record().source : KillSource::None);
+        e.text = s == SafetyState::Killed ? vehicle_.readings().safety().kill_record().reason : std::string();
         e.client = events_.caller();
         add_event(std::move(e), now);
     }
@@ -129,11 +129,11 @@ void DiveRecorder::vehicle_changed(uint32_t changes) {
         }
     }
     if (changes & kChangeProfile)
-        add_event({0, dive::EventKind::Profile, 0, 0, 0, 0, static_cast<float>(vehicle_.profile().factor),
-                   vehicle_.profile().name, events_.caller()}, now);
+        add_event({0, dive::EventKind::Profile, 0, 0, 0, 0, static_cast<float>(vehicle_.readings().profile().factor),
+                   vehicle_.readings().profile().name, events_.caller()}, now);
     if ((changes & kChangeState) && !driving)
         finish(now, s == SafetyState::PoweredOff ? "powered-off"
-                                                 : "killed (" + std::string(vehicle_.kill_source_name()) + ")");
+                                                 : "killed (" + std::string(vehicle_.readings().kill_source_name()) + ")");
 }
 
 void DiveRecorder::failsafe(const ActiveFailsafe& f, bool raised) {

@@ -18,15 +18,15 @@ const dive::Sample& DiveSampler::sample(uint32_t t_100us) {
     s.distances = std::move(room);
     s.t_100us = t_100us;
     for (std::size_t i = 0; i < dive::kThrusters; ++i) {
-        s.requested[i] = clamp16(vehicle_.requested_values()[i]);
-        s.applied[i] = clamp16(vehicle_.order_value(i));
+        s.requested[i] = clamp16(vehicle_.readings().requested_values()[i]);
+        s.applied[i] = clamp16(vehicle_.readings().order_value(i));
     }
-    s.budget_limit = clamp16(vehicle_.budget_limit());
+    s.budget_limit = clamp16(vehicle_.readings().budget_limit());
     const BusTelemetry& bt = bus_.monitor().telemetry();
-    s.flags = static_cast<uint8_t>((vehicle_.saturated() ? dive::kSaturated : 0) |
-                                   (vehicle_.safety().kill_switch_set() ? dive::kKillSwitch : 0) |
+    s.flags = static_cast<uint8_t>((vehicle_.readings().saturated() ? dive::kSaturated : 0) |
+                                   (vehicle_.readings().safety().kill_switch_set() ? dive::kKillSwitch : 0) |
                                    (teensy_.telemetry().online ? dive::kTeensyOnline : 0) |
-                                   (vehicle_.kill_output_asserted() ? dive::kKillOutput : 0) |
+                                   (vehicle_.readings().kill_output_asserted() ? dive::kKillOutput : 0) |
                                    (static_cast<unsigned>(bt.state) << dive::kBusStateShift));
     for (std::size_t i = 0; i < dive::kThrusters && i < bus_.size(); ++i) {
         const ThrusterDriver& d = bus_.thruster(i);

@@ -7,7 +7,7 @@ namespace caracara {
 void FailsafeAscent::begin(std::string reason, uint64_t now) {
     // Nothing to drive while arming or killed: a surface then ends as it would, killed.
     reason_ = std::move(reason);
-    if (!vehicle_.may_drive() || !vehicle_.surface(AxisDemand{0, 0, settings_.heave, 0, 0, 0}).ok()) {
+    if (!vehicle_.readings().may_drive() || !vehicle_.motors().surface(AxisDemand{0, 0, settings_.heave, 0, 0, 0}).ok()) {
         vehicle_.kill(KillSource::Failsafe, reason_ + ": the vehicle could not drive the ascent");
         return;
     }
@@ -20,8 +20,8 @@ void FailsafeAscent::begin(std::string reason, uint64_t now) {
 void FailsafeAscent::keep(uint64_t now) {
     if (until_ == 0)
         return;
-    if (!vehicle_.surfacing()) { // a Kill, the kill switch or another fault ended it
-        log_notice("surfacing ended by a kill (%s)", std::string(vehicle_.kill_source_name()).c_str());
+    if (!vehicle_.readings().surfacing()) { // a Kill, the kill switch or another fault ended it
+        log_notice("surfacing ended by a kill (%s)", std::string(vehicle_.readings().kill_source_name()).c_str());
         until_ = 0;
         events_.changed(kChangeState);
         return;
@@ -32,7 +32,7 @@ void FailsafeAscent::keep(uint64_t now) {
         return;
     }
     // Again, or the command timeout would stop the ascent.
-    vehicle_.surface(AxisDemand{0, 0, settings_.heave, 0, 0, 0});
+    vehicle_.motors().surface(AxisDemand{0, 0, settings_.heave, 0, 0, 0});
 }
 
 } // namespace caracara

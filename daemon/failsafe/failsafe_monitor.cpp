@@ -13,7 +13,7 @@ FailsafeMonitor::FailsafeMonitor(sd_event* event, const FailsafeSettings& settin
     : event_(event), settings_(settings), thrusters_(thrusters), readings_(std::move(readings)), vehicle_(vehicle),
       events_(events), policy_(settings, thrusters), report_(settings, events), ascent_(settings.surface, vehicle, events),
       clearance_(policy_, vehicle, events),
-      period_us_(std::max<uint64_t>(1000, std::min(kPeriodNs, vehicle.safety().config().command_timeout_ns / 2)) /
+      period_us_(std::max<uint64_t>(1000, std::min(kPeriodNs, vehicle.readings().safety().config().command_timeout_ns / 2)) /
                  1000) {}
 
 std::string FailsafeMonitor::start() {
@@ -109,7 +109,7 @@ void FailsafeMonitor::carry_out(const FailsafeTransitions& ts, uint64_t now) {
         excluded[i] = policy_.excluded(i);
     if (excluded != excluded_) {
         excluded_ = excluded;
-        vehicle_.exclude(excluded);
+        vehicle_.motors().exclude(excluded);
     }
     for (const FailsafeTransition& t : ts) {
         if (!t.raised)

@@ -29,7 +29,7 @@ void BusLoss::recovered() {
 
 int BusLoss::on_timer(sd_event_source*, uint64_t, void* userdata) {
     auto* self = static_cast<BusLoss*>(userdata);
-    if (self->bus_.recovering())
+    if (self->bus_.monitor().recovering())
         self->declare("locked up for longer than the command timeout (" +
                       std::to_string(self->control_.command_timeout_ms) + " ms)");
     return 0;

@@ -25,7 +25,7 @@ BusRecovery::BusRecovery(sd_event* event, const DaemonConfig& config, DeviceIo& 
 
 void BusRecovery::bus_locked_up(const std::string& reason) {
     BusTelemetry& tm = bus_.monitor().telemetry();
-    if (bus_.recovering() || tm.state == BusState::Lost)
+    if (bus_.monitor().recovering() || tm.state == BusState::Lost)
         return;
     if (!config_.recovery.enabled) {
         // Nothing to clear the bus with: report it and keep trying the transfers each tick.
@@ -56,7 +56,7 @@ void BusRecovery::reopen() {
         phase_ = Phase::Idle; // a transfer got through: the bus is back
         return;
     }
-    if (!bus_.idle()) {
+    if (!bus_.worker().idle()) {
         schedule(kIdlePollNs); // not under a transfer on the worker's thread
         return;
     }
@@ -92,7 +92,7 @@ int BusRecovery::on_timer(sd_event_source*, uint64_t, void* userdata) {
 
 void BusRecovery::attempt() {
     const RecoverySettings& rc = config_.recovery;
-    if (!bus_.idle()) {
+    if (!bus_.worker().idle()) {
         // A transfer is still on the wire (bounded by the adapter's timeout): the descriptor
         // cannot be closed under it.
         schedule(kIdlePollNs);
@@ -135,7 +135,7 @@ void BusRecovery::finish() {
 }
 
 void BusRecovery::verify() {
-    if (!bus_.idle()) {
+    if (!bus_.worker().idle()) {
         schedule(kIdlePollNs); // the orders are still on the wire (the worker's thread)
         return;
     }

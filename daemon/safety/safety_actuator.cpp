@@ -7,7 +7,7 @@ void SafetyActuator::carry_out(const SafetyAction& a, bool kill_output_asserted,
         // The kill output first: it is one GPIO write, and the zero orders behind it are bus
         // transfers that a hung device can delay. The zeros go before anything queued.
         if (a.state_changed) {
-            bus_.hold_orders();
+            bus_.worker().hold_orders();
             lines_.set_kill_output(true);
         }
         if (a.zero_outputs)

@@ -85,11 +85,11 @@ MotorVerdict CommandAcceptance::within_range_and_budget(const MotorValues& wante
 }
 
 Result CommandAcceptance::take(std::string_view client) {
-    const std::string previous = safety_.commanding_client();
+    const std::string previous = safety_.commands().client();
     if (!safety_.accept_command(monotonic_ns(), client).ok())
         return condition_.state_error();
     deadline_.arm(safety_.next_deadline());
-    if (previous != safety_.commanding_client())
+    if (previous != safety_.commands().client())
         events_.changed(kChangeController);
     pilots_.tell_failsafes(); // a pilot again: pilot-lost ends
     return {};

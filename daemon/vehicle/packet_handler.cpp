@@ -30,8 +30,8 @@ Result PacketHandler::apply(std::span<const int32_t> words, std::string_view cli
     }
     if (p.power_off)
         return vehicle_.power_off(VehicleCondition::kPowerOffConfirmation);
-    if (vehicle_.safety().state() == SafetyState::Killed) {
-        if (vehicle_.safety().kill_source() != KillSource::Packet)
+    if (vehicle_.readings().safety().state() == SafetyState::Killed) {
+        if (vehicle_.readings().safety().kill_record().source != KillSource::Packet)
             return vehicle_.state_error();
         // killState 0 is the packet's "all clear": it clears a packet kill (arming follows).
         if (Result r = vehicle_.clear_packet_kill(); !r.ok())
@@ -39,7 +39,7 @@ Result PacketHandler::apply(std::span<const int32_t> words, std::string_view cli
         teensy_.set_leds(p.red, p.green, p.blue, nullptr);
         return {};
     }
-    if (Result r = vehicle_.drive(p.motors, client); !r.ok())
+    if (Result r = vehicle_.motors().drive(p.motors, client); !r.ok())
         return r;
     if (teensy_.leds() != std::array<uint8_t, 3>{p.red, p.green, p.blue})
         teensy_.set_leds(p.red, p.green, p.blue, nullptr);
@@ -47,9 +47,9 @@ Result PacketHandler::apply(std::span<const int32_t> words, std::string_view cli
 }
 
 void PacketHandler::apply(std::span<const int32_t> words, std::string_view client, Completion done) {
-    const SafetyState before = vehicle_.safety().state();
+    const SafetyState before = vehicle_.readings().safety().state();
     Result r = apply(words, client);
-    const SafetyState after = vehicle_.safety().state();
+    const SafetyState after = vehicle_.readings().safety().state();
     // An error too: a refused packet that carried a kill still killed, and its zeros go first.
     if (after != before && (after == SafetyState::Killed || after == SafetyState::PoweredOff))
         vehicle_.after_zeros(std::move(done), std::move(r));

@@ -19,7 +19,7 @@ void PilotWatch::client_left(std::string_view unique_name) {
     if (unique_name.empty())
         return;
     const bool was_lost = safety_.pilot_lost();
-    if (unique_name == safety_.commanding_client()) {
+    if (unique_name == safety_.commands().client()) {
         log_notice("controlling client %s left the bus: thrusters to zero", std::string(unique_name).c_str());
         // Its zeros go behind what it had sent (ZeroOrder::Behind).
         handle_(safety_.client_left(unique_name, monotonic_ns())); // announces Controller with the motors

@@ -20,7 +20,8 @@ Vehicle::Vehicle(const DaemonConfig& config, ThrusterBus& bus, SafetyLines& line
       condition_(safety_, bus, lines, failsafes),
       pilots_(config.failsafe, safety_, failsafes, [this](const SafetyAction& a) { handle(a); }),
       acceptance_(config.mixing, safety_, condition_, deadline_, events, pilots_),
-      motors_(config, safety_, acceptance_, actuator_, events) {}
+      motors_(config, safety_, acceptance_, actuator_, events),
+      readings_(safety_, condition_, acceptance_, motors_) {}
 
 void Vehicle::handle(const SafetyAction& a, const Result* kill) {
     uint32_t changes = 0;
@@ -56,7 +57,7 @@ Result Vehicle::kill(KillSource source, std::string_view reason) {
     const Result turn_ends{Status::Killed, "the vehicle was killed during the turn"};
     handle(safety_.kill(source, monotonic_ns(), reason), &turn_ends);
     if (!was_killed && safety_.state() == SafetyState::Killed)
-        log_warning("KILLED by %s%s%s", std::string(kill_source_name()).c_str(), reason.empty() ? "" : ": ",
+        log_warning("KILLED by %s%s%s", std::string(condition_.kill_source_name()).c_str(), reason.empty() ? "" : ": ",
                     std::string(reason).c_str());
     return {};
 }

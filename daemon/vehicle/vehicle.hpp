@@ -26,6 +26,7 @@
 #include "daemon/vehicle/motor_commands.hpp"
 #include "daemon/vehicle/pilot_watch.hpp"
 #include "daemon/vehicle/vehicle_condition.hpp"
+#include "daemon/vehicle/vehicle_readings.hpp"
 #include "daemon/interfaces/vehicle_events.hpp"
 #include "drivers/platform/event_loop.hpp"
 
@@ -48,19 +49,17 @@ public:
     std::string start(sd_event* event);
     void stop() { deadline_.stop(); }
 
-    // The motor commands are its MotorCommands' job.
-    Result set_thrust(std::span<const int32_t> values, std::string_view client) { return motors_.set_thrust(values, client); }
-    Result set_motion(const AxisDemand& demand, std::string_view client) { return motors_.set_motion(demand, client); }
+    // The motor commands (SetThrust, SetMotion, a packet's, SetProfile, the failsafes' exclusion
+    // and ascent) are its MotorCommands'.
+    MotorCommands& motors() { return motors_; }
+    // What readers read: the state, who commands, the motor values (VehicleReadings).
+    const VehicleReadings& readings() const { return readings_; }
+
     Result kill(KillSource source, std::string_view reason = {});
     Result clear_kill();
     // A packet's "all clear" (killState 0): clears a kill only the packet made.
     Result clear_packet_kill() { return clear(); }
     Result power_off(std::string_view confirmation);
-    // A packet's motor values, as SetThrust's; `range`: the caller's verdict on its own
-    // arguments (the motor test's), decided after the state (CommandAcceptance).
-    Result drive(const MotorValues& values, std::string_view client, const Result& range = {}) {
-        return motors_.drive(values, client, range);
-    }
     // The calls that stop the thrusters hand their result to `done` once the zero orders they
     // put on the bus are on the wire (the bus worker's thread): a caller that gets it knows
     // the thrusters were told zero. The loop does not wait for them; the kill output was
@@ -73,7 +72,6 @@ public:
     }
     // `done(r)` once the zeros handed to the bus so far are on the wire.
     void after_zeros(Completion done, Result r) { actuator_.after_zeros(std::move(done), std::move(r)); }
-    Result set_profile(std::string_view name) { return motors_.set_profile(name); }
     void client_left(std::string_view unique_name) { pilots_.client_left(unique_name); }
     // Once per cycle: arming and the command timeout.
     void tick(uint64_t now_ns) { handle(safety_.tick(now_ns)); }
@@ -89,27 +87,6 @@ public:
     // Inside a safety sequence being carried out (SafetyActuator::carry_out): the failsafes
     // decide a condition pushed meanwhile once it is done, not halfway through it.
     bool acting() const { return acting_; }
-
-    // What thruster i is to be ordered now: its applied value while the vehicle may drive.
-    int32_t order_value(size_t i) const { return motors_.order_value(i); }
-    bool may_drive() const { return safety_.may_drive(); }
-    bool kill_output_asserted() const { return safety_.kill_output_asserted(); }
-
-    const SafetyMachine& safety() const { return safety_; }
-    std::string_view state_name() const { return condition_.state_name(); }
-    std::string_view kill_source_name() const { return condition_.kill_source_name(); }
-    const MotorValues& motor_values() const { return motors_.demand().applied(); }
-    const MotorValues& requested_values() const { return motors_.demand().requested(); }
-    int32_t budget_limit() const { return motors_.demand().limit(); }
-    bool saturated() const { return motors_.demand().saturated(); }
-    int64_t command_age_ms() const { return condition_.command_age_ms(); }
-    const std::string& controller_client() const { return safety_.commanding_client(); }
-    const ThrustProfile& profile() const { return motors_.demand().profile(); }
-
-    // Failsafes (daemon/failsafe_monitor decides, the Vehicle carries out).
-    void exclude(const std::array<bool, kMotorCount>& excluded) { motors_.exclude(excluded); }
-    Result surface(const AxisDemand& ascent) { return motors_.surface(ascent); }
-    bool surfacing() const { return acceptance_.surfacing(); }
 
 private:
     Result clear();
@@ -129,6 +106,7 @@ private:
     PilotWatch pilots_;
     CommandAcceptance acceptance_;
     MotorCommands motors_;
+    VehicleReadings readings_;
     bool acting_ = false;
 };
 

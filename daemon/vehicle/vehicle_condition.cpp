@@ -55,11 +55,11 @@ std::string_view VehicleCondition::state_name() const {
 std::string_view VehicleCondition::kill_source_name() const {
     if (safety_.state() != SafetyState::Killed)
         return "";
-    return caracara::kill_source_name(safety_.kill_source());
+    return caracara::kill_source_name(safety_.kill_record().source);
 }
 
 int64_t VehicleCondition::command_age_ms() const {
-    const uint64_t last = safety_.last_command_at();
+    const uint64_t last = safety_.commands().last_command_at();
     if (last == 0)
         return -1;
     return static_cast<int64_t>((monotonic_ns() - last) / 1'000'000ull);

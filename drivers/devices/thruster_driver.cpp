@@ -80,7 +80,6 @@ IoError ThrusterDriver::send_order(int32_t value) {
     ++counters_.orders_sent;
     online_ = true;
     last_speed_ = *speed;
-    last_motor_ = motor_value;
     return IoError::None;
 }
 

@@ -61,8 +61,7 @@ public:
     IoError last_error() const { return last_error_; }        // last failure (kept after recovery)
     int last_errno() const { return last_errno_; }            // its errno (EBADMSG for a bad reply)
     CodecError last_reply_error() const { return last_reply_error_; }
-    std::optional<uint8_t> last_speed() const { return last_speed_; }        // last ACKed SPEED byte
-    std::optional<int32_t> last_motor_value() const { return last_motor_; } // its value, before reversal
+    std::optional<uint8_t> last_speed() const { return last_speed_; } // last ACKed SPEED byte
     const std::optional<ThrusterStatus>& last_status() const { return last_status_; }
     std::span<const uint8_t> last_reply() const { return std::span<const uint8_t>(rx_).first(rx_len_); }
 
@@ -79,8 +78,8 @@ private:
     IoError last_error_ = IoError::None;
     int last_errno_ = 0;
     CodecError last_reply_error_ = CodecError::None;
+    // Kept: the SPEED byte the thruster last ACKed, the wire's own word (OrderedSpeed), not the order.
     std::optional<uint8_t> last_speed_;
-    std::optional<int32_t> last_motor_;
     std::optional<ThrusterStatus> last_status_;
     std::array<uint8_t, kMaxStatusLength> rx_{};
     std::size_t rx_len_ = 0;

@@ -82,7 +82,7 @@ void bring(DaemonRig& rig, Given g) {
         REQUIRE(v.clear_kill().ok()); // arming until the loop's next tick, which does not run here
         break;
     case Given::PoweredOff: REQUIRE(v.power_off("power-off").ok()); break;
-    case Given::Surfacing: REQUIRE(v.surface(AxisDemand{0, 0, -0.3, 0, 0, 0}).ok()); break;
+    case Given::Surfacing: REQUIRE(v.motors().surface(AxisDemand{0, 0, -0.3, 0, 0, 0}).ok()); break;
     }
 }
 
@@ -138,24 +138,24 @@ TEST_CASE("each command in each state: accepted, or its named error in the order
         DaemonRig rig;
         rig.run_until_ready();
         bring(rig, row.given);
-        const ThrustProfile& profile = rig.vehicle().profile();
+        const ThrustProfile& profile = rig.vehicle().readings().profile();
         const MotorDemand scale(BudgetPolicy::Scale, profile);
         const MotorDemand reject(BudgetPolicy::Reject, profile);
-        const std::string controller = rig.vehicle().controller_client();
+        const std::string controller = rig.vehicle().readings().controller_client();
         const Result r = row.command(rig.vehicle().acceptance(), scale, reject);
         CHECK(status_name(r.status) == status_name(row.expected));
         CHECK(r.ok() == r.message.empty()); // a refusal says why
         if (r.ok())
-            CHECK(rig.vehicle().controller_client() == kPilot);
+            CHECK(rig.vehicle().readings().controller_client() == kPilot);
         else
-            CHECK(rig.vehicle().controller_client() == controller);
+            CHECK(rig.vehicle().readings().controller_client() == controller);
     }
 }
 
 TEST_CASE("an accepted motor command carries what the demand takes: the values, the budget over them") {
     DaemonRig rig;
     rig.run_until_ready();
-    const MotorDemand scale(BudgetPolicy::Scale, rig.vehicle().profile());
+    const MotorDemand scale(BudgetPolicy::Scale, rig.vehicle().readings().profile());
     CommandAcceptance& a = rig.vehicle().acceptance();
 
     const MotorVerdict full = a.thrust(kFull, scale, kPilot);
@@ -174,12 +174,12 @@ TEST_CASE("an accepted motor command carries what the demand takes: the values, 
 TEST_CASE("the ascent: only the failsafe drives while it surfaces, and a kill ends that") {
     DaemonRig rig;
     rig.run_until_ready();
-    const MotorDemand scale(BudgetPolicy::Scale, rig.vehicle().profile());
+    const MotorDemand scale(BudgetPolicy::Scale, rig.vehicle().readings().profile());
     CommandAcceptance& a = rig.vehicle().acceptance();
 
     REQUIRE(a.ascent({0, 0, -0.3, 0, 0, 0}, scale).ok());
     CHECK(a.surfacing());
-    CHECK(rig.vehicle().controller_client() == CommandAcceptance::kFailsafeClient);
+    CHECK(rig.vehicle().readings().controller_client() == CommandAcceptance::kFailsafeClient);
     CHECK(a.thrust(kGood, scale, kPilot).result.status == Status::Surfacing);
     CHECK(a.accept_command(kPilot, {}).status == Status::Surfacing);
     CHECK(a.ascent({0, 0, -0.3, 0, 0, 0}, scale).ok()); // kept up past the command timeout

@@ -68,16 +68,16 @@ TEST_CASE("the failsafe table: each fixed condition pushed kills with its row's 
         INFO(name);
         DaemonRig rig("loop_rate_hz = 50\n", "[failsafe.pilot-lost]\npersistence_ms = 200\n");
         rig.run_until_ready();
-        REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+        REQUIRE(rig.vehicle().motors().set_thrust(kThrust, ":1.7").ok());
         rig.run_for(60);
         rig.wire().clear();
         const uint64_t pushed_at = monotonic_ns();
         rig.daemon().failsafes().push(row.condition, true, "test: " + name + " holds");
         if (row.default_rule.persistence_ms == 0) {
             // Handled at once: killed before the loop runs again, not at the monitor's reading.
-            CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
+            CHECK(rig.vehicle().readings().safety().state() == SafetyState::Killed);
         } else {
-            CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+            CHECK(rig.vehicle().readings().safety().state() == SafetyState::Ready);
             CHECK(rig.daemon().failsafes().pilot_lost_kill_at() >= pushed_at + ms_to_ns(200));
         }
         REQUIRE(rig.run_until([&] {
@@ -87,12 +87,12 @@ TEST_CASE("the failsafe table: each fixed condition pushed kills with its row's 
         }));
         if (row.default_rule.persistence_ms != 0)
             CHECK(monotonic_ns() - pushed_at >= ms_to_ns(200));
-        CHECK(rig.vehicle().kill_source_name() == kill_source_name(row.kill_source));
+        CHECK(rig.vehicle().readings().kill_source_name() == kill_source_name(row.kill_source));
         // A source's own kill reads with the reason it pushed; a failsafe's, with its name.
         if (row.kill_source == KillSource::Failsafe)
-            CHECK(rig.vehicle().safety().kill_reason() == name + " kill");
+            CHECK(rig.vehicle().readings().safety().kill_record().reason == name + " kill");
         else
-            CHECK(rig.vehicle().safety().kill_reason() == "test: " + name + " holds");
+            CHECK(rig.vehicle().readings().safety().kill_record().reason == "test: " + name + " holds");
         REQUIRE(rig.daemon().failsafes().active().size() == 1);
         CHECK(rig.daemon().failsafes().active()[0].condition == row.condition);
         rig.daemon().failsafes().push(row.condition, false, "test: cleared");
@@ -105,7 +105,7 @@ TEST_CASE("the failsafe table: teensy-link-lost keeps the kill while it holds, b
     DaemonRig rig;
     rig.run_until_ready();
     rig.daemon().failsafes().push(FailsafeCondition::TeensyLinkLost, true, "test: the Teensy went away");
-    REQUIRE(rig.vehicle().safety().state() == SafetyState::Killed);
+    REQUIRE(rig.vehicle().readings().safety().state() == SafetyState::Killed);
     const Result r = rig.vehicle().clear_kill();
     CHECK(r.status == Status::FailsafeActive);
     CHECK(r.message.find("teensy-link-lost") != std::string::npos);
@@ -116,13 +116,13 @@ TEST_CASE("the failsafe table: teensy-link-lost keeps the kill while it holds, b
 TEST_CASE("safety-line-lost: the kill output gone under a running vehicle kills, source device, until it is back") {
     DaemonRig rig;
     rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.vehicle().motors().set_thrust(kThrust, ":1.7").ok());
     rig.run_for(60);
     rig.wire().clear();
     rig.gpio().set_outputs_gone(true); // found by the outputs' read-back (every 100 ms)
-    REQUIRE(rig.run_until([&] { return rig.vehicle().safety().state() == SafetyState::Killed; }));
-    CHECK(rig.vehicle().kill_source_name() == "device");
-    CHECK(rig.vehicle().safety().kill_reason() == "kill output went away");
+    REQUIRE(rig.run_until([&] { return rig.vehicle().readings().safety().state() == SafetyState::Killed; }));
+    CHECK(rig.vehicle().readings().kill_source_name() == "device");
+    CHECK(rig.vehicle().readings().safety().kill_record().reason == "kill output went away");
     REQUIRE(rig.run_until([&] { return zeroed_after(rig.wire().events(), 0); }));
     CHECK(rig.vehicle().clear_kill().status == Status::Hardware);
     rig.gpio().set_outputs_gone(false); // asked for again once a second: back asserted, and cleared
@@ -133,17 +133,17 @@ TEST_CASE("safety-line-lost: the kill output gone under a running vehicle kills,
 TEST_CASE("safety-line-lost: a kill output that fails as a Kill asserts it is decided after that kill, not inside it") {
     DaemonRig rig;
     rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.vehicle().motors().set_thrust(kThrust, ":1.7").ok());
     rig.run_for(60);
     rig.wire().clear();
     rig.gpio().set_outputs_gone(true);
     CHECK(rig.vehicle().kill(KillSource::DBus, "test").ok());
     // The Kill's own sequence ran to its end: killed by D-Bus, its zeros handed down.
-    CHECK(rig.vehicle().kill_source_name() == "dbus");
+    CHECK(rig.vehicle().readings().kill_source_name() == "dbus");
     CHECK(rig.daemon().failsafes().active().empty()); // not yet: right after the sequence
     REQUIRE(rig.run_until([&] { return !rig.daemon().failsafes().active().empty(); }, 500));
     CHECK(rig.daemon().failsafes().active()[0].condition == FailsafeCondition::SafetyLineLost);
-    CHECK(rig.vehicle().kill_source_name() == "dbus"); // the first kill's source is kept
+    CHECK(rig.vehicle().readings().kill_source_name() == "dbus"); // the first kill's source is kept
     REQUIRE(rig.run_until([&] { return zeroed_after(rig.wire().events(), 0); }));
     rig.gpio().set_outputs_gone(false);
 }

@@ -65,7 +65,7 @@ TEST_CASE("the arming delay is configurable") {
 TEST_CASE("starting with the kill switch set starts killed") {
     SafetyMachine s(SafetyConfig{}, true, kT0);
     CHECK(s.state() == SafetyState::Killed);
-    CHECK(s.kill_source() == KillSource::Switch);
+    CHECK(s.kill_record().source == KillSource::Switch);
     CHECK(s.kill_output_asserted());
     CHECK(s.next_deadline() == SafetyMachine::kNoDeadline);
     s.tick(kT0 + ms(60000));
@@ -95,12 +95,12 @@ TEST_CASE("a kill zeroes at once, drops commands and latches") {
         CHECK(a.zero_outputs);
         CHECK(a.clear_commands);
         CHECK(s.state() == SafetyState::Killed);
-        CHECK(s.kill_source() == src);
-        CHECK(s.killed_at() == now + 1);
+        CHECK(s.kill_record().source == src);
+        CHECK(s.kill_record().at == now + 1);
         CHECK(s.kill_output_asserted());
         CHECK_FALSE(s.may_drive());
         CHECK_FALSE(s.command_active());
-        CHECK(s.commanding_client().empty());
+        CHECK(s.commands().client().empty());
 
         // Latched: time passing changes nothing, commands are refused.
         s.tick(now + ms(600000));
@@ -124,8 +124,8 @@ TEST_CASE("a second kill keeps the first source and still asks for zero") {
     CHECK(a.ok());
     CHECK_FALSE(a.state_changed);
     CHECK(a.zero_outputs);
-    CHECK(s.kill_source() == KillSource::Packet);
-    CHECK(s.killed_at() == now);
+    CHECK(s.kill_record().source == KillSource::Packet);
+    CHECK(s.kill_record().at == now);
 }
 
 TEST_CASE("a kill during arming stops the arming") {
@@ -146,7 +146,7 @@ TEST_CASE("clearing needs a kill, the switch released, then a full arming delay"
 
     s.kill(KillSource::DBus, now);
     s.switch_changed(true, now + 1);  // switch set while already killed
-    CHECK(s.kill_source() == KillSource::DBus);
+    CHECK(s.kill_record().source == KillSource::DBus);
     a = s.clear_kill(now + 2);
     CHECK(a.error == SafetyError::KillSwitchSet);
     CHECK(s.state() == SafetyState::Killed);
@@ -158,7 +158,7 @@ TEST_CASE("clearing needs a kill, the switch released, then a full arming delay"
     CHECK(a.state_changed);
     CHECK(a.zero_outputs);
     CHECK(s.state() == SafetyState::Arming);
-    CHECK(s.kill_source() == KillSource::None);
+    CHECK(s.kill_record().source == KillSource::None);
     CHECK_FALSE(s.kill_output_asserted());
     CHECK_FALSE(s.may_drive());
     CHECK(s.accept_command(cleared + ms(2999)).error == SafetyError::NotReady);
@@ -176,7 +176,7 @@ TEST_CASE("the kill switch kills from ready and keeps the vehicle killed while s
     SafetyMachine s = ready_machine(now);
     s.switch_changed(true, now);
     CHECK(s.state() == SafetyState::Killed);
-    CHECK(s.kill_source() == KillSource::Switch);
+    CHECK(s.kill_record().source == KillSource::Switch);
     CHECK(s.kill_switch_set());
     CHECK(s.clear_kill(now + ms(1)).error == SafetyError::KillSwitchSet);
     s.switch_changed(false, now + ms(2));
@@ -243,7 +243,7 @@ TEST_CASE("a silent command stream zeroes the output without killing") {
     CHECK(a.clear_commands);
     CHECK_FALSE(a.state_changed);
     CHECK(s.state() == SafetyState::Ready);  // not a kill
-    CHECK(s.kill_source() == KillSource::None);
+    CHECK(s.kill_record().source == KillSource::None);
     CHECK_FALSE(s.kill_output_asserted());
     CHECK_FALSE(s.command_active());
 
@@ -268,7 +268,7 @@ TEST_CASE("the commanding client leaving zeroes the output without killing") {
     uint64_t now = 0;
     SafetyMachine s = ready_machine(now);
     REQUIRE(s.accept_command(now, ":1.7").ok());
-    CHECK(s.commanding_client() == ":1.7");
+    CHECK(s.commands().client() == ":1.7");
 
     SafetyAction a = s.client_left(":1.9", now + 1);  // someone else
     CHECK_FALSE(a.zero_outputs);
@@ -355,8 +355,8 @@ TEST_CASE("start killed: source start until ClearKill, and any real kill names i
     cfg.start_killed = true;
     SafetyMachine s(cfg, false, kT0);
     CHECK(s.state() == SafetyState::Killed);
-    CHECK(s.kill_source() == KillSource::Start);
-    CHECK(kill_source_name(s.kill_source()) == "start");
+    CHECK(s.kill_record().source == KillSource::Start);
+    CHECK(kill_source_name(s.kill_record().source) == "start");
     CHECK(s.kill_output_asserted());
     CHECK_FALSE(s.may_drive());
     CHECK(s.next_deadline() == SafetyMachine::kNoDeadline); // nothing ends a start kill by itself
@@ -367,7 +367,7 @@ TEST_CASE("start killed: source start until ClearKill, and any real kill names i
     // The switch set at start: the kill is the switch's now, and ClearKill wants it released.
     SafetyAction a = s.switch_changed(true, kT0 + ms(2));
     CHECK(a.zero_outputs);
-    CHECK(s.kill_source() == KillSource::Switch);
+    CHECK(s.kill_record().source == KillSource::Switch);
     CHECK(s.clear_kill(kT0 + ms(3)).error == SafetyError::KillSwitchSet);
     s.switch_changed(false, kT0 + ms(4));
     CHECK(s.clear_kill(kT0 + ms(5)).ok());
@@ -383,11 +383,11 @@ TEST_CASE("start killed: ClearKill arms it; a second kill keeps its first real s
     CHECK(s.state() == SafetyState::Ready);
     s.kill(KillSource::DBus, kT0 + ms(4000));
     s.kill(KillSource::Packet, kT0 + ms(4001));
-    CHECK(s.kill_source() == KillSource::DBus);
+    CHECK(s.kill_record().source == KillSource::DBus);
 }
 
 TEST_CASE("the default machine (arm at start) still starts arming") {
     SafetyMachine s(SafetyConfig{}, false, kT0);
     CHECK(s.state() == SafetyState::Arming);
-    CHECK(s.kill_source() == KillSource::None);
+    CHECK(s.kill_record().source == KillSource::None);
 }

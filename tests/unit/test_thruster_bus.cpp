@@ -76,7 +76,7 @@ struct BusRig {
     }
     void release_and_drain() {
         wire.release();
-        if (!run_until([&] { return bus.idle(); }))
+        if (!run_until([&] { return bus.worker().idle(); }))
             throw std::runtime_error("the worker did not drain");
     }
 };
@@ -91,7 +91,7 @@ TEST_CASE("each order reaches its thruster with its value; ordered_value is what
     BusRig r;
     for (std::size_t i = 0; i < 8; ++i)
         r.bus.send_order(i, 1000 + 100 * static_cast<int32_t>(i));
-    REQUIRE(r.run_until([&] { return r.bus.idle(); }));
+    REQUIRE(r.run_until([&] { return r.bus.worker().idle(); }));
     const auto ev = r.wire.events();
     for (std::size_t i = 0; i < 8; ++i) {
         CHECK(order_at(ev, i, 1000 + 100 * static_cast<int32_t>(i)) >= 0);
@@ -107,7 +107,7 @@ TEST_CASE("zeros first: they overtake the queued orders, which are dropped") {
     r.hang_first(0, 2000);
     r.bus.send_order(1, 2000);
     r.bus.send_order(2, 2000);
-    r.bus.hold_orders(); // a kill: no older non-zero order after its kill output
+    r.bus.worker().hold_orders(); // a kill: no older non-zero order after its kill output
     r.bus.zero_all(ZeroOrder::First);
     r.release_and_drain();
     const auto ev = r.wire.events();
@@ -177,7 +177,7 @@ TEST_CASE("a thruster failing three transfers in a row is unreachable; the fails
     for (int n = 0; n < 5; ++n) {
         r.bus.send_order(3, 0);
         r.bus.send_order(0, 0); // the bus itself works
-        REQUIRE(r.run_until([&] { return r.bus.idle(); }));
+        REQUIRE(r.run_until([&] { return r.bus.worker().idle(); }));
         CHECK(r.bus.health().first_unreachable().has_value() == (n >= 2));
     }
     REQUIRE(gate.lost.size() == 1);
@@ -185,14 +185,14 @@ TEST_CASE("a thruster failing three transfers in a row is unreachable; the fails
     CHECK(r.bus.monitor().telemetry().state == BusState::Ok);
     r.wire.fail(3, 0);
     r.bus.send_order(3, 0);
-    REQUIRE(r.run_until([&] { return r.bus.idle(); }));
+    REQUIRE(r.run_until([&] { return r.bus.worker().idle(); }));
     CHECK_FALSE(r.bus.health().first_unreachable());
     CHECK(gate.cleared.size() == 1); // thruster-unreachable ends with the last one answering
     Gate late;
     r.wire.fail(6, ENXIO);
     for (int n = 0; n < 3; ++n) {
         r.bus.send_order(6, 0);
-        REQUIRE(r.run_until([&] { return r.bus.idle(); }));
+        REQUIRE(r.run_until([&] { return r.bus.worker().idle(); }));
     }
     r.bus.health().set_failsafes(&late); // told at once of the one already unreachable
     CHECK(late.lost.size() == 1);
@@ -206,13 +206,13 @@ TEST_CASE("a bus on which every transfer times out is locked up: the monitor tel
         r.wire.fail(i, ETIMEDOUT);
     for (int n = 0; n < 4 && lockups.reasons.empty(); ++n) {
         r.bus.send_order(static_cast<std::size_t>(n), 0);
-        REQUIRE(r.run_until([&] { return r.bus.idle(); }));
+        REQUIRE(r.run_until([&] { return r.bus.worker().idle(); }));
     }
     REQUIRE(lockups.reasons.size() == 1);
     CHECK(r.bus.monitor().telemetry().errors >= LockupDetector::kBusErrors);
     // While recovering, the failures say nothing new and no transfer is handed over.
     r.bus.set_recovering(true);
     r.bus.zero_all();
-    CHECK(r.bus.idle());
+    CHECK(r.bus.worker().idle());
     r.bus.set_recovering(false);
 }

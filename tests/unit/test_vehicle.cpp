@@ -50,7 +50,7 @@ long check_kill_output_first(const std::vector<WireEvent>& ev) {
 // Ready, with kThrust on the wire.
 void drive(DaemonRig& rig) {
     rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.vehicle().motors().set_thrust(kThrust, ":1.7").ok());
     REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
 }
 
@@ -60,7 +60,7 @@ TEST_CASE("SetThrust: each motor value reaches its thruster, and the tick keeps 
     DaemonRig rig;
     rig.run_until_ready();
     rig.wire().clear();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.vehicle().motors().set_thrust(kThrust, ":1.7").ok());
     REQUIRE(rig.run_until([&] { return each_ordered(rig.wire().events(), kThrust); }));
     // The ticks refresh each order with the same value (three times here)...
     const auto orders_of = [&](const std::vector<WireEvent>& ev, std::size_t i) {
@@ -88,8 +88,8 @@ TEST_CASE("a refused command changes nothing on the wire") {
     rig.wire().clear();
     std::vector<int32_t> bad = kThrust;
     bad[3] = 9000;
-    CHECK(rig.vehicle().set_thrust(bad, ":1.7").status == Status::OutOfRange);
-    CHECK(rig.vehicle().set_thrust(std::vector<int32_t>(7, 100), ":1.7").status == Status::InvalidLength);
+    CHECK(rig.vehicle().motors().set_thrust(bad, ":1.7").status == Status::OutOfRange);
+    CHECK(rig.vehicle().motors().set_thrust(std::vector<int32_t>(7, 100), ":1.7").status == Status::InvalidLength);
     rig.run_for(100);
     CHECK(first_nonzero_order(rig.wire().events()) < 0);
 }
@@ -107,7 +107,7 @@ TEST_CASE("Kill: the kill output first, then a zero to every thruster; the compl
     const auto ev = rig.wire().events();
     const long asserted = check_kill_output_first(ev);
     CHECK(all_zeroed(*at_completion, asserted)); // the reply waits for the zeros
-    CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Killed);
 }
 
 TEST_CASE("a Kill behind a hung transfer: the kill output at once, no older order after it") {
@@ -116,7 +116,7 @@ TEST_CASE("a Kill behind a hung transfer: the kill output at once, no older orde
     rig.wire().hold();
     REQUIRE(rig.run_until([&] { return rig.wire().transfer_waiting(); }));
     // Orders queued behind the hung transfer, then the kill.
-    REQUIRE(rig.vehicle().set_thrust(std::vector<int32_t>(8, 4000), ":1.7").ok());
+    REQUIRE(rig.vehicle().motors().set_thrust(std::vector<int32_t>(8, 4000), ":1.7").ok());
     rig.run_for(20);
     rig.wire().clear();
     bool completed = false;
@@ -143,21 +143,21 @@ TEST_CASE("the kill switch: the kill output first, then the zeros; released, the
     check_kill_output_first(rig.wire().events());
     rig.gpio().set_kill_switch(false);
     rig.run_for(60);
-    CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Killed);
     CHECK(kill_output(rig.wire().events(), 0) < 0);
 }
 
 TEST_CASE("started killed with the kill switch set: the kill is the switch's, not the start's") {
     DaemonRig rig("arm_at_start = false\nloop_rate_hz = 50\n", "", true);
     rig.run_for(40);
-    REQUIRE(rig.vehicle().safety().state() == SafetyState::Killed);
+    REQUIRE(rig.vehicle().readings().safety().state() == SafetyState::Killed);
     // What holds the vehicle killed is the switch, which the user must release.
-    CHECK(rig.vehicle().kill_source_name() == "switch");
+    CHECK(rig.vehicle().readings().kill_source_name() == "switch");
     CHECK(rig.vehicle().clear_kill().status == Status::KillSwitchSet);
     CHECK(kill_output(rig.wire().events(), 0) < 0);
     rig.gpio().set_kill_switch(false);
     rig.run_for(40);
-    CHECK(rig.vehicle().kill_source_name() == "switch"); // released, the kill stays until ClearKill
+    CHECK(rig.vehicle().readings().kill_source_name() == "switch"); // released, the kill stays until ClearKill
     CHECK(rig.vehicle().clear_kill().ok());
 }
 
@@ -165,7 +165,7 @@ TEST_CASE("a client that leaves: what it sent reaches the wire, then its zeros; 
     DaemonRig rig("loop_rate_hz = 50\n", "[failsafe.pilot-lost]\npersistence_ms = 300\n");
     rig.run_until_ready();
     rig.wire().clear();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.vehicle().motors().set_thrust(kThrust, ":1.7").ok());
     const uint64_t left_at = monotonic_ns();
     rig.vehicle().client_left(":1.7"); // before the loop ran: the orders are still due
     // Each thruster gets what the client sent, then its zero.
@@ -180,13 +180,13 @@ TEST_CASE("a client that leaves: what it sent reaches the wire, then its zeros; 
     };
     CHECK(rig.run_until(sent_then_zero));
     CHECK(kill_output(rig.wire().events(), 1) < 0);
-    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
-    CHECK(rig.vehicle().controller_client().empty());
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Ready);
+    CHECK(rig.vehicle().readings().controller_client().empty());
     // It was the last pilot: the pilot-lost failsafe kills once its persistence has passed.
     REQUIRE(rig.run_until([&] { return kill_output(rig.wire().events(), 1) >= 0; }, 2000));
     CHECK(monotonic_ns() - left_at >= ms_to_ns(300));
     REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events(), kill_output(rig.wire().events(), 1)); }));
-    CHECK(rig.vehicle().kill_source_name() == "failsafe");
+    CHECK(rig.vehicle().readings().kill_source_name() == "failsafe");
     CHECK(rig.daemon().failsafes().active().size() == 1);
     check_kill_output_first(rig.wire().events());
     // The kill ended it: a plain ClearKill arms again.
@@ -201,18 +201,18 @@ TEST_CASE("a client that never commanded leaving is no pilot lost") {
     rig.vehicle().client_left(":1.5");
     rig.run_for(300);
     CHECK(kill_output(rig.wire().events(), 1) < 0);
-    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Ready);
 }
 
 TEST_CASE("another client leaving changes nothing") {
     DaemonRig rig;
     rig.run_until_ready();
-    REQUIRE(rig.vehicle().set_thrust(kThrust, ":1.7").ok());
+    REQUIRE(rig.vehicle().motors().set_thrust(kThrust, ":1.7").ok());
     rig.vehicle().client_left(":1.8");
     rig.run_for(60);
     const auto ev = rig.wire().events();
     CHECK(each_ordered(ev, kThrust));
-    CHECK(rig.vehicle().motor_values()[0] == 1000);
+    CHECK(rig.vehicle().readings().motor_values()[0] == 1000);
 }
 
 TEST_CASE("the command timeout: zeros, no kill") {
@@ -221,7 +221,7 @@ TEST_CASE("the command timeout: zeros, no kill") {
     rig.wire().clear();
     REQUIRE(rig.run_until([&] { return all_zeroed(rig.wire().events()); }, 1000));
     CHECK(kill_output(rig.wire().events(), 1) < 0);
-    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Ready);
 }
 
 TEST_CASE("PowerOff: the zeros, then the power-off line; the completion after the zeros") {
@@ -253,7 +253,7 @@ TEST_CASE("PowerOff without its confirmation changes nothing") {
     CHECK(result->status == Status::ConfirmationRequired);
     rig.run_for(40);
     CHECK(find(rig.wire().events(), [](const WireEvent& e) { return e.kind == Kind::PowerOff && e.value == 1; }) < 0);
-    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Ready);
 }
 
 TEST_CASE("a packet that kills completes after its zeros; one that drives completes at once") {
@@ -273,15 +273,15 @@ TEST_CASE("a packet that kills completes after its zeros; one that drives comple
     rig.packets().apply(packet, ":1.7", [&](const Result&) { at_completion = rig.wire().events(); });
     REQUIRE(rig.run_until([&] { return at_completion.has_value(); }));
     check_kill_output_first(*at_completion); // the completion comes after the zeros
-    CHECK(rig.vehicle().safety().kill_source() == KillSource::Packet);
+    CHECK(rig.vehicle().readings().safety().kill_record().source == KillSource::Packet);
 }
 
 TEST_CASE("a thruster that stops answering kills the vehicle (source device); the kill stays until it answers") {
     DaemonRig rig;
     rig.run_until_ready();
     rig.wire().fail(5, ENXIO);
-    REQUIRE(rig.run_until([&] { return rig.vehicle().safety().state() == SafetyState::Killed; }));
-    CHECK(rig.vehicle().safety().kill_source() == KillSource::Device);
+    REQUIRE(rig.run_until([&] { return rig.vehicle().readings().safety().state() == SafetyState::Killed; }));
+    CHECK(rig.vehicle().readings().safety().kill_record().source == KillSource::Device);
     CHECK(rig.vehicle().clear_kill().status == Status::ThrusterUnreachable);
     rig.wire().fail(5, 0);
     REQUIRE(rig.run_until([&] { return !rig.daemon().bus().health().first_unreachable(); }));
@@ -292,8 +292,8 @@ TEST_CASE("a fitted Teensy absent at start keeps the vehicle killed by teensy-li
     // The fakes have no SPI node: the Teensy the [spi] table says is fitted is absent.
     DaemonRig rig("loop_rate_hz = 50\n", "[spi]\nfitted = true\n");
     // Killed as the failsafes start, before any loop cycle: never ready, not even armed at start.
-    CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
-    CHECK(rig.vehicle().kill_source_name() == "failsafe");
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Killed);
+    CHECK(rig.vehicle().readings().kill_source_name() == "failsafe");
     CHECK(rig.daemon().teensy().loss() == TeensyLoss::Absent);
     rig.run_for(300);
     REQUIRE(rig.daemon().failsafes().active().size() == 1);
@@ -301,7 +301,7 @@ TEST_CASE("a fitted Teensy absent at start keeps the vehicle killed by teensy-li
     const Result r = rig.vehicle().clear_kill();
     CHECK(r.status == Status::FailsafeActive);
     CHECK_THAT(r.message, Catch::Contains("teensy-link-lost"));
-    CHECK(rig.vehicle().safety().state() == SafetyState::Killed);
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Killed);
     check_kill_output_first(rig.wire().events());
 }
 
@@ -309,7 +309,7 @@ TEST_CASE("a Teensy not fitted and absent is no failsafe") {
     DaemonRig rig("loop_rate_hz = 50\n", "[spi]\nfitted = false\nsilence_ms = 50\n");
     rig.run_until_ready();
     rig.run_for(200); // several silences long
-    CHECK(rig.vehicle().safety().state() == SafetyState::Ready);
+    CHECK(rig.vehicle().readings().safety().state() == SafetyState::Ready);
     CHECK(rig.daemon().failsafes().active().empty());
     CHECK(rig.daemon().teensy().loss() == TeensyLoss::None);
 }

@@ -52,7 +52,7 @@ void DaemonRig::run_for(int ms) {
 
 void DaemonRig::run_until_ready() {
     const bool ready = run_until([&] {
-        if (!vehicle().may_drive())
+        if (!vehicle().readings().may_drive())
             return false;
         const auto ev = wire_.events();
         for (std::size_t i = 0; i < config_.thrusters.size(); ++i)
