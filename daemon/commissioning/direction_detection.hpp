@@ -3,7 +3,7 @@
 // holds still (after a rest, the Teensy's orientation moved at most detect_settle_mrad between
 // the halves of detect_settle_ms), takes
 // that attitude, pulses the thruster alone (detect_pulse_value for detect_pulse_ms, through
-// Vehicle::drive like any motor command: budget, state, commanding client, the wire), takes the
+// MotorCommands::drive like any motor command: budget, state, commanding client, the wire), takes the
 // attitude over the end of the pulse, orders it zero, and has core/direction_judgement say ok,
 // reversed or inconclusive. It never changes the configuration: the caller gets the fragment.
 // A kill, the caller leaving or another pilot commanding, a failsafe, or a vehicle that will not

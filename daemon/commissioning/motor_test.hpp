@@ -1,6 +1,6 @@
 // A motor test (docs/commissioning.md): one thruster run at a bounded value, the others held
 // at zero, for as long as the caller keeps asking. It is an ordinary motor command from the
-// caller's client (Vehicle::drive: the same budget, state checks, commanding client and path
+// caller's client (MotorCommands::drive: the same budget, state checks, commanding client and path
 // to the wire as SetThrust), so whatever ends a command ends it at once: a kill zeroes it, the
 // caller leaving the bus zeroes it (PilotWatch), a pilot's command or a second test replaces
 // it. What it adds: the value's bound (commissioning.motor_test_limit), armed only, and the

@@ -1,11 +1,12 @@
-// The vehicle as callers see it: the safety state machine, the commands (thrust, motion,
-// kill, clear, power-off) and who is commanding; the legacy packet is read by its
-// PacketHandler, which asks the Vehicle for each of these. Whether a command is accepted is its
-// CommandAcceptance's job (also the CommandGate the Teensy's wheels and turns ask); the motor
-// commands and their values (requested, applied, the budget), its MotorCommands'; what the
-// safety machine decides is carried out by its SafetyActuator (on the bus, the safety lines and
-// the Teensy); the end of arming and the command timeout come from its DeadlineTimer; who left,
-// its PilotWatch.
+// The vehicle as callers see it: the safety state machine, the commands (kill, clear,
+// power-off) and who is commanding; the legacy packet is read by its PacketHandler, which asks
+// the Vehicle for each of these. Whether a command is accepted is its CommandAcceptance's job
+// (also the CommandGate the Teensy's wheels and turns ask); the motor commands and their values
+// (requested, applied, the budget), its MotorCommands', handed out by motors(); what readers read
+// (the state, who commands, the motor values), its VehicleReadings, handed out by readings();
+// what the safety machine decides is carried out by its SafetyActuator (on the bus, the safety
+// lines and the Teensy); the end of arming and the command timeout come from its DeadlineTimer;
+// who left, its PilotWatch.
 #pragma once
 
 #include "core/config.hpp"
