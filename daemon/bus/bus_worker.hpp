@@ -6,6 +6,7 @@
 // through the copy made after its last job.
 #pragma once
 
+#include "daemon/bus/bus_controls.hpp"
 #include "daemon/bus/bus_job_queue.hpp"
 #include "daemon/bus/bus_transfer.hpp"
 #include "daemon/loop/worker_thread.hpp"
@@ -24,7 +25,7 @@
 
 namespace caracara {
 
-class BusWorker final : private WorkerThread::Jobs {
+class BusWorker final : public BusControls, private WorkerThread::Jobs {
 public:
     using DoneFn = std::function<void(const BusJobDone&)>;
 
@@ -45,29 +46,29 @@ public:
     // The thread is woken once for the jobs submitted between these two (a dispatch of the
     // cycle's work), not at each: when the device answers at once, a wake-up per job costs
     // more than the job. submit_first() always wakes it at once.
-    void hold_wakeups() { holding_wakeups_ = true; }
-    void release_wakeups();
+    void hold_wakeups() override { holding_wakeups_ = true; }
+    void release_wakeups() override;
     // `jobs` go before everything queued, which is dropped (a kill's zero orders).
     void submit_first(std::span<const BusJob> jobs);
     // Drops what is queued but not yet on the wire (the bus is closed for recovery).
     void drop_queued();
     // A kill's fence and the emergency stop's gate: see BusTransfer.
-    void hold_orders() { transfer_.hold_orders(); }
-    void set_gate(BusGate* gate) { transfer_.set_gate(gate); }
+    void hold_orders() override { transfer_.hold_orders(); }
+    void set_gate(BusGate* gate) override { transfer_.set_gate(gate); }
     void set_prober(BusProber* prober) { transfer_.set_prober(prober); } // runs the Probe jobs; set while idle
     // Nothing queued, on the wire, or finished but not yet handed to `done`.
-    bool idle() const { return outstanding_ == 0; }
+    bool idle() const override { return outstanding_ == 0; }
     // At once (the default): the loop is woken as soon as a batch is over. Otherwise it takes the
     // results itself (collect(), at its next tick: a cycle's routine transfers need no wake-up
     // of their own), and only a failed transfer or a long batch wakes it.
     void set_wake_at_once(bool at_once);
     // At once for the jobs handed over so far (call after the last of them): the loop is woken
     // once they are done (a command's orders: its properties show what is on the wire).
-    void wake_when_done();
-    void collect() { deliver(); }
+    void wake_when_done() override;
+    void collect() override { deliver(); }
     // Blocks until idle, handing the finished jobs to `done`: start-up and shutdown only,
     // where the zero orders must be on the wire before the daemon goes on.
-    void wait_idle();
+    void wait_idle() override;
     // Thruster i as of its last finished job.
     const ThrusterDriver& view(std::size_t i) const { return views_[i]; }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "core/config.hpp"
+#include "daemon/bus/bus_controls.hpp"
 #include "daemon/bus/bus_monitor.hpp"
 #include "daemon/bus/bus_worker.hpp"
 #include "daemon/bus/thruster_health.hpp"
@@ -52,13 +53,10 @@ public:
         results_at_tick_ = at_tick;
         update_wake_at_once();
     }
-    // The worker's own controls: how the transfers handed over wake it and come back
-    // (hold_wakeups/release_wakeups, collect, wake_when_done), a kill holding older orders back
-    // (hold_orders), the emergency stop's gate (set_gate), and whether it is idle (idle,
-    // wait_idle at start-up and shutdown, where the zeros must be on the wire first). Orders,
-    // status reads and probes go through the ThrusterBus, which keeps what was ordered.
-    BusWorker& worker() { return worker_; }
-    const BusWorker& worker() const { return worker_; }
+    // The worker's own controls (wake-ups, a kill's fence, the emergency stop's gate, idle);
+    // orders, status reads and probes go through the ThrusterBus, which keeps what was ordered.
+    BusControls& worker() { return worker_; }
+    const BusControls& worker() const { return worker_; }
 
     // The adapter closed for a bus recovery (its queued work dropped) and open again; whether
     // it is, is its BusMonitor's (monitor().recovering()).
