@@ -170,6 +170,10 @@ bool parse_sim_config(const std::string& text, SimConfig& out, std::string& erro
             c.thrusters.push_back(s);
         }
     }
+    if (std::string e = VehicleGeometry::parse(root, c.vehicle); !e.empty()) {
+        error = e;
+        return false;
+    }
     out = std::move(c);
     return true;
 }

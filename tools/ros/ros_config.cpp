@@ -151,7 +151,7 @@ std::string load_config(const std::string& path, RosConfig& c) {
         static const char* const known[] = {"namespace", "domain_id", "range_layout", "commands", "world_frame",
                                             "base_frame", "frame_convention", "publish_odom_tf", "range_min_m",
                                             "range_max_m", "range_fov_rad", "security", "security_plugins", "insecure_commands",
-                                            "sensor_rate_hz", "imu", "range"};
+                                            "sensor_rate_hz", "imu", "range", "wrench_units", "vehicle_config"};
         bool ok = false;
         for (const char* k : known)
             ok = ok || key.str() == k;
@@ -247,6 +247,23 @@ std::string load_config(const std::string& path, RosConfig& c) {
     }
     if (auto v = t["network"]["interface"].value<std::string>())
         c.interface = *v;
+    if (const toml::node* n = ros["wrench_units"].node()) {
+        const auto v = n->value_exact<std::string>();
+        const auto u = v ? parse_name<WrenchUnits>(*v) : std::nullopt;
+        if (!u)
+            return path + ": ros.wrench_units must be \"fraction\" or \"newton\"" + (v ? " (\"" + *v + "\")" : "");
+        c.wrench_units = *u;
+    }
+    if (const toml::node* n = ros["vehicle_config"].node()) {
+        const auto v = n->value_exact<std::string>();
+        if (!v || v->empty() || (*v)[0] != '/')
+            return path + ": ros.vehicle_config must be the absolute path of the caracarad.toml that describes the "
+                          "vehicle" + (v ? " (\"" + *v + "\")" : "");
+        c.vehicle_config = *v;
+    }
+    if (c.wrench_units == WrenchUnits::Newton)
+        if (std::string e = VehicleGeometry::load(c.vehicle_config, c.vehicle); !e.empty())
+            return path + ": ros.wrench_units = \"newton\" needs the vehicle's description: " + e;
     return check_values(path, c);
 }
 
