@@ -2,7 +2,7 @@
 
 #include "core/failsafe_config.hpp"
 #include "core/thruster_table.hpp"
-#include "core/vehicle_geometry.hpp"
+#include "core/vehicle_config.hpp"
 #include "core/toml_checker.hpp"
 #include "core/toml_text.hpp"
 
@@ -316,7 +316,7 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     // [vehicle] and the thrusters' position / direction are caracara-ros's and caracara-sim's (a
     // Wrench in newtons); the daemon checks them so one file is wrong in one place.
     VehicleGeometry geometry;
-    if (std::string e = VehicleGeometry::parse(root, geometry); !e.empty()) {
+    if (std::string e = parse_vehicle(root, geometry); !e.empty()) {
         const auto at = e.find(": ");
         c.fail(e.substr(0, at), e.substr(at + 2));
     }

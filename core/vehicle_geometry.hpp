@@ -12,7 +12,6 @@
 #include <array>
 #include <optional>
 #include <string>
-#include <toml++/toml.h>
 
 namespace caracara {
 
@@ -36,12 +35,6 @@ public:
     // corners, BTD150 curves, no mass given.
     VehicleGeometry();
     VehicleGeometry(std::array<ThrusterPlacement, kMotorCount> placements, ForceCurve curve);
-
-    // Reads [vehicle] and the [[thruster]] tables' position / direction of a parsed caracarad.toml
-    // into `out` (the defaults where absent); "" or "<key>: <problem>".
-    static std::string parse(const toml::table& root, VehicleGeometry& out);
-    // The file at `path`: "" or "<path>: <key>: <problem>".
-    static std::string load(const std::string& path, VehicleGeometry& out);
 
     // The eight motor values that push `wrench` (newtons and newton-metres, body FLU): each
     // thruster's force by the pseudo-inverse of the geometry's force/torque matrix, scaled by one

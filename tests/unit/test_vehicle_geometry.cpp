@@ -1,7 +1,7 @@
 // core/vehicle_geometry: a Wrench in newtons through the vehicle's geometry and force curve to
 // motor values, the saturation that keeps its direction, the reverse curve for pushes backwards,
 // and the config's errors named by key.
-#include "core/vehicle_geometry.hpp"
+#include "core/vehicle_config.hpp"
 
 #include "core/mixing.hpp"
 
@@ -18,7 +18,7 @@ frames::BodyMotion force(double x, double y, double z) { return {{x, y, z}, {}};
 
 std::string parse_error(const std::string& text) {
     VehicleGeometry g;
-    return VehicleGeometry::parse(toml::parse(text), g);
+    return parse_vehicle(toml::parse(text), g);
 }
 
 // Eight thrusters on the body's x axis, each pushing forward (motors 0..3) or left (4..7), at the
@@ -115,7 +115,7 @@ TEST_CASE("the description is read from caracarad.toml's [vehicle] and [[thruste
         eight += "[[thruster]]\naddress = " + std::to_string(0x52 + 2 * i) + "\nposition = [0, 0, 0]\ndirection = [" +
                  (i < 4 ? "2, 0, 0" : "0, 3, 0") + "]\n";
     VehicleGeometry g;
-    REQUIRE(VehicleGeometry::parse(toml::parse("[vehicle]\nmass_kg = 12.5\ninertia_kg_m2 = [0.3, 0.5, 0.6]\n"
+    REQUIRE(parse_vehicle(toml::parse("[vehicle]\nmass_kg = 12.5\ninertia_kg_m2 = [0.3, 0.5, 0.6]\n"
                                                "thrust_forward_n = [0, 10]\nthrust_reverse_n = [0, 5]\n" + eight), g) == "");
     CHECK(*g.mass_kg == 12.5);
     CHECK(g.inertia_kg_m2->z == 0.6);
@@ -123,7 +123,7 @@ TEST_CASE("the description is read from caracarad.toml's [vehicle] and [[thruste
     CHECK(g.motors_for(force(-8, 0, 0)).motors == MotorValues{-3540, -3540, -3540, -3540, 0, 0, 0, 0});
     // No [vehicle]: the BTD150 curve and no mass.
     VehicleGeometry d;
-    REQUIRE(VehicleGeometry::parse(toml::parse(""), d) == "");
+    REQUIRE(parse_vehicle(toml::parse(""), d) == "");
     CHECK_FALSE(d.mass_kg);
     CHECK(d.curve().full_n(true) == Approx(kFull));
 }

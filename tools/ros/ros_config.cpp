@@ -1,6 +1,7 @@
 #include "tools/ros/ros_config.hpp"
 
 #include "core/toml_text.hpp"
+#include "core/vehicle_config.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -262,7 +263,7 @@ std::string load_config(const std::string& path, RosConfig& c) {
         c.vehicle_config = *v;
     }
     if (c.wrench_units == WrenchUnits::Newton)
-        if (std::string e = VehicleGeometry::load(c.vehicle_config, c.vehicle); !e.empty())
+        if (std::string e = load_vehicle(c.vehicle_config, c.vehicle); !e.empty())
             return path + ": ros.wrench_units = \"newton\" needs the vehicle's description: " + e;
     return check_values(path, c);
 }
