@@ -14,22 +14,6 @@ using frames::Vec3;
 
 constexpr double kMaxOffsetM = 10.0; // as a sensor's mount: a typo (mm for m) is refused
 
-// Three finite numbers within `limit`; false otherwise.
-bool triple(const toml::node* n, double limit, Vec3& out) {
-    const toml::array* a = n ? n->as_array() : nullptr;
-    if (!a || a->size() != 3)
-        return false;
-    double v[3];
-    for (std::size_t i = 0; i < 3; ++i) {
-        const auto d = (*a)[i].value<double>();
-        if (!d || !std::isfinite(*d) || std::fabs(*d) > limit)
-            return false;
-        v[i] = *d;
-    }
-    out = {v[0], v[1], v[2]};
-    return true;
-}
-
 std::string read_curve(const toml::table& v, const char* key, std::vector<double>& out) {
     const toml::node* n = v.get(key);
     if (!n)
@@ -59,7 +43,7 @@ std::string read_vehicle(const toml::table& v, VehicleGeometry& g, ForceCurve& c
     }
     if (const toml::node* n = v.get("inertia_kg_m2")) {
         Vec3 i;
-        if (!triple(n, 10000, i) || i.x <= 0 || i.y <= 0 || i.z <= 0)
+        if (!read_triple(n, 10000, i) || i.x <= 0 || i.y <= 0 || i.z <= 0)
             return "vehicle.inertia_kg_m2: must be 3 moments of inertia in kg m^2 about x forward, y left, z up, each "
                    "above 0";
         g.inertia_kg_m2 = i;
@@ -88,11 +72,11 @@ std::string read_placements(const toml::table& root, std::array<ThrusterPlacemen
         if (arr->size() != kMotorCount)
             return where + "position: the vehicle is described by exactly 8 [[thruster]] tables, got " +
                    std::to_string(arr->size());
-        if (!triple(t->get("position"), kMaxOffsetM, p[i].position))
+        if (!read_triple(t->get("position"), kMaxOffsetM, p[i].position))
             return where + "position: must be 3 numbers, metres from the centre of mass (x forward, y left, z up), "
                            "each within 10";
         Vec3 d;
-        const double len = triple(t->get("direction"), 1e6, d) ? std::hypot(d.x, d.y, d.z) : 0.0;
+        const double len = read_triple(t->get("direction"), 1e6, d) ? std::hypot(d.x, d.y, d.z) : 0.0;
         if (!(len > 1e-9))
             return where + "direction: must be 3 numbers (x forward, y left, z up), not all 0: the way a positive "
                            "motor value pushes";
@@ -107,6 +91,21 @@ std::string read_placements(const toml::table& root, std::array<ThrusterPlacemen
 }
 
 } // namespace
+
+bool read_triple(const toml::node* n, double limit, Vec3& out) {
+    const toml::array* a = n ? n->as_array() : nullptr;
+    if (!a || a->size() != 3)
+        return false;
+    double v[3];
+    for (std::size_t i = 0; i < 3; ++i) {
+        const auto d = (*a)[i].value<double>();
+        if (!d || !std::isfinite(*d) || std::fabs(*d) > limit)
+            return false;
+        v[i] = *d;
+    }
+    out = {v[0], v[1], v[2]};
+    return true;
+}
 
 std::string parse_vehicle(const toml::table& root, VehicleGeometry& out) {
     VehicleGeometry g;

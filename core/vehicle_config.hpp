@@ -10,6 +10,10 @@
 
 namespace caracara {
 
+// Three finite numbers, each within `limit`, into `out` (a position, a direction; caracara-ros's
+// sensor mounts too); false otherwise.
+bool read_triple(const toml::node* n, double limit, frames::Vec3& out);
+
 // Reads a parsed caracarad.toml into `out` (the defaults where a key is absent); "" or
 // "<key>: <problem>", `out` unchanged then.
 std::string parse_vehicle(const toml::table& root, VehicleGeometry& out);

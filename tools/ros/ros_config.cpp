@@ -77,22 +77,6 @@ std::string check_values(const std::string& path, const RosConfig& c) {
 constexpr double kMaxMountOffsetM = 10.0;
 constexpr double kMaxMountAngleRad = 2 * std::numbers::pi;
 
-// Three finite numbers, each within `limit`, into `out`; false otherwise.
-bool read_triple(const toml::node* n, double limit, frames::Vec3& out) {
-    const toml::array* a = n ? n->as_array() : nullptr;
-    if (!a || a->size() != 3)
-        return false;
-    double v[3];
-    for (std::size_t i = 0; i < 3; ++i) {
-        const auto d = (*a)[i].value<double>();
-        if (!d || !std::isfinite(*d) || std::fabs(*d) > limit)
-            return false;
-        v[i] = *d;
-    }
-    out = {v[0], v[1], v[2]};
-    return true;
-}
-
 // One [ros.imu] or [[ros.range]] table (`name` as the errors call it) into `m`.
 std::string read_mount(const std::string& path, const std::string& name, const toml::node& node, SensorMount& m) {
     const toml::table* t = node.as_table();
