@@ -2,6 +2,7 @@
 
 #include "core/failsafe_config.hpp"
 #include "core/thruster_table.hpp"
+#include "core/vehicle_config.hpp"
 #include "core/toml_checker.hpp"
 #include "core/toml_text.hpp"
 
@@ -306,12 +307,19 @@ ConfigResult parse_config_string(std::string_view text, std::string_view source)
     DaemonConfig cfg;
     // [sim] belongs to caracara-sim, which reads the same file; it is not checked here.
     c.only_keys(root, "", {"i2c", "spi", "thruster", "mixing", "control", "gpio", "recovery", "profiles", "recorder", "failsafe",
-                       "realtime", "commissioning", "sim"});
+                       "realtime", "commissioning", "sim", "vehicle"});
     if (const toml::table* t = c.table(root, "", "i2c"))
         parse_i2c(c, *t, cfg.i2c);
     if (const toml::table* t = c.table(root, "", "spi"))
         parse_spi(c, *t, cfg.spi);
     parse_thrusters(c, root, cfg.thrusters);
+    // [vehicle] and the thrusters' position / direction are caracara-ros's and caracara-sim's (a
+    // Wrench in newtons); the daemon checks them so one file is wrong in one place.
+    VehicleGeometry geometry;
+    if (std::string e = parse_vehicle(root, geometry); !e.empty()) {
+        const auto at = e.find(": ");
+        c.fail(e.substr(0, at), e.substr(at + 2));
+    }
     if (const toml::table* t = c.table(root, "", "mixing"))
         parse_mixing(c, *t, cfg.mixing);
     if (const toml::table* t = c.table(root, "", "control"))

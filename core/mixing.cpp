@@ -36,6 +36,17 @@ MixResult mix_error(MixError e, int axis, std::string message) {
 }
 } // namespace
 
+bool saturate_keeping_direction(std::span<double> values, double full) {
+    double peak = 0.0;
+    for (double v : values)
+        peak = std::max(peak, std::abs(v));
+    if (peak <= full)
+        return false;
+    for (double& v : values)
+        v *= full / peak;
+    return true;
+}
+
 MixResult mix(const AxisDemand& demand, const MixMatrix& matrix) {
     for (std::size_t j = 0; j < kAxisCount; ++j) {
         const double a = demand[j];
@@ -52,7 +63,6 @@ MixResult mix(const AxisDemand& demand, const MixMatrix& matrix) {
     }
 
     std::array<double, kMotorCount> out{};
-    double peak = 0.0;
     for (std::size_t i = 0; i < kMotorCount; ++i) {
         double sum = 0.0;
         for (std::size_t j = 0; j < kAxisCount; ++j)
@@ -61,15 +71,12 @@ MixResult mix(const AxisDemand& demand, const MixMatrix& matrix) {
             return mix_error(MixError::NotFinite, -1,
                              "motor " + std::to_string(i) + ": the mixing matrix produced a non-finite value");
         out[i] = sum;
-        peak = std::max(peak, std::abs(sum));
     }
 
     MixResult r;
-    // One common factor keeps the ratios between motors, hence the direction of motion.
-    const double scale = peak > 1.0 ? 1.0 / peak : 1.0;
-    r.saturated = peak > 1.0;
+    r.saturated = saturate_keeping_direction(out);
     for (std::size_t i = 0; i < kMotorCount; ++i) {
-        const double v = std::clamp(out[i] * scale, -1.0, 1.0) * kMotorMax;
+        const double v = std::clamp(out[i], -1.0, 1.0) * kMotorMax;
         r.motors[i] = static_cast<int32_t>(std::lround(v));
     }
     return r;

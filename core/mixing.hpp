@@ -21,6 +21,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -62,6 +63,11 @@ struct MixResult {
     std::string message;      // human-readable, names the axis and the value
     bool ok() const { return error == MixError::None; }
 };
+
+// When the largest |value| exceeds `full`, divides every value by largest / full: one common
+// factor keeps the ratios, hence the direction of motion (as ArduSub's AP_Motors6DOF does) rather
+// than clipping values one by one. Returns whether it scaled.
+bool saturate_keeping_direction(std::span<double> values, double full = 1.0);
 
 // out_i = sum_j M[i][j] * demand_j. If the largest |out_i| exceeds 1, every output is
 // divided by it so the direction of motion is kept (as ArduSub's AP_Motors6DOF does)

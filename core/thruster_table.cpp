@@ -21,7 +21,7 @@ bool parse_thruster(Checker& c, const toml::table& t, std::size_t i, ThrusterCon
     const std::string p = "thruster[" + std::to_string(i) + "].";
     const std::size_t before = c.errors.size();
     // "brushless" describes the simulated motor (caracara-sim reads the same file).
-    c.only_keys(t, p, {"address", "variant", "info", "mux_address", "mux_channel", "reversed", "brushless"});
+    c.only_keys(t, p, {"address", "variant", "info", "mux_address", "mux_channel", "reversed", "brushless", "position", "direction"});
 
     const toml::node* an = t.get("address");
     if (!an) {

@@ -116,6 +116,7 @@ SpiPort& spi(V v) { return v.teensy_port(); }
 constexpr dbus::Member kMembers[] = {
     property<[](V v) { auto o = v.teensy().orientation(); return std::tuple{o.yaw, o.pitch, o.roll}; }>("Orientation"),
     property<[](V v) { auto p = v.body().position(); return std::tuple{p.x, p.y, p.depth}; }>("Position"),
+    property<[](V v) { auto w = v.body().velocity(); return std::tuple{w.x, w.y, w.depth}; }>("Velocity"),
     property<[](V v) {
         auto w = v.teensy().wheels();
         return std::tuple{w.front_left, w.front_right, w.back_left, w.back_right};

@@ -189,6 +189,9 @@ int main(int argc, char** argv) {
                 vehicle.i2c_path().c_str(), vehicle.i2c().clock_hz(),
                 vehicle.realistic_timing() ? " (realistic timing)" : "", socket_path.c_str(),
                 bridge ? "; kernel bridge " : "", kernel_bridge.c_str());
+    if (cfg.vehicle.mass_kg)
+        std::printf("caracara-sim: thrust in newtons through the vehicle's description: mass %.3g kg%s\n",
+                    *cfg.vehicle.mass_kg, cfg.vehicle.inertia_kg_m2 ? ", inertia given" : "");
     std::fflush(stdout);
     sd_notify(0, "READY=1\nSTATUS=Simulating the vehicle");
 

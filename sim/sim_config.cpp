@@ -2,6 +2,7 @@
 
 #include "core/toml_checker.hpp"
 #include "core/toml_text.hpp"
+#include "core/vehicle_config.hpp"
 
 #include <fstream>
 #include <sstream>
@@ -169,6 +170,10 @@ bool parse_sim_config(const std::string& text, SimConfig& out, std::string& erro
                 s.brushless = *b;
             c.thrusters.push_back(s);
         }
+    }
+    if (std::string e = parse_vehicle(root, c.vehicle); !e.empty()) {
+        error = e;
+        return false;
     }
     out = std::move(c);
     return true;

@@ -2,6 +2,7 @@
 // The [[thruster]] tables use the same keys as caracarad.toml so one file can describe both.
 #pragma once
 
+#include "core/vehicle_geometry.hpp"
 #include "sim/teensy_config.hpp"
 #include "sim/thruster_model.hpp"
 
@@ -33,6 +34,9 @@ struct SimConfig {
     std::array<bool, 8> disconnected{};
     // The Teensy's orientation sensor noise and drift, among its other settings.
     TeensyConfig teensy;
+    // [vehicle] and the thrusters' position / direction, as caracara-ros reads them: with a mass
+    // (and an inertia) the body moves in newtons (sim/vehicle_body.hpp).
+    VehicleGeometry vehicle;
 };
 
 SimConfig default_sim_config();

@@ -5,6 +5,14 @@
 
 namespace caracara::sim {
 
+namespace {
+VehicleBodyConfig body_config(const SimConfig& cfg) {
+    VehicleBodyConfig b;
+    b.vehicle = cfg.vehicle;
+    return b;
+}
+} // namespace
+
 SimVehicle::SimVehicle(const SimConfig& cfg)
     : cfg_(cfg), i2c_(log_, cfg.i2c_clock_hz), gpio_(i2c_, log_, cfg.kill_switch_active_low),
       realistic_(cfg.realistic_timing) {
@@ -23,7 +31,7 @@ SimVehicle::SimVehicle(const SimConfig& cfg)
             if (!cfg_.disconnected[i])
                 f[i] = (cfg_.mounted_reversed[i] ? -1.0 : 1.0) * thrusters_[i]->actual_fraction();
         return f;
-    });
+    }, body_config(cfg_));
     teensy_ = std::make_unique<TeensyModel>(cfg_.teensy, *body_);
     attach_spi(cfg_.spi_device, teensy_.get());
     stepped_.push_back(body_.get());

@@ -1,5 +1,7 @@
 #include "sim/vehicle_body.hpp"
 
+#include "core/frames.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -62,12 +64,36 @@ std::array<double, 6> VehicleBody::generalised_force() const {
     return f;
 }
 
+std::array<double, 6> VehicleBody::thrust_acceleration() const {
+    const std::array<double, 6> f = generalised_force();
+    std::array<double, 6> a{};
+    for (std::size_t j = 0; j < 6; ++j)
+        a[j] = (j < 3 ? cfg_.k_force : cfg_.k_torque) * f[j];
+    const std::optional<VehicleGeometry>& v = cfg_.vehicle;
+    if (!v || (!v->mass_kg && !v->inertia_kg_m2))
+        return a;
+    std::array<double, 8> t = thrust_();
+    for (double& ti : t)
+        ti = std::isfinite(ti) ? std::clamp(ti, -1.0, 1.0) : 0.0;
+    // The wrench in REP 103's FLU, turned into the seed's axes this body moves in (core/frames).
+    const AxisDemand w = frames::from_flu(v->wrench_of(t));
+    if (v->mass_kg)
+        for (std::size_t j = 0; j < 3; ++j)
+            a[j] = w[j] / *v->mass_kg;
+    if (v->inertia_kg_m2) { // yaw is about z (up), pitch about y (left), roll about x (forward)
+        a[3] = w[3] / v->inertia_kg_m2->z;
+        a[4] = w[4] / v->inertia_kg_m2->y;
+        a[5] = w[5] / v->inertia_kg_m2->x;
+    }
+    return a;
+}
+
 void VehicleBody::step(double dt_s, uint64_t now_ns) {
     (void)now_ns;
     if (!std::isfinite(dt_s) || dt_s <= 0.0)
         return;
     // Thrust is sampled once per step: the thruster models change on the same tick anyway.
-    const std::array<double, 6> f = generalised_force();
+    const std::array<double, 6> f = thrust_acceleration();
     double left = dt_s;
     while (left > 0.0) {
         double h = std::min(left, cfg_.max_substep_s);
@@ -76,12 +102,12 @@ void VehicleBody::step(double dt_s, uint64_t now_ns) {
     }
 }
 
-void VehicleBody::substep(double dt, const std::array<double, 6>& f) {
+void VehicleBody::substep(double dt, const std::array<double, 6>& f) { // f: thrust_acceleration()
     // Semi-implicit Euler: update rates first, then angles with the new rates (stable for
     // the damped oscillator that pitch and roll are).
-    rate_.yaw += dt * (cfg_.k_torque * f[3] - cfg_.k_damp * rate_.yaw);
-    rate_.pitch += dt * (cfg_.k_torque * f[4] - cfg_.k_damp * rate_.pitch - cfg_.k_restore * std::sin(att_.pitch));
-    rate_.roll += dt * (cfg_.k_torque * f[5] - cfg_.k_damp * rate_.roll - cfg_.k_restore * std::sin(att_.roll));
+    rate_.yaw += dt * (f[3] - cfg_.k_damp * rate_.yaw);
+    rate_.pitch += dt * (f[4] - cfg_.k_damp * rate_.pitch - cfg_.k_restore * std::sin(att_.pitch));
+    rate_.roll += dt * (f[5] - cfg_.k_damp * rate_.roll - cfg_.k_restore * std::sin(att_.roll));
     att_.yaw = wrap_angle(att_.yaw + dt * rate_.yaw);
     att_.pitch = wrap_angle(att_.pitch + dt * rate_.pitch);
     att_.roll = wrap_angle(att_.roll + dt * rate_.roll);
@@ -93,9 +119,9 @@ void VehicleBody::substep(double dt, const std::array<double, 6>& f) {
     const double s = std::sin(att_.yaw);
     const double fx = f[0] * c - f[1] * s;
     const double fy = f[0] * s + f[1] * c;
-    vel_.x += dt * (cfg_.k_force * fx - cfg_.k_drag * vel_.x);
-    vel_.y += dt * (cfg_.k_force * fy - cfg_.k_drag * vel_.y);
-    vel_.depth += dt * (cfg_.k_force * f[2] - cfg_.k_drag * vel_.depth);
+    vel_.x += dt * (fx - cfg_.k_drag * vel_.x);
+    vel_.y += dt * (fy - cfg_.k_drag * vel_.y);
+    vel_.depth += dt * (f[2] - cfg_.k_drag * vel_.depth);
     pos_.x += dt * vel_.x;
     pos_.y += dt * vel_.y;
     pos_.depth += dt * vel_.depth;

@@ -6,11 +6,13 @@
 // system; pitch and roll also feel a restoring moment because the vehicle is bottom-heavy.
 #pragma once
 
+#include "core/vehicle_geometry.hpp"
 #include "sim/stepped.hpp"
 
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 
 namespace caracara::sim {
 
@@ -46,6 +48,11 @@ struct VehicleBodyConfig {
     double k_drag = 1.0;  // 1/s
     // Long steps are split so the explicit integration stays stable.
     double max_substep_s = 0.01;
+    // The vehicle's description (caracarad.toml's [vehicle] and thruster placements, the one
+    // caracara-ros maps a Wrench in newtons through): with its mass, translation takes each
+    // thruster's thrust in newtons (the force curve) through the geometry, v' = F / m - k_drag * v;
+    // with its inertia, rotation likewise, rate' = torque / I - k_damp * rate (- restoring).
+    std::optional<VehicleGeometry> vehicle;
 
     static AxisTable seed_axis_table();
 };
@@ -62,6 +69,10 @@ public:
     // Generalised force per axis: the thrust vector projected onto each axis column, divided by
     // the column's absolute sum so that a full command on one axis gives exactly +-1.
     std::array<double, 6> generalised_force() const;
+    // What the thrust does to each axis (BodyAxis order, the seed's senses): m/s^2 and rad/s^2
+    // before drag, damping and restoring; in newtons through the description where it gives the
+    // mass (translation) and the inertia (rotation), else k_force / k_torque times the above.
+    std::array<double, 6> thrust_acceleration() const;
 
     BodyAttitude attitude() const { return att_; }
     double yaw() const { return att_.yaw; }

@@ -739,13 +739,14 @@ class VehicleTestCase(unittest.TestCase):
     GPIO = True
     EXTRA_CONFIG = {}
     EXTRA_TOML = ""
+    SIM_TOML = ""  # the simulator's own file (--config), when not empty
     BUS_POLICY_EXTRA = ""
     WAIT_READY = True
 
     @classmethod
     def setUpClass(cls):
         cls.rig = Rig(control=cls.CONTROL, gpio=cls.GPIO, extra_config=cls.EXTRA_CONFIG,
-                      extra_toml=cls.EXTRA_TOML,
+                      extra_toml=cls.EXTRA_TOML, sim_toml=cls.SIM_TOML,
                       bus_policy_extra=cls.BUS_POLICY_EXTRA)
         cls.addClassCleanup(cls.rig.stop_checked)
         cls.rig.start()

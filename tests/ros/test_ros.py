@@ -39,10 +39,10 @@ import harness  # noqa: E402
 from harness import missing, npm_ci  # noqa: E402
 from bounds import CLIENT_LOSS_ZERO_MS_MAX, ORIENTATION_TO_JUDGE_MIN_RAD, ROS_READING_STAMP_AGE_MS_MAX  # noqa: E402
 from bounds import ROS_SENSOR_RATE_MAX_FRACTION, ROS_SENSOR_RATE_MIN_FRACTION, ROS_SENSOR_RATE_WINDOW_S  # noqa: E402
-from bounds import ROS_TAKEOVER_EARLY_MS_MAX  # noqa: E402
+from bounds import ROS_NEWTON_ACCEL_ERROR_FRACTION_MAX, ROS_NEWTON_ACCEL_WINDOW_S, ROS_TAKEOVER_EARLY_MS_MAX  # noqa: E402
 from harness import BUILD_DIR, MOTORS, ZERO, VehicleTestCase, angle_diff, poll, speed_byte  # noqa: E402
 from test_failsafes import kill_edges, orders  # noqa: E402
-from vehicle_motion import START_HEADING_RAD, judge, place  # noqa: E402
+from vehicle_motion import START_HEADING_RAD, body_motion, judge, place, pose, settle  # noqa: E402
 
 
 # Every type caracara-ros speaks, with the topic it is on.
@@ -336,7 +336,8 @@ class RosTestCase(VehicleTestCase):
         with open(conf, "w") as f:
             f.write('[ros]\nnamespace = "/caracara"\ncommands = %s\n%s%s[network]\ninterface = "lo"\n'
                     % ("true" if cls.COMMANDS else "false",
-                       'range_layout = "%s"\n' % cls.DISTRO if cls.LAYOUT_IN_CONFIG else "", cls.ROS_CONFIG))
+                       'range_layout = "%s"\n' % cls.DISTRO if cls.LAYOUT_IN_CONFIG else "",
+                       cls.ROS_CONFIG.replace("{rig_dir}", cls.rig.dir)))
         cls.ros = cls.rig._spawn("caracara-ros", harness.EMULATOR + [
             os.path.join(BUILD_DIR, "tools", "ros", "caracara-ros"), "--bus-address", cls.rig.address, "--config", conf])
         cls.addClassCleanup(cls.stop_ros)
@@ -1639,6 +1640,69 @@ class CommandsTest(RosTestCase):
         print("peer SIGKILL -> zeros on the wire: %.1f ms" % ms, file=sys.stderr)
         self.assertLess(ms, CLIENT_LOSS_ZERO_MS_MAX)
         self.assertIn("gone", rig.log("caracara-ros"))
+
+
+# The vehicle's description for NewtonWrenchTest: the simulator's file, which caracara-ros reads too.
+NEWTON_MASS_KG = 11.5
+SIM_DRAG_PER_S = 1.0  # sim/vehicle_body.hpp's k_drag: v' = F / m - k_drag * v
+
+
+class NewtonWrenchTest(RosTestCase):
+    """[ros] wrench_units = "newton": a Wrench in newtons through the vehicle's description (its
+    thrusters' positions and directions, the BTD150 force curve) to motor values; the simulator
+    moves by the same description's mass, so 10 N forward is 10 / mass m/s^2, along REP 103's +x."""
+    COMMANDS = True
+    SIM_TOML = "[vehicle]\nmass_kg = %s\n" % NEWTON_MASS_KG
+    ROS_CONFIG = 'wrench_units = "newton"\nvehicle_config = "{rig_dir}/sim.toml"\n'
+
+    def setUp(self):
+        self.rig.rearm()
+
+    def velocity_forward(self, heading):
+        """The simulator's velocity (its world: x port and y forward at yaw 0) along the body's
+        forward and port axes at `heading`, and the time it was read."""
+        vx, vy, _ = (float(v) for v in self.rig.sim_teensy("Velocity"))
+        t = time.monotonic()
+        c, s = math.cos(heading), math.sin(heading)
+        return -vx * s + vy * c, vx * c + vy * s, t
+
+    def test_ten_newtons_forward_accelerate_by_the_mass(self):
+        rig = self.rig
+        self.assertIn("cmd_wrench in newtons", rig.log("caracara-ros"))
+        settle(rig)
+        place(rig)
+        start = pose(rig)
+        wrench = json.loads(json.dumps(ZERO_WRENCH))
+        wrench["force"]["x"] = 10.0
+        with self.steering("rt/caracara/cmd_wrench", "geometry_msgs/Wrench", wrench) as send:
+            # The four horizontal thrusters, forward, and the thrust ramp done: from here on the
+            # thrust is steady and the body's acceleration is F / m less the drag.
+            def steady():
+                ordered = [int(v) for v in rig.sim_thrusters("OrderedSpeed")]
+                actual = [int(v) for v in rig.sim_thrusters("ActualSpeed")]
+                horizontal = (0, 2, 4, 6)
+                return all(ordered[i] > ZERO and actual[i] == ordered[i] for i in horizontal) and ordered
+            ordered = poll(steady, 20, message="the 10 N Wrench never reached the thrusters")
+            f1, p1, t1 = self.velocity_forward(START_HEADING_RAD)
+            time.sleep(ROS_NEWTON_ACCEL_WINDOW_S)
+            f2, p2, t2 = self.velocity_forward(START_HEADING_RAD)
+            send(ZERO_WRENCH)
+            poll(lambda: rig.motor_values() == [0] * MOTORS, 10, message="a zero Wrench left the thrust on")
+        end = pose(rig)
+        dt = t2 - t1
+        forward = (f2 - f1) / dt + SIM_DRAG_PER_S * (f1 + f2) / 2
+        port = (p2 - p1) / dt + SIM_DRAG_PER_S * (p1 + p2) / 2
+        want = 10.0 / NEWTON_MASS_KG
+        print("10 N forward: %.4f m/s^2 (10 / %.1f kg = %.4f), sideways %.4f; speeds %s" %
+              (forward, NEWTON_MASS_KG, want, port, ordered), file=sys.stderr)
+        self.assertLessEqual(abs(forward - want), ROS_NEWTON_ACCEL_ERROR_FRACTION_MAX * want)
+        self.assertLessEqual(abs(port), ROS_NEWTON_ACCEL_ERROR_FRACTION_MAX * want)
+        # REP 103's +x is forward: the vehicle went forward in its own frame, not to a side.
+        moved = body_motion(start, end)["translation"]
+        self.assertGreater(moved[1], 0, moved)
+        self.assertLess(abs(moved[0]), 0.1 * moved[1], moved)
+        # The vertical thrusters stay still: 10 N forward needs none of them.
+        self.assertEqual([ordered[i] for i in (1, 3, 5, 7)], [ZERO] * 4)
 
 
 if __name__ == "__main__":

@@ -16,3 +16,5 @@ caracara_unit_test(test_bus_scan_report SOURCES unit/test_bus_scan_report.cpp LI
 caracara_unit_test(test_enum_names SOURCES unit/test_enum_names.cpp LIBS caracara_daemon caracara_simcore)
 # It reads the sources for every EnumNames table, so that none is left out of its list.
 target_compile_definitions(test_enum_names PRIVATE CARACARA_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
+# core/vehicle_geometry: a Wrench in newtons through thruster positions, directions and force curve.
+caracara_unit_test(test_vehicle_geometry SOURCES unit/test_vehicle_geometry.cpp LIBS caracara_core)

@@ -127,6 +127,7 @@ const std::vector<Table> kTables{
     CARACARA_TABLE(bridge::SeatChange),
     CARACARA_TABLE(ros::CommandRefusal),
     CARACARA_TABLE(ros::RangeLayout),
+    CARACARA_TABLE(ros::WrenchUnits),
 };
 #undef CARACARA_TABLE
 

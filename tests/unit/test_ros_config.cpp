@@ -79,3 +79,31 @@ TEST_CASE("values beyond their types: names ROS takes, distances a Range carries
         CHECK(e.find(": ") != std::string::npos);
     }
 }
+
+TEST_CASE("wrench_units: fractions by default, newtons through the vehicle's description, anything else named") {
+    RosConfig c;
+    CHECK(load("[ros]\n", c).empty());
+    CHECK(c.wrench_units == caracara::ros::WrenchUnits::Fraction);
+    // The description is the daemon's file: [vehicle] and the [[thruster]] tables.
+    char vehicle[] = "/tmp/caracara-vehicle-XXXXXX";
+    const int fd = ::mkstemp(vehicle);
+    REQUIRE(fd >= 0);
+    const std::string text = "[vehicle]\nmass_kg = 11.5\nthrust_reverse_n = [0, 12]\n";
+    REQUIRE(::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()));
+    ::close(fd);
+    RosConfig n;
+    CHECK(load("[ros]\nwrench_units = \"newton\"\nvehicle_config = \"" + std::string(vehicle) + "\"\n", n).empty());
+    CHECK(n.wrench_units == caracara::ros::WrenchUnits::Newton);
+    CHECK(*n.vehicle.mass_kg == 11.5);
+    CHECK(n.vehicle.curve().full_n(true) == 12.0);
+    ::unlink(vehicle);
+    RosConfig bad;
+    CHECK(load("[ros]\nwrench_units = \"newtons\"\n", bad).find("ros.wrench_units must be \"fraction\" or \"newton\" (\"newtons\")") != std::string::npos);
+    CHECK(bad.wrench_units == caracara::ros::WrenchUnits::Fraction);
+    CHECK(load("[ros]\nvehicle_config = \"caracarad.toml\"\n", bad).find("ros.vehicle_config must be the absolute path") !=
+          std::string::npos);
+    // Newtons with no description to read: named, with the file.
+    const std::string e = load("[ros]\nwrench_units = \"newton\"\nvehicle_config = \"/nonexistent/caracarad.toml\"\n", bad);
+    CHECK(e.find("ros.wrench_units = \"newton\" needs the vehicle's description: /nonexistent/caracarad.toml: cannot be "
+                 "read") != std::string::npos);
+}

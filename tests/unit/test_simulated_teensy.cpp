@@ -11,6 +11,10 @@
 #include <vector>
 
 using namespace caracara::sim;
+using caracara::kMotorMax;
+using caracara::VehicleGeometry;
+using caracara::WrenchMotors;
+namespace frames = caracara::frames;
 using Bytes = std::vector<uint8_t>;
 
 namespace {
@@ -403,6 +407,40 @@ TEST_CASE("VehicleBody: translation follows the axis table and the heading") {
     thrust = {5.0, 0, std::nan(""), 0, 0, 0, 0, 0}; // out-of-range input is clamped / ignored
     auto f = body.generalised_force();
     CHECK(f[3] == Approx(0.25));
+}
+
+TEST_CASE("with the vehicle's mass, thrust in newtons accelerates the body by F = m a") {
+    // The description caracara-ros maps a Wrench through: 10 N forward on an 11.5 kg vehicle is
+    // 10 / 11.5 m/s^2 forward at the start (drag, k_drag * v, still nothing), at an odd heading.
+    VehicleBodyConfig cfg;
+    cfg.vehicle = VehicleGeometry();
+    cfg.vehicle->mass_kg = 11.5;
+    cfg.vehicle->inertia_kg_m2 = frames::Vec3{0.2, 0.3, 0.4};
+    const WrenchMotors m = cfg.vehicle->motors_for({{10, 0, 0}, {}});
+    std::array<double, 8> thrust{};
+    for (std::size_t i = 0; i < 8; ++i)
+        thrust[i] = m.motors[i] / double(kMotorMax);
+    VehicleBody body([&] { return thrust; }, cfg);
+    body.set_attitude({0.6, 0, 0});
+    const auto a = body.thrust_acceleration();
+    CHECK(a[static_cast<std::size_t>(BodyAxis::Y)] == Approx(10 / 11.5).epsilon(0.002)); // forward
+    for (BodyAxis other : {BodyAxis::X, BodyAxis::Z, BodyAxis::Yaw, BodyAxis::Pitch, BodyAxis::Roll})
+        CHECK(a[static_cast<std::size_t>(other)] == Approx(0).margin(1e-3));
+    body.step(0.01, 0);
+    // The world's forward at yaw 0.6 (clockwise from above) is (-sin, cos).
+    const double v = 0.01 * 10 / 11.5;
+    CHECK(body.velocity().x == Approx(-std::sin(0.6) * v).epsilon(0.01));
+    CHECK(body.velocity().y == Approx(std::cos(0.6) * v).epsilon(0.01));
+    // 1 N m about up (REP 103: counter-clockwise from above) on 0.4 kg m^2: yaw (clockwise) -2.5 rad/s^2.
+    const WrenchMotors t = cfg.vehicle->motors_for({{}, {0, 0, 1}});
+    for (std::size_t i = 0; i < 8; ++i)
+        thrust[i] = t.motors[i] / double(kMotorMax);
+    CHECK(body.thrust_acceleration()[static_cast<std::size_t>(BodyAxis::Yaw)] == Approx(-2.5).epsilon(0.01));
+    // Without a mass, the normalised model as before: k_force and k_torque times the generalised force.
+    VehicleBody plain([&] { return thrust; });
+    const auto f = plain.generalised_force();
+    for (std::size_t j = 0; j < 6; ++j)
+        CHECK(plain.thrust_acceleration()[j] == Approx((j < 3 ? 1.0 : 2.0) * f[j]));
 }
 
 TEST_CASE("the Teensy reports the body's yaw as thrusters turn it") {

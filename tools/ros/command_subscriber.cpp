@@ -192,11 +192,27 @@ Pilot* CommandSubscriber::pilot(dds_instance_handle_t writer) {
 void CommandSubscriber::take_wrenches() {
     take_each<geometry_msgs_msg_dds__Wrench_>(wrench_reader_, [&](const auto& w, dds_instance_handle_t writer) {
         // REP 103: the Wrench is in the body's FLU frame (force along, torque about x forward,
-        // y left, z up), each -1..1 of the axis's full demand; core/frames turns it into the
-        // seed's axes SetMotion takes. Range and NaN are the daemon's to refuse, by name.
+        // y left, z up). As fractions, each -1..1 of the axis's full demand: core/frames turns it
+        // into the seed's axes SetMotion takes; range and NaN are the daemon's to refuse, by name.
         const frames::BodyMotion flu{{w.force.x, w.force.y, w.force.z}, {w.torque.x, w.torque.y, w.torque.z}};
-        if (Pilot* p = commanding(wrench_reader_, writer, "cmd_wrench"))
+        Pilot* p = commanding(wrench_reader_, writer, "cmd_wrench");
+        if (!p)
+            return;
+        if (config_.wrench_units == WrenchUnits::Fraction) {
             p->set_motion(frames::from_flu(flu));
+            return;
+        }
+        // Newtons: through the vehicle's geometry and force curve to the eight motor values
+        // (SetThrust), where the daemon's budget holds them as it holds any.
+        const WrenchMotors m = config_.vehicle.motors_for(flu);
+        if (!m.ok()) {
+            const std::string& name = gid(wrench_reader_, writer);
+            const std::string why = "org.caracara.Vehicle1.Error.InvalidValue: " + m.error;
+            std::fprintf(stderr, "caracara-ros: cmd_wrench from writer %s refused: %s\n", name.c_str(), why.c_str());
+            record_.refused(name, CommandRefusal::BadValue, why, monotonic_ns());
+            return;
+        }
+        p->set_thrust(std::vector<int32_t>(m.motors.begin(), m.motors.end()));
     });
 }
 

@@ -142,4 +142,25 @@ unsigned DistroDetector::peers(RangeLayout distro) const {
     return n;
 }
 
+bool DistroDetector::choose(SpokenDistro& distro) const {
+    const unsigned humble = peers(RangeLayout::Humble), jazzy = peers(RangeLayout::Jazzy);
+    if (!humble && !jazzy)
+        return false;
+    const auto count = [](unsigned n) { return std::to_string(n) + (n == 1 ? " participant" : " participants"); };
+    if (!humble || !jazzy) {
+        distro.layout = humble ? RangeLayout::Humble : RangeLayout::Jazzy;
+        distro.why = "the peers' ros_discovery_info: " + count(humble + jazzy) + ", all " +
+                     std::string(name_of(distro.layout));
+    } else {
+        // Both: the distro of more peers (on a tie, the one spoken already: no flapping). The
+        // others cannot read Range nor list this node: a setting to make (range_layout).
+        if (humble != jazzy)
+            distro.layout = humble > jazzy ? RangeLayout::Humble : RangeLayout::Jazzy;
+        distro.why = "peers of both distros (humble " + count(humble) + ", jazzy " + count(jazzy) + "): " +
+                     std::string(name_of(distro.layout)) + (humble != jazzy ? ", the more" : ", spoken already") +
+                     "; the others cannot read Range or list this node (set range_layout to choose)";
+    }
+    return true;
+}
+
 } // namespace caracara::ros

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "tools/ros/ros_config.hpp"
+#include "tools/ros/spoken_distro.hpp"
 
 #include <array>
 #include <cstdint>
@@ -31,6 +32,10 @@ public:
     // Takes what came; true when the count of peers of either distro changed.
     bool update();
     unsigned peers(RangeLayout distro) const;
+    // The distro to speak from the peers' counts, and why, into `distro`: the peers' one, or where
+    // both are about the more numerous (on a tie, the one spoken already: no flapping). False,
+    // `distro` unchanged, when no peer is left.
+    bool choose(SpokenDistro& distro) const;
 
     // The distro a ParticipantEntitiesInfo's CDR (encapsulation header included) is laid out in,
     // none when it parses in neither or both.

@@ -100,6 +100,9 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "caracara-ros: domain %u, namespace %s, commands %s, DDS Security %s%s\n", config.domain_id,
                      config.ros_namespace.empty() ? "/" : config.ros_namespace.c_str(), config.commands ? "on" : "off",
                      config.security.empty() ? "off" : "on, enclave ", config.security.c_str());
+        if (config.commands && config.wrench_units == caracara::ros::WrenchUnits::Newton)
+            std::fprintf(stderr, "caracara-ros: cmd_wrench in newtons and newton-metres, through the vehicle %s "
+                                 "describes\n", config.vehicle_config.c_str());
         if (config.commands && config.security.empty() && !caracara::ros::is_loopback(config.interface))
             std::fprintf(stderr, "caracara-ros: warning: commands from anyone who reaches interface %s: no DDS Security "
                                  "(ros.insecure_commands = true)\n", config.interface.empty() ? "(any)" : config.interface.c_str());

@@ -1,6 +1,7 @@
 #include "tools/ros/ros_config.hpp"
 
 #include "core/toml_text.hpp"
+#include "core/vehicle_config.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -76,22 +77,6 @@ std::string check_values(const std::string& path, const RosConfig& c) {
 constexpr double kMaxMountOffsetM = 10.0;
 constexpr double kMaxMountAngleRad = 2 * std::numbers::pi;
 
-// Three finite numbers, each within `limit`, into `out`; false otherwise.
-bool read_triple(const toml::node* n, double limit, frames::Vec3& out) {
-    const toml::array* a = n ? n->as_array() : nullptr;
-    if (!a || a->size() != 3)
-        return false;
-    double v[3];
-    for (std::size_t i = 0; i < 3; ++i) {
-        const auto d = (*a)[i].value<double>();
-        if (!d || !std::isfinite(*d) || std::fabs(*d) > limit)
-            return false;
-        v[i] = *d;
-    }
-    out = {v[0], v[1], v[2]};
-    return true;
-}
-
 // One [ros.imu] or [[ros.range]] table (`name` as the errors call it) into `m`.
 std::string read_mount(const std::string& path, const std::string& name, const toml::node& node, SensorMount& m) {
     const toml::table* t = node.as_table();
@@ -151,7 +136,7 @@ std::string load_config(const std::string& path, RosConfig& c) {
         static const char* const known[] = {"namespace", "domain_id", "range_layout", "commands", "world_frame",
                                             "base_frame", "frame_convention", "publish_odom_tf", "range_min_m",
                                             "range_max_m", "range_fov_rad", "security", "security_plugins", "insecure_commands",
-                                            "sensor_rate_hz", "imu", "range"};
+                                            "sensor_rate_hz", "imu", "range", "wrench_units", "vehicle_config"};
         bool ok = false;
         for (const char* k : known)
             ok = ok || key.str() == k;
@@ -247,6 +232,23 @@ std::string load_config(const std::string& path, RosConfig& c) {
     }
     if (auto v = t["network"]["interface"].value<std::string>())
         c.interface = *v;
+    if (const toml::node* n = ros["wrench_units"].node()) {
+        const auto v = n->value_exact<std::string>();
+        const auto u = v ? parse_name<WrenchUnits>(*v) : std::nullopt;
+        if (!u)
+            return path + ": ros.wrench_units must be \"fraction\" or \"newton\"" + (v ? " (\"" + *v + "\")" : "");
+        c.wrench_units = *u;
+    }
+    if (const toml::node* n = ros["vehicle_config"].node()) {
+        const auto v = n->value_exact<std::string>();
+        if (!v || v->empty() || (*v)[0] != '/')
+            return path + ": ros.vehicle_config must be the absolute path of the caracarad.toml that describes the "
+                          "vehicle" + (v ? " (\"" + *v + "\")" : "");
+        c.vehicle_config = *v;
+    }
+    if (c.wrench_units == WrenchUnits::Newton)
+        if (std::string e = load_vehicle(c.vehicle_config, c.vehicle); !e.empty())
+            return path + ": ros.wrench_units = \"newton\" needs the vehicle's description: " + e;
     return check_values(path, c);
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "core/frames.hpp"
+#include "core/vehicle_geometry.hpp"
 #include "drivers/sdbus/sdbus.hpp"
 #include "tools/ros/ros_conventions.hpp"
 
@@ -24,6 +25,8 @@ struct SensorMount {
 
 // Where caracara-ros and caracaractl export read the settings unless told (a missing one: the defaults).
 inline constexpr const char* kDefaultConfigPath = "/etc/caracara/ros.toml";
+// Where the vehicle's description is (wrench_units = "newton"): the daemon's own file.
+inline constexpr const char* kDefaultVehicleConfigPath = "/etc/caracara/caracarad.toml";
 
 struct RosConfig {
     std::string ros_namespace = "/caracara";
@@ -31,6 +34,11 @@ struct RosConfig {
     RangeLayout range_layout = RangeLayout::Humble; // also ros_discovery_info's Gid: 24 bytes, Jazzy's 16
     bool range_layout_given = false; // else the peers' distro (DistroDetector) and the Range subscribers' (RangeSubscribers)
     bool commands = false;            // Wrench and per-thruster commands; kill is always taken
+    WrenchUnits wrench_units = WrenchUnits::Fraction;
+    // Newton: the description read from this caracarad.toml ([vehicle], [[thruster]] position and
+    // direction), the one caracara-sim reads too.
+    std::string vehicle_config = kDefaultVehicleConfigPath;
+    VehicleGeometry vehicle;
     // An SROS2 enclave directory (keystore/enclaves/<path>): DDS Security on, "" = off.
     std::string security;
     // Where libdds_security_{auth,ac,crypto}.so are: Debian's libddsc0debian directory, found at build time.

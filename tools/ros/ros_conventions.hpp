@@ -19,6 +19,10 @@ inline constexpr unsigned kThrusterJoints = 8;
 // variance) and rmw_dds_common's Gid (24 bytes in Humble, 16 since Iron).
 enum class RangeLayout { Humble, Jazzy };
 
+// What cmd_wrench's numbers are: each -1..1 of the axis's full demand (SetMotion's), or newtons
+// and newton-metres through the vehicle's description (core/vehicle_geometry.hpp) to motor values.
+enum class WrenchUnits { Fraction, Newton };
+
 // caracarad announces its telemetry (the Teensy's attitude, the thrusters' readings) at 5 Hz
 // (daemon/control/control_loop.cpp, kTelemetryPeriodNs): the sensor topics' default rate.
 inline constexpr double kDaemonTelemetryRateHz = 5.0;
@@ -57,6 +61,13 @@ inline bool state_is_killed(const std::string& state) { return state == "killed"
 
 namespace caracara {
 
+template <>
+struct EnumNames<ros::WrenchUnits> {
+    static constexpr std::array<EnumName<ros::WrenchUnits>, 2> table{{
+        {ros::WrenchUnits::Fraction, "fraction"},
+        {ros::WrenchUnits::Newton, "newton"},
+    }};
+};
 template <>
 struct EnumNames<ros::RangeLayout> {
     static constexpr std::array<EnumName<ros::RangeLayout>, 2> table{{

@@ -1,7 +1,7 @@
 // The ROS 2 distro caracara-ros speaks (ros_discovery_info's Gid size, and sensor_msgs/Range's
 // layout where no Range subscriber asks for one: RangeSubscribers): the config's range_layout when
-// it names one, else what the peers' ros_discovery_info says (DistroDetector), chosen by the
-// TelemetryPublisher; read where a Gid is written or printed.
+// it names one, else what the peers' ros_discovery_info says (DistroDetector::choose, on the
+// TelemetryPublisher's loop); read where a Gid is written or printed.
 #pragma once
 
 #include "tools/ros/ros_config.hpp"

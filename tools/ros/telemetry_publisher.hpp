@@ -15,6 +15,8 @@
 #include "tools/ros/distro_detector.hpp"
 #include "tools/ros/range_subscribers.hpp"
 #include "tools/ros/spoken_distro.hpp"
+#include "tools/ros/static_frames.hpp"
+#include "tools/ros/vehicle_diagnostics.hpp"
 
 #include <array>
 #include <memory>
@@ -57,11 +59,8 @@ private:
     void write_imu_and_tf();
     void write_joints();
     void write_ranges();
-    void write_static_frames();
     void write_state();
-    void write_diagnostics();
     void choose_distro();
-    std::vector<uint8_t> levels() const;
 
     sd_event* event_;
     DdsParticipant& dds_;
@@ -84,14 +83,14 @@ private:
     // says the value held was read again unchanged. Zero: nothing read yet.
     timespec orientation_read_at_{}, teensy_read_at_{}, thrusters_read_at_{};
     client::ObjectMirror mirror_;
+    VehicleDiagnostics diagnostics_;
+    StaticFrames static_frames_;
     unsigned dirty_ = 0;
     uint64_t diagnostics_last_us_ = 0;
-    std::vector<uint8_t> last_levels_;
     std::string last_state_, last_source_;
     bool state_written_ = false;
-    bool sent_static_frames_ = false;
 
-    dds_entity_t imu_, tf_ = 0, tf_static_, joints_, ordered_, diagnostics_, killed_, state_, kill_source_;
+    dds_entity_t imu_, tf_ = 0, joints_, ordered_, killed_, state_, kill_source_;
     std::vector<dds_entity_t> ranges_;
     RangeLayout ranges_layout_{}; // the layout of ranges_' writers
     dds_topic_descriptor_t jazzy_range_;
