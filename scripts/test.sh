@@ -31,8 +31,8 @@ which=${1:-all}
 jobs=$(nproc)
 # Tests at twice the cores: the end-to-end tests wait on the vehicle's clock, not the CPU (43 of
 # them, 643 s of test time, took 30 s user and 26 s system CPU at -j4 on 2 cores, 2026-12-05);
-# the tests that keep a core busy say so with PROCESSORS (tests/CMakeLists.txt). The cross and
-# Debian 13 suites read it too.
+# the Debian 13 suite, which compiles, takes two slots (tests/system/system.cmake) and runs its
+# own ctest at the cores. scripts/cross_test.sh reads it too.
 export CARACARA_TEST_JOBS=${CARACARA_TEST_JOBS:-$((2 * jobs))}
 
 # What the table reads: each step's selection, exit status and time, and each ctest run's
