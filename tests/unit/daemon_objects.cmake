@@ -10,3 +10,10 @@ caracara_unit_test(test_preflight SOURCES unit/test_preflight.cpp LIBS daemon_fa
 caracara_unit_test(test_failsafe_table SOURCES unit/test_failsafe_table.cpp LIBS daemon_fakes)
 # CommandAcceptance: every command in every state, accepted or its named error, in order.
 caracara_unit_test(test_command_acceptance SOURCES unit/test_command_acceptance.cpp LIBS daemon_fakes)
+# The D-Bus objects (dbus/) on a private dbus-daemon, serving the daemon's objects on the fakes.
+add_library(service_rig STATIC unit/fakes/service_rig.cpp)
+target_link_libraries(service_rig PUBLIC daemon_fakes caracara_vehicle_dbus sim_fixture)
+caracara_unit_test(test_vehicle_object SOURCES unit/test_vehicle_object.cpp LIBS service_rig)
+caracara_unit_test(test_thruster_object SOURCES unit/test_thruster_object.cpp LIBS service_rig)
+caracara_unit_test(test_i2c_bus_object SOURCES unit/test_i2c_bus_object.cpp LIBS service_rig)
+caracara_unit_test(test_teensy_object SOURCES unit/test_teensy_object.cpp LIBS service_rig)
