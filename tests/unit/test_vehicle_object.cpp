@@ -26,22 +26,12 @@ const std::vector<int32_t> kZeros(kMotorCount, 0);
 // The contract's name (the XML), written out: not the map under test.
 std::string error(Status s) { return "org.caracara.Vehicle1.Error." + std::string(status_name(s)); }
 
-BusReply set_thrust(ServiceRig& s, const std::vector<int32_t>& values) {
-    return s.call_with(kRootPath, kVehicleIface, "SetThrust", [&](sd_bus_message* m) {
-        return sd_bus_message_append_array(m, 'i', values.data(), values.size() * sizeof(int32_t));
-    });
-}
+BusReply set_thrust(ServiceRig& s, const std::vector<int32_t>& values) { return s.set_thrust(values); }
 
 std::string text(ServiceRig& s, const char* property) { return s.text(kRootPath, kVehicleIface, property); }
 std::vector<int32_t> motor_values(ServiceRig& s) { return s.ints(kRootPath, kVehicleIface, "MotorValues"); }
 
-bool each_ordered(ServiceRig& s, const std::vector<int32_t>& values, long from = 0) {
-    const auto ev = s.rig().wire().events();
-    for (std::size_t i = 0; i < values.size(); ++i)
-        if (find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(values[i])); }, from) < 0)
-            return false;
-    return true;
-}
+bool each_ordered(ServiceRig& s, const std::vector<int32_t>& values) { return s.each_ordered(values); }
 
 // Any order on the wire that is neither `a`'s nor `b`'s value for its thruster.
 bool other_order(ServiceRig& s, const std::vector<int32_t>& a, const std::vector<int32_t>& b) {
@@ -305,29 +295,4 @@ TEST_CASE("VehicleObject: a command's change is announced in PropertiesChanged")
     dbus::SlotPtr held(slot);
     REQUIRE(set_thrust(s, kThrust).ok());
     CHECK(s.rig().run_until([&] { return announced == kThrust; }));
-}
-
-TEST_CASE("ClientTracker: the controlling client leaving the bus stops its command; another leaving does not") {
-    ServiceRig s;
-    s.rig().run_until_ready();
-    dbus::BusPtr bystander = s.connect("bystander");
-    REQUIRE(set_thrust(s, kThrust).ok());
-    REQUIRE(s.rig().run_until([&] { return each_ordered(s, kThrust); }));
-    bystander.reset(); // a client that never commanded
-    s.rig().run_for(100);
-    CHECK(text(s, "Controller") == s.client_name());
-    CHECK(motor_values(s) == kThrust);
-
-    dbus::BusPtr pilot = s.connect("pilot");
-    std::vector<int32_t> other = kThrust;
-    other[0] = 2500;
-    REQUIRE(s.call_with(kRootPath, kVehicleIface, "SetThrust", [&](sd_bus_message* m) {
-        return sd_bus_message_append_array(m, 'i', other.data(), other.size() * sizeof(int32_t));
-    }, pilot.get()).ok());
-    CHECK(text(s, "Controller") != s.client_name());
-    s.rig().wire().clear();
-    pilot.reset();
-    CHECK(s.rig().run_until([&] { return each_ordered(s, kZeros); }));
-    CHECK(text(s, "Controller").empty());
-    CHECK(motor_values(s) == kZeros);
 }

@@ -122,4 +122,18 @@ std::vector<int32_t> ServiceRig::ints(const char* path, const char* iface, const
     return {v, v + n / sizeof(int32_t)};
 }
 
+BusReply ServiceRig::set_thrust(const std::vector<int32_t>& values, sd_bus* bus) {
+    return call_with(dbus::kRootPath, dbus::kVehicleIface, "SetThrust", [&](sd_bus_message* m) {
+        return sd_bus_message_append_array(m, 'i', values.data(), values.size() * sizeof(int32_t));
+    }, bus);
+}
+
+bool ServiceRig::each_ordered(const std::vector<int32_t>& values, long from) {
+    const auto ev = rig_.wire().events();
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(values[i])); }, from) < 0)
+            return false;
+    return true;
+}
+
 } // namespace caracara::test

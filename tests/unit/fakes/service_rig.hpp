@@ -64,6 +64,11 @@ public:
     }
     std::vector<int32_t> ints(const char* path, const char* iface, const char* property);
 
+    // SetThrust(values) on the vehicle through `bus` (the client when null).
+    BusReply set_thrust(const std::vector<int32_t>& values, sd_bus* bus = nullptr);
+    // Each thruster was ordered its value of `values` on the fake wire (from event `from` on).
+    bool each_ordered(const std::vector<int32_t>& values, long from = 0);
+
 private:
     DaemonRig rig_;
     std::string dir_;
