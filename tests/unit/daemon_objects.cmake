@@ -19,3 +19,4 @@ caracara_unit_test(test_i2c_bus_object SOURCES unit/test_i2c_bus_object.cpp LIBS
 caracara_unit_test(test_teensy_object SOURCES unit/test_teensy_object.cpp LIBS service_rig)
 caracara_unit_test(test_client_tracker SOURCES unit/test_client_tracker.cpp LIBS service_rig)
 caracara_unit_test(test_announcer SOURCES unit/test_announcer.cpp LIBS caracara_vehicle_dbus)
+caracara_unit_test(test_vehicle_service SOURCES unit/test_vehicle_service.cpp LIBS service_rig)

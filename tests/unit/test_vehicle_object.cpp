@@ -296,3 +296,52 @@ TEST_CASE("VehicleObject: a command's change is announced in PropertiesChanged")
     REQUIRE(set_thrust(s, kThrust).ok());
     CHECK(s.rig().run_until([&] { return announced == kThrust; }));
 }
+
+TEST_CASE("VehicleObject: a failsafe that kills: the Failsafe signal, Failsafes, ClearKill refused by its name until it clears") {
+    ServiceRig s;
+    drive(s);
+    struct Seen {
+        std::string condition, action;
+        int32_t thruster = 0;
+    } seen;
+    auto on_failsafe = [](sd_bus_message* m, void* userdata, sd_bus_error*) {
+        auto* out = static_cast<Seen*>(userdata);
+        const char *condition = nullptr, *action = nullptr;
+        if (sd_bus_message_read(m, "ssi", &condition, &action, &out->thruster) >= 0) {
+            out->condition = condition;
+            out->action = action;
+        }
+        return 0;
+    };
+    sd_bus_slot* slot = nullptr;
+    REQUIRE(sd_bus_match_signal(s.client(), &slot, dbus::kBusName, kRootPath, kVehicleIface, "Failsafe", on_failsafe,
+                                &seen) >= 0);
+    dbus::SlotPtr held(slot);
+    s.rig().daemon().failsafes().push(FailsafeCondition::TeensyLinkLost, true, "test: the Teensy stopped answering");
+    REQUIRE(s.rig().run_until([&] { return !seen.condition.empty(); }));
+    CHECK(seen.condition == "teensy-link-lost");
+    CHECK(seen.action == std::string(action_name(FailsafeAction::Kill)));
+    CHECK(seen.thruster == -1);
+    CHECK(text(s, "State") == "killed");
+    CHECK(motor_values(s) == kZeros);
+    BusReply fs = s.get(kRootPath, kVehicleIface, "Failsafes", "a(ssi)");
+    REQUIRE(sd_bus_message_enter_container(fs.reply.get(), 'a', "(ssi)") >= 0);
+    const char *condition = nullptr, *action = nullptr;
+    int32_t thruster = 0;
+    REQUIRE(sd_bus_message_read(fs.reply.get(), "(ssi)", &condition, &action, &thruster) > 0);
+    CHECK(std::string(condition) == "teensy-link-lost");
+    CHECK(sd_bus_message_at_end(fs.reply.get(), 0) > 0);
+
+    BusReply r = s.call(kRootPath, kVehicleIface, "ClearKill", "");
+    CHECK(r.error == error(Status::FailsafeActive));
+    CHECK(r.message.find("teensy-link-lost") != std::string::npos);
+    // Fixed at kill: no override.
+    CHECK(s.call(kRootPath, kVehicleIface, "ClearKillOverride", "s", "teensy-link-lost").error ==
+          error(Status::FailsafeActive));
+    CHECK(text(s, "State") == "killed");
+
+    s.rig().daemon().failsafes().push(FailsafeCondition::TeensyLinkLost, false, "test: the Teensy answers again");
+    s.rig().run_for(50);
+    REQUIRE(s.call(kRootPath, kVehicleIface, "ClearKill", "").ok());
+    CHECK(text(s, "State") == "ready");
+}
