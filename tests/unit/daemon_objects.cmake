@@ -20,3 +20,4 @@ caracara_unit_test(test_teensy_object SOURCES unit/test_teensy_object.cpp LIBS s
 caracara_unit_test(test_client_tracker SOURCES unit/test_client_tracker.cpp LIBS service_rig)
 caracara_unit_test(test_announcer SOURCES unit/test_announcer.cpp LIBS caracara_vehicle_dbus)
 caracara_unit_test(test_vehicle_service SOURCES unit/test_vehicle_service.cpp LIBS service_rig)
+caracara_unit_test(test_error_reply SOURCES unit/test_error_reply.cpp LIBS service_rig)

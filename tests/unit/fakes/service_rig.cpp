@@ -74,10 +74,11 @@ int on_reply(sd_bus_message* m, void* userdata, sd_bus_error*) {
 } // namespace
 
 BusReply ServiceRig::call_with(const char* path, const char* iface, const char* method,
-                               const std::function<int(sd_bus_message*)>& append, sd_bus* bus) {
+                               const std::function<int(sd_bus_message*)>& append, sd_bus* bus,
+                               const char* destination) {
     sd_bus* b = bus ? bus : client_.get();
     sd_bus_message* m = nullptr;
-    if (sd_bus_message_new_method_call(b, &m, dbus::kBusName, path, iface, method) < 0)
+    if (sd_bus_message_new_method_call(b, &m, destination, path, iface, method) < 0)
         throw std::runtime_error(std::string("cannot build ") + method);
     dbus::MessagePtr call(m);
     if (append && append(m) < 0)

@@ -41,10 +41,11 @@ public:
     // Another client on the same bus and loop (e.g. one that leaves).
     dbus::BusPtr connect(const char* description);
 
-    // Calls `method` through `bus` (the client when null), the arguments appended by `append`,
-    // and runs the loop until the reply.
+    // Calls `method` of `destination` through `bus` (the client when null), the arguments
+    // appended by `append`, and runs the loop until the reply.
     BusReply call_with(const char* path, const char* iface, const char* method,
-                       const std::function<int(sd_bus_message*)>& append, sd_bus* bus = nullptr);
+                       const std::function<int(sd_bus_message*)>& append, sd_bus* bus = nullptr,
+                       const char* destination = dbus::kBusName);
     template <typename... A>
     BusReply call(const char* path, const char* iface, const char* method, const char* signature, A... args) {
         return call_with(path, iface, method,
