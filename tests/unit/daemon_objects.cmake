@@ -21,3 +21,6 @@ caracara_unit_test(test_client_tracker SOURCES unit/test_client_tracker.cpp LIBS
 caracara_unit_test(test_announcer SOURCES unit/test_announcer.cpp LIBS caracara_vehicle_dbus)
 caracara_unit_test(test_vehicle_service SOURCES unit/test_vehicle_service.cpp LIBS service_rig)
 caracara_unit_test(test_error_reply SOURCES unit/test_error_reply.cpp LIBS service_rig)
+# The event loop's own pieces (daemon/loop/), each on an sd-event loop of its own.
+caracara_unit_test(test_deadline_timer SOURCES unit/test_deadline_timer.cpp LIBS caracara_daemon)
+caracara_unit_test(test_loop_waker SOURCES unit/test_loop_waker.cpp LIBS caracara_daemon)
