@@ -24,3 +24,4 @@ caracara_unit_test(test_error_reply SOURCES unit/test_error_reply.cpp LIBS servi
 # The event loop's own pieces (daemon/loop/), each on an sd-event loop of its own.
 caracara_unit_test(test_deadline_timer SOURCES unit/test_deadline_timer.cpp LIBS caracara_daemon)
 caracara_unit_test(test_loop_waker SOURCES unit/test_loop_waker.cpp LIBS caracara_daemon)
+caracara_unit_test(test_service_status SOURCES unit/test_service_status.cpp LIBS daemon_fakes)
