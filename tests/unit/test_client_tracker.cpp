@@ -14,9 +14,6 @@ using dbus::kVehicleIface;
 
 namespace {
 
-const std::vector<int32_t> kThrust{1000, -2000, 3000, -4000, 500, -500, 1500, -1500};
-const std::vector<int32_t> kZeros(kMotorCount, 0);
-
 std::string controller(ServiceRig& s) { return s.text(kRootPath, kVehicleIface, "Controller"); }
 
 } // namespace

@@ -50,10 +50,8 @@ TEST_CASE("ThrusterObject: one object per configured thruster, its settings as c
 TEST_CASE("ThrusterObject: OrderedValue is each thruster's own order") {
     ServiceRig s;
     s.rig().run_until_ready();
-    const std::vector<int32_t> values{1000, -2000, 3000, -4000, 500, -500, 1500, -1500};
-    REQUIRE(s.call_with(dbus::kRootPath, dbus::kVehicleIface, "SetThrust", [&](sd_bus_message* m) {
-        return sd_bus_message_append_array(m, 'i', values.data(), values.size() * sizeof(int32_t));
-    }).ok());
+    const std::vector<int32_t>& values = kThrust;
+    REQUIRE(s.set_thrust(values).ok());
     // What the bus ordered, once the loop handed it over.
     const ThrusterBus& bus = s.rig().daemon().bus();
     REQUIRE(s.rig().run_until([&] {

@@ -20,9 +20,6 @@ using dbus::kVehicleIface;
 
 namespace {
 
-const std::vector<int32_t> kThrust{1000, -2000, 3000, -4000, 500, -500, 1500, -1500};
-const std::vector<int32_t> kZeros(kMotorCount, 0);
-
 // The contract's name (the XML), written out: not the map under test.
 std::string error(Status s) { return "org.caracara.Vehicle1.Error." + std::string(status_name(s)); }
 

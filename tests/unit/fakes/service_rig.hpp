@@ -16,6 +16,10 @@
 
 namespace caracara::test {
 
+// Eight motor values, each thruster's its own (a mixed-up thruster shows), and eight zeros.
+inline const std::vector<int32_t> kThrust{1000, -2000, 3000, -4000, 500, -500, 1500, -1500};
+inline const std::vector<int32_t> kZeros(kMotorCount, 0);
+
 // A method's reply as the client got it: the error's name and text, or the return message.
 struct BusReply {
     std::string error; // "" on success
