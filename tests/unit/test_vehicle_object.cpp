@@ -3,10 +3,12 @@
 // reply and its named error (org.caracara.Vehicle1.Error.<Status>, the one error map of
 // dbus/error_reply), and that a refused call changes nothing, on the bus and on the fake wire.
 #include "core/budget.hpp"
+#include "core/packet.hpp"
 #include "core/status.hpp"
 #include "tests/catch.hpp"
 #include "tests/unit/fakes/service_rig.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -341,4 +343,47 @@ TEST_CASE("VehicleObject: a failsafe that kills: the Failsafe signal, Failsafes,
     s.rig().run_for(50);
     REQUIRE(s.call(kRootPath, kVehicleIface, "ClearKill", "").ok());
     CHECK(text(s, "State") == "ready");
+}
+
+TEST_CASE("VehicleObject: ApplyPacket drives, kills, and refuses a malformed packet without moving anything") {
+    ServiceRig s;
+    s.rig().run_until_ready();
+    const auto apply = [&](const std::vector<int32_t>& words) {
+        return s.call_with(kRootPath, kVehicleIface, "ApplyPacket", [&](sd_bus_message* m) {
+            return sd_bus_message_append_array(m, 'i', words.data(), words.size() * sizeof(int32_t));
+        });
+    };
+    std::vector<int32_t> packet(kPacketWords, 0);
+    std::copy(kThrust.begin(), kThrust.end(), packet.begin());
+    REQUIRE(apply(packet).ok());
+    CHECK(motor_values(s) == kThrust);
+    CHECK(text(s, "Controller") == s.client_name());
+    REQUIRE(s.rig().run_until([&] { return each_ordered(s, kThrust); }));
+
+    s.rig().wire().clear();
+    std::vector<int32_t> other = packet;
+    other[0] = 2500;
+    std::vector<int32_t> short_packet(other.begin(), other.end() - 1);
+    BusReply r = apply(short_packet);
+    CHECK(r.error == error(Status::InvalidLength));
+    std::vector<int32_t> bad_power = other;
+    bad_power[kPacketPowerOff] = 7;
+    r = apply(bad_power);
+    INFO(r.error << ": " << r.message);
+    CHECK(r.error == error(Status::InvalidValue));
+    std::vector<int32_t> far = other;
+    far[1] = kMotorMax + 1;
+    CHECK(apply(far).error == error(Status::OutOfRange));
+    CHECK(motor_values(s) == kThrust);
+    s.rig().run_for(50);
+    CHECK_FALSE(other_order(s, kThrust, kThrust));
+    CHECK(text(s, "State") == "ready");
+
+    // A packet that kills: replied to after the zeros, killed by the packet.
+    std::vector<int32_t> kill = packet;
+    kill[kPacketKill] = 1;
+    REQUIRE(apply(kill).ok());
+    CHECK(each_ordered(s, kZeros));
+    CHECK(text(s, "State") == "killed");
+    CHECK(text(s, "KillSource") == "packet");
 }
