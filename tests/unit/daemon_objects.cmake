@@ -27,3 +27,4 @@ caracara_unit_test(test_loop_waker SOURCES unit/test_loop_waker.cpp LIBS caracar
 caracara_unit_test(test_service_status SOURCES unit/test_service_status.cpp LIBS daemon_fakes)
 caracara_unit_test(test_motor_test SOURCES unit/test_motor_test.cpp LIBS daemon_fakes)
 caracara_unit_test(test_bus_scan SOURCES unit/test_bus_scan.cpp LIBS daemon_fakes)
+caracara_unit_test(test_teensy_port SOURCES unit/test_teensy_port.cpp LIBS daemon_fakes)

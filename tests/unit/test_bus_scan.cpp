@@ -26,7 +26,7 @@ Result scan(DaemonRig& rig) {
 
 } // namespace
 
-TEST_CASE("BusScan: refused unless the vehicle is killed, with nothing probed") {
+TEST_CASE("BusScan: refused unless the vehicle is killed, its report left empty") {
     DaemonRig rig;
     rig.run_until_ready();
     rig.wire().clear();
