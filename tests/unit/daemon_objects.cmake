@@ -29,3 +29,4 @@ caracara_unit_test(test_motor_test SOURCES unit/test_motor_test.cpp LIBS daemon_
 caracara_unit_test(test_bus_scan SOURCES unit/test_bus_scan.cpp LIBS daemon_fakes)
 caracara_unit_test(test_teensy_port SOURCES unit/test_teensy_port.cpp LIBS daemon_fakes)
 caracara_unit_test(test_announced_object SOURCES unit/test_announced_object.cpp LIBS service_rig)
+caracara_unit_test(test_bus_input_probe SOURCES unit/test_bus_input_probe.cpp LIBS service_rig)
