@@ -78,10 +78,12 @@ TEST_CASE("AnnouncedObject (Changed): a thruster's member goes out when its valu
     const std::string path = std::string(dbus::kRootPath) + "/thruster/0";
     Announced a;
     dbus::SlotPtr held = watch(s, path, a);
-    s.rig().run_for(600); // three telemetry ticks: the thruster's values have settled
+    // Settled: online, and its first order's value on the wire (a slow build takes longer).
+    const ThrusterBus& bus = s.rig().daemon().bus();
+    REQUIRE(s.rig().run_until([&] { return bus.thruster(0).online() && bus.ordered_value(0) == 0; }));
     REQUIRE(s.set_thrust(kThrust).ok());
-    REQUIRE(s.rig().run_until([&] { return !a.values.empty(); }));
-    CHECK(a.values.back() == kThrust[0]);
+    // The tick after the order carries it (and whatever else moved since the last one).
+    CHECK(s.rig().run_until([&] { return !a.values.empty() && a.values.back() == kThrust[0]; }));
     // Unchanged since, over three more telemetry ticks: no OrderedValue again.
     a = {};
     s.rig().run_for(600);
