@@ -10,3 +10,23 @@ caracara_unit_test(test_preflight SOURCES unit/test_preflight.cpp LIBS daemon_fa
 caracara_unit_test(test_failsafe_table SOURCES unit/test_failsafe_table.cpp LIBS daemon_fakes)
 # CommandAcceptance: every command in every state, accepted or its named error, in order.
 caracara_unit_test(test_command_acceptance SOURCES unit/test_command_acceptance.cpp LIBS daemon_fakes)
+# The D-Bus objects (dbus/) on a private dbus-daemon, serving the daemon's objects on the fakes.
+add_library(service_rig STATIC unit/fakes/service_rig.cpp)
+target_link_libraries(service_rig PUBLIC daemon_fakes caracara_vehicle_dbus sim_fixture)
+caracara_unit_test(test_vehicle_object SOURCES unit/test_vehicle_object.cpp LIBS service_rig)
+caracara_unit_test(test_thruster_object SOURCES unit/test_thruster_object.cpp LIBS service_rig)
+caracara_unit_test(test_i2c_bus_object SOURCES unit/test_i2c_bus_object.cpp LIBS service_rig)
+caracara_unit_test(test_teensy_object SOURCES unit/test_teensy_object.cpp LIBS service_rig)
+caracara_unit_test(test_client_tracker SOURCES unit/test_client_tracker.cpp LIBS service_rig)
+caracara_unit_test(test_announcer SOURCES unit/test_announcer.cpp LIBS caracara_vehicle_dbus)
+caracara_unit_test(test_vehicle_service SOURCES unit/test_vehicle_service.cpp LIBS service_rig)
+caracara_unit_test(test_error_reply SOURCES unit/test_error_reply.cpp LIBS service_rig)
+# The event loop's own pieces (daemon/loop/), each on an sd-event loop of its own.
+caracara_unit_test(test_deadline_timer SOURCES unit/test_deadline_timer.cpp LIBS caracara_daemon)
+caracara_unit_test(test_loop_waker SOURCES unit/test_loop_waker.cpp LIBS caracara_daemon)
+caracara_unit_test(test_service_status SOURCES unit/test_service_status.cpp LIBS daemon_fakes)
+caracara_unit_test(test_motor_test SOURCES unit/test_motor_test.cpp LIBS daemon_fakes)
+caracara_unit_test(test_bus_scan SOURCES unit/test_bus_scan.cpp LIBS daemon_fakes)
+caracara_unit_test(test_teensy_port SOURCES unit/test_teensy_port.cpp LIBS daemon_fakes)
+caracara_unit_test(test_announced_object SOURCES unit/test_announced_object.cpp LIBS service_rig)
+caracara_unit_test(test_bus_input_probe SOURCES unit/test_bus_input_probe.cpp LIBS service_rig)
