@@ -44,6 +44,11 @@ public:
     std::string start(int64_t priority); // the worker and the silence timer
     void close(); // after the worker's job on the wire (what was queued still runs)
     bool is_open() const { return open_; }
+    // A command's own verdict before it takes the vehicle: its arguments' (`args`), then the
+    // link's, so that a command the Teensy cannot carry makes no one the commanding client.
+    Result carries(const Result& args) const {
+        return !args.ok() || open_ ? args : Result{Status::LinkError, "the Teensy is not connected"};
+    }
     // The link is lost (gone, absent though fitted, or silent) and no valid frame came since. A
     // Teensy not fitted that never answered is not lost.
     bool link_lost() const { return watch_.loss() != TeensyLoss::None; }

@@ -42,8 +42,8 @@ Result TeensyPort::set_leds(int red, int green, int blue, Completion done) {
     for (int v : {red, green, blue})
         if (v < 0 || v > 255)
             return {Status::OutOfRange, "LED values are 0..255"};
-    if (!connection_.is_open())
-        return {Status::LinkError, "the Teensy is not connected"};
+    if (Result r = connection_.carries({}); !r.ok())
+        return r;
     const std::array<uint8_t, 3> want{static_cast<uint8_t>(red), static_cast<uint8_t>(green), static_cast<uint8_t>(blue)};
     // A packet stream repeats its LEDs at every packet: while the same values are on their way
     // (a slow Teensy), they are not queued again.
@@ -71,7 +71,7 @@ Result TeensyPort::set_speed(int left, int right, std::string_view client, Compl
     const bool moving = left != 0 || right != 0;
     if (moving) {
         const Result range = teensy::result_of(teensy::encode_set_speed(left, right).error, "Set Speed");
-        if (Result r = gate_.accept_command(client, range); !r.ok())
+        if (Result r = gate_.accept_command(client, connection_.carries(range)); !r.ok())
             return r;
     }
     TeensyLink& link = connection_.link();

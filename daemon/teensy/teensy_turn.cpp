@@ -13,7 +13,7 @@ Result TeensyTurn::start(double radians, bool absolute, std::string_view client,
         return {Status::Busy, "a turn is already running"};
     const Result range = std::isfinite(radians) ? Result{}
                                                 : Result{Status::InvalidValue, "the angle must be a finite number of radians"};
-    if (Result r = gate_.accept_command(client, range); !r.ok())
+    if (Result r = gate_.accept_command(client, connection_.carries(range)); !r.ok())
         return r;
     done_ = std::move(done);
     connection_.telemetry().turning = true;

@@ -36,4 +36,7 @@ TEST_CASE("TeensyObject: each command refused with LinkError when the Teensy is 
     CHECK(s.call(kTeensyPath, kTeensyIface, "SetSpeed", "s", "fast").error == "org.freedesktop.DBus.Error.InvalidArgs");
     CHECK(s.text(kTeensyPath, kTeensyIface, "Task") == "idle");
     CHECK(s.text(dbus::kRootPath, dbus::kVehicleIface, "State") == "ready");
+    // A command the Teensy cannot carry takes nothing: its caller did not become the commanding
+    // client (whose leaving would zero another pilot's thrusters).
+    CHECK(s.text(dbus::kRootPath, dbus::kVehicleIface, "Controller").empty());
 }
