@@ -32,7 +32,8 @@ jobs=$(nproc)
 # Tests at twice the cores: the end-to-end tests wait on the vehicle's clock, not the CPU (43 of
 # them, 643 s of test time, took 30 s user and 26 s system CPU at -j4 on 2 cores, 2026-12-05);
 # the Debian 13 suite, which compiles, takes two slots (tests/system/system.cmake) and runs its
-# own ctest at the cores. scripts/cross_test.sh reads it too.
+# own ctest at the cores. scripts/cross_test.sh reads it too; the sanitized build's tests run at
+# the cores (sanitize_suite).
 export CARACARA_TEST_JOBS=${CARACARA_TEST_JOBS:-$((2 * jobs))}
 
 # What the table reads: each step's selection, exit status and time, and each ctest run's
@@ -48,12 +49,13 @@ ctest_run() {
   ctest --test-dir "$dir" --output-on-failure --output-junit "$results/$step.xml" \
     --test-output-size-passed 1048576 --test-output-size-failed 1048576 "$@"
 }
+# run_suite STEP DIR CTEST_JOBS [cmake options...]
 run_suite() {
-  local step=$1 dir=$2; shift 2
+  local step=$1 dir=$2 test_jobs=$3; shift 3
   echo "== build $dir ($*)"
   "$top/scripts/build.sh" "$dir" -DCARACARA_WERROR=ON "$@" || return
-  echo "== test $dir"
-  ctest_run "$step" "$dir" -j"$CARACARA_TEST_JOBS" --timeout 900
+  echo "== test $dir (ctest -j$test_jobs)"
+  ctest_run "$step" "$dir" -j"$test_jobs" --timeout 900
 }
 # Each step's wall time, so that the 30-minute budget of CI can be read from its log.
 stamp() { echo "== $1 done at $((SECONDS / 60)) min $((SECONDS % 60)) s"; }
@@ -86,10 +88,13 @@ arm64_packages() {
 sanitize_suite() {
   export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1}
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-  run_suite sanitize "$top/build-asan" -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
+  # At the cores, not twice: under ASan the bridge's and the cockpit's tests keep a core busy,
+  # and beside three others they missed their waits (the 256 MB listing's first page, the
+  # failsafe banner while surfacing; 2026-12-05).
+  run_suite sanitize "$top/build-asan" "$jobs" -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 }
 
-step normal run_suite normal "$top/build"
+step normal run_suite normal "$top/build" "$CARACARA_TEST_JOBS"
 step cross cross_suite
 step arm64-packages arm64_packages
 step sanitize sanitize_suite
