@@ -27,6 +27,6 @@ endif()
 # cross build.
 if(NOT CARACARA_SANITIZE AND NOT CMAKE_CROSSCOMPILING)
   add_test(NAME system_debian13 COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/system/debian13.sh ${CMAKE_SOURCE_DIR})
-  set_tests_properties(system_debian13 PROPERTIES TIMEOUT 2400 LABELS "system;debian13"
+  set_tests_properties(system_debian13 PROPERTIES TIMEOUT 3300 LABELS "system;debian13"
                        SKIP_RETURN_CODE 77 PROCESSORS 2)
 endif()
