@@ -1,6 +1,7 @@
 // What reached the "wire" of the in-process fakes of the device seam (FakeDeviceIo, FakeGpio),
 // in the order it got there: every thruster order with its motor value, every status read, and
-// every write of the kill and power-off outputs. Tests judge the daemon's objects from it, as
+// every write of the kill and power-off outputs, every SCL pulse and STOP of a bus clear. Tests
+// judge the daemon's objects from it, as
 // the e2e tests judge the whole daemon from the simulator's wire log. Thread-safe: the bus
 // worker writes from its own thread.
 #pragma once
@@ -14,7 +15,7 @@
 namespace caracara::test {
 
 struct WireEvent {
-    enum class Kind { Order, StatusRead, KillOutput, PowerOff };
+    enum class Kind { Order, StatusRead, KillOutput, PowerOff, SclPulse, Stop };
     Kind kind = Kind::Order;
     std::size_t thruster = 0; // Order, StatusRead
     int32_t value = 0;        // Order: the motor value the speed byte means; outputs: 0/1
@@ -48,6 +49,47 @@ public:
         std::lock_guard lk(mu_);
         return i < failing_.size() ? failing_[i] : 0;
     }
+    // Thruster i's status replies carry these FAULT bits (SeaBotix IDS 8.4.2 word 2; 0: none).
+    void set_faults(std::size_t i, uint8_t bits) {
+        std::lock_guard lk(mu_);
+        if (faults_.size() <= i)
+            faults_.resize(i + 1, 0);
+        faults_[i] = bits;
+    }
+    uint8_t faults(std::size_t i) const {
+        std::lock_guard lk(mu_);
+        return i < faults_.size() ? faults_[i] : 0;
+    }
+    // A slave holds SDA low until it has seen `pulses` SCL clock pulses (a bus clear's), or SCL
+    // low for good: meanwhile every transfer times out (ETIMEDOUT), as on a locked bus.
+    void hold_sda(unsigned pulses) {
+        std::lock_guard lk(mu_);
+        sda_pulses_ = pulses;
+    }
+    void hold_scl(bool held) {
+        std::lock_guard lk(mu_);
+        scl_held_ = held;
+    }
+    bool locked() const {
+        std::lock_guard lk(mu_);
+        return sda_pulses_ > 0 || scl_held_;
+    }
+    bool scl_low() const {
+        std::lock_guard lk(mu_);
+        return scl_held_;
+    }
+    bool sda_low() const {
+        std::lock_guard lk(mu_);
+        return sda_pulses_ > 0;
+    }
+    // A clock pulse on SCL (the GPIO line let go after being driven low): recorded, and one
+    // pulse fewer for the slave that holds SDA.
+    void scl_pulse() {
+        std::lock_guard lk(mu_);
+        events_.push_back({WireEvent::Kind::SclPulse, 0, 0, 0});
+        if (sda_pulses_ > 0 && !scl_held_)
+            --sda_pulses_;
+    }
     // While held, a transfer that reaches the wire waits there (a thruster holding the bus):
     // what the daemon hands over meanwhile queues behind it.
     void hold() {
@@ -80,6 +122,9 @@ private:
     mutable std::mutex mu_;
     std::vector<WireEvent> events_;
     std::vector<int> failing_;
+    std::vector<uint8_t> faults_;
+    unsigned sda_pulses_ = 0;
+    bool scl_held_ = false;
     std::condition_variable released_;
     bool held_ = false;
     int waiting_ = 0;
