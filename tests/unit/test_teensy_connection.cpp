@@ -43,6 +43,11 @@ struct TeensyRig {
         io.model([&](sim::TeensyModel& m) { n = m.frames().commands_executed(command); });
         return n;
     }
+    uint64_t received(uint8_t command) {
+        uint64_t n = 0;
+        io.model([&](sim::TeensyModel& m) { n = m.frames().commands_received(command); });
+        return n;
+    }
     uint64_t frames() {
         uint64_t n = 0;
         io.model([&](sim::TeensyModel& m) { n = m.frames().total(); });
@@ -140,8 +145,13 @@ TEST_CASE("TeensyLinkWatch: a Teensy that falls silent kills by teensy-link-lost
         INFO(name);
         TeensyRig t;
         t.drive();
+        const uint64_t asked = t.received(fw::kStop);
         t.io.model([&](sim::TeensyModel& m) { fault(m.faults()); });
         t.check_killed(TeensyLoss::Silent);
+        // The kill's own Stop reached the silent Teensy and is over (its resends too) before it
+        // answers again: a Stop after this is the one of its coming back.
+        REQUIRE(t.rig->run_until([&] { return t.received(fw::kStop) > asked; }));
+        t.rig->run_for(100);
         const uint64_t stops = t.executed(fw::kStop);
         t.io.model([](sim::TeensyModel& m) { m.faults().clear(); });
         t.check_back(stops);
@@ -154,9 +164,10 @@ TEST_CASE("TeensyConnection: the node gone kills at once; TeensyReopen asks agai
     t.io.set_gone(true);
     t.check_killed(TeensyLoss::Gone);
     CHECK_FALSE(t.port().is_open());
-    // Nothing reaches a node that is not there, and nothing is lost twice.
+    // Nothing reaches a node that is not there, and nothing is lost twice: past the first ask
+    // again (a second after the loss), still gone, so it is asked for once more.
     const uint64_t frames = t.frames();
-    t.rig->run_for(100);
+    t.rig->run_for(1200);
     CHECK(t.frames() == frames);
     CHECK(t.port().loss() == TeensyLoss::Gone);
     const uint64_t stops = t.executed(fw::kStop);
