@@ -38,21 +38,9 @@ struct TeensyRig {
     ~TeensyRig() { rig.reset(); } // the daemon before the node it talks to
 
     TeensyPort& port() { return rig->daemon().teensy(); }
-    uint64_t executed(uint8_t command) {
-        uint64_t n = 0;
-        io.model([&](sim::TeensyModel& m) { n = m.frames().commands_executed(command); });
-        return n;
-    }
-    uint64_t received(uint8_t command) {
-        uint64_t n = 0;
-        io.model([&](sim::TeensyModel& m) { n = m.frames().commands_received(command); });
-        return n;
-    }
-    uint64_t frames() {
-        uint64_t n = 0;
-        io.model([&](sim::TeensyModel& m) { n = m.frames().total(); });
-        return n;
-    }
+    uint64_t executed(uint8_t command) { return io.executed(command); }
+    uint64_t received(uint8_t command) { return io.received(command); }
+    uint64_t frames() { return io.frames(); }
     SafetyState state() { return rig->vehicle().readings().safety().state(); }
     bool link_lost_holds() {
         const auto& a = rig->daemon().failsafes().active();

@@ -34,11 +34,7 @@ struct TurnRig {
     ~TurnRig() { rig.reset(); } // the daemon before the node it talks to
 
     TeensyPort& port() { return rig->daemon().teensy(); }
-    uint64_t executed(uint8_t command) {
-        uint64_t n = 0;
-        io.model([&](sim::TeensyModel& m) { n = m.frames().commands_executed(command); });
-        return n;
-    }
+    uint64_t executed(uint8_t command) { return io.executed(command); }
     sim::TeensyTaskState task() {
         sim::TeensyTaskState s{};
         io.model([&](sim::TeensyModel& m) { s = m.task_state(); });

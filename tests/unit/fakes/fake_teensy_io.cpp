@@ -78,4 +78,19 @@ void FakeTeensyIo::model(const std::function<void(sim::TeensyModel&)>& f) {
     f(model_);
 }
 
+uint64_t FakeTeensyIo::received(uint8_t command) {
+    std::lock_guard lk(mu_);
+    return model_.frames().commands_received(command);
+}
+
+uint64_t FakeTeensyIo::executed(uint8_t command) {
+    std::lock_guard lk(mu_);
+    return model_.frames().commands_executed(command);
+}
+
+uint64_t FakeTeensyIo::frames() {
+    std::lock_guard lk(mu_);
+    return model_.frames().total();
+}
+
 } // namespace caracara::test

@@ -35,6 +35,10 @@ public:
     void set_attitude(const sim::BodyAttitude& a);
     // `f` with the model, under the lock the worker's frames take.
     void model(const std::function<void(sim::TeensyModel&)>& f);
+    // The model's frame log: frames of `command` received and executed, and all frames so far.
+    uint64_t received(uint8_t command);
+    uint64_t executed(uint8_t command);
+    uint64_t frames();
 
 private:
     std::mutex mu_;

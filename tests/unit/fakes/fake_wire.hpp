@@ -41,24 +41,20 @@ public:
     // Thruster i answers every transfer with -err from now on (0: answers again).
     void fail(std::size_t i, int err) {
         std::lock_guard lk(mu_);
-        if (failing_.size() <= i)
-            failing_.resize(i + 1, 0);
-        failing_[i] = err;
+        at(i).failing = err;
     }
     int failure(std::size_t i) const {
         std::lock_guard lk(mu_);
-        return i < failing_.size() ? failing_[i] : 0;
+        return of(i).failing;
     }
     // Thruster i's status replies carry these FAULT bits (SeaBotix IDS 8.4.2 word 2; 0: none).
     void set_faults(std::size_t i, uint8_t bits) {
         std::lock_guard lk(mu_);
-        if (faults_.size() <= i)
-            faults_.resize(i + 1, 0);
-        faults_[i] = bits;
+        at(i).faults = bits;
     }
     uint8_t faults(std::size_t i) const {
         std::lock_guard lk(mu_);
-        return i < faults_.size() ? faults_[i] : 0;
+        return of(i).faults;
     }
     // A slave holds SDA low until it has seen `pulses` SCL clock pulses (a bus clear's), or SCL
     // low for good: meanwhile every transfer times out (ETIMEDOUT), as on a locked bus.
@@ -119,10 +115,21 @@ public:
     }
 
 private:
+    // What a test made of one thruster (under mu_).
+    struct Thruster {
+        int failing = 0;
+        uint8_t faults = 0;
+    };
+    Thruster& at(std::size_t i) {
+        if (thrusters_.size() <= i)
+            thrusters_.resize(i + 1);
+        return thrusters_[i];
+    }
+    Thruster of(std::size_t i) const { return i < thrusters_.size() ? thrusters_[i] : Thruster{}; }
+
     mutable std::mutex mu_;
     std::vector<WireEvent> events_;
-    std::vector<int> failing_;
-    std::vector<uint8_t> faults_;
+    std::vector<Thruster> thrusters_;
     unsigned sda_pulses_ = 0;
     bool scl_held_ = false;
     std::condition_variable released_;
