@@ -3,10 +3,10 @@
 // (FakeTeensyIo): judged by what the Teensy got (its frame log, its wheels and LEDs), what the
 // daemon read from it (the telemetry), the failsafes and the fake I2C wire (the kill output, the
 // thrusters' zeros). The poll reads the three axes and the distance sensors in turn; a Teensy
-// that falls silent (no answer, a garbage ack, busy for ever) or whose node goes away kills by
-// teensy-link-lost, and is back (the wheels stopped, the failsafe cleared, the kill kept) at its
-// next valid frame; a node that went, or a fitted Teensy absent at start, is asked for again
-// until it opens; a Teensy not fitted is relied on once it has answered.
+// that falls silent (no answer, a garbage ack, busy for ever, a frame held) or whose node goes
+// away kills by teensy-link-lost, and is back (the wheels stopped, the failsafe cleared, the kill
+// kept) at its next valid frame; a node that went, or a fitted Teensy absent at start, is asked
+// for again until it opens; a Teensy not fitted is relied on once it has answered.
 #include "daemon/teensy/teensy_port.hpp"
 
 #include "core/safety.hpp"
@@ -144,6 +144,17 @@ TEST_CASE("TeensyLinkWatch: a Teensy that falls silent kills by teensy-link-lost
         t.io.model([](sim::TeensyModel& m) { m.faults().clear(); });
         t.check_back(stops);
     }
+}
+
+TEST_CASE("TeensyLinkWatch: a frame held on the wire (a hung Teensy) is silence: the kill goes out meanwhile, not behind it") {
+    TeensyRig t;
+    t.drive();
+    t.io.hold(true);
+    // The kill output and the zeros reach the I2C wire while the Teensy's frame is still held.
+    t.check_killed(TeensyLoss::Silent);
+    const uint64_t stops = t.executed(fw::kStop);
+    t.io.hold(false);
+    t.check_back(stops);
 }
 
 TEST_CASE("TeensyConnection: the node gone kills at once; TeensyReopen asks again until it is back, the wheels stopped") {

@@ -99,6 +99,10 @@ TEST_CASE("Turn: a second turn while one runs is Busy, a non-finite angle Invali
     CHECK_FALSE(nan_done);
     CHECK_FALSE(second_done);
     CHECK_FALSE(first.has_value());
+    // The first one is still running: it ends with the kill, before `first` goes out of scope.
+    REQUIRE(t.rig->vehicle().kill(KillSource::DBus, "test").ok());
+    REQUIRE(t.rig->run_until([&] { return first.has_value(); }));
+    CHECK_FALSE(second_done);
 }
 
 TEST_CASE("Turn: a kill ends a running turn with its error, and the Teensy is told Stop") {
