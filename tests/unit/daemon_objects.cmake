@@ -8,7 +8,6 @@ caracara_unit_test(test_thruster_bus SOURCES unit/test_thruster_bus.cpp LIBS dae
 caracara_unit_test(test_teensy_worker SOURCES unit/test_teensy_worker.cpp LIBS daemon_fakes)
 caracara_unit_test(test_preflight SOURCES unit/test_preflight.cpp LIBS daemon_fakes)
 caracara_unit_test(test_failsafe_table SOURCES unit/test_failsafe_table.cpp LIBS daemon_fakes)
-caracara_unit_test(test_failsafe_clearance SOURCES unit/test_failsafe_clearance.cpp LIBS daemon_fakes)
 # The bus recovery and a lost bus, judged by the fake wire's bus clear and orders.
 caracara_unit_test(test_bus_recovery_steps SOURCES unit/test_bus_recovery_steps.cpp LIBS daemon_fakes)
 caracara_unit_test(test_bus_loss SOURCES unit/test_bus_loss.cpp LIBS daemon_fakes)
@@ -18,6 +17,7 @@ caracara_unit_test(test_command_acceptance SOURCES unit/test_command_acceptance.
 add_library(service_rig STATIC unit/fakes/service_rig.cpp)
 target_link_libraries(service_rig PUBLIC daemon_fakes caracara_vehicle_dbus sim_fixture)
 caracara_unit_test(test_vehicle_object SOURCES unit/test_vehicle_object.cpp LIBS service_rig)
+caracara_unit_test(test_failsafe_clearance SOURCES unit/test_failsafe_clearance.cpp LIBS service_rig)
 caracara_unit_test(test_thruster_object SOURCES unit/test_thruster_object.cpp LIBS service_rig)
 caracara_unit_test(test_i2c_bus_object SOURCES unit/test_i2c_bus_object.cpp LIBS service_rig)
 caracara_unit_test(test_teensy_object SOURCES unit/test_teensy_object.cpp LIBS service_rig)
