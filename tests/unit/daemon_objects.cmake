@@ -8,12 +8,16 @@ caracara_unit_test(test_thruster_bus SOURCES unit/test_thruster_bus.cpp LIBS dae
 caracara_unit_test(test_teensy_worker SOURCES unit/test_teensy_worker.cpp LIBS daemon_fakes)
 caracara_unit_test(test_preflight SOURCES unit/test_preflight.cpp LIBS daemon_fakes)
 caracara_unit_test(test_failsafe_table SOURCES unit/test_failsafe_table.cpp LIBS daemon_fakes)
+# The bus recovery and a lost bus, judged by the fake wire's bus clear and orders.
+caracara_unit_test(test_bus_recovery_steps SOURCES unit/test_bus_recovery_steps.cpp LIBS daemon_fakes)
+caracara_unit_test(test_bus_loss SOURCES unit/test_bus_loss.cpp LIBS daemon_fakes)
 # CommandAcceptance: every command in every state, accepted or its named error, in order.
 caracara_unit_test(test_command_acceptance SOURCES unit/test_command_acceptance.cpp LIBS daemon_fakes)
 # The D-Bus objects (dbus/) on a private dbus-daemon, serving the daemon's objects on the fakes.
 add_library(service_rig STATIC unit/fakes/service_rig.cpp)
 target_link_libraries(service_rig PUBLIC daemon_fakes caracara_vehicle_dbus sim_fixture)
 caracara_unit_test(test_vehicle_object SOURCES unit/test_vehicle_object.cpp LIBS service_rig)
+caracara_unit_test(test_failsafe_clearance SOURCES unit/test_failsafe_clearance.cpp LIBS service_rig)
 caracara_unit_test(test_thruster_object SOURCES unit/test_thruster_object.cpp LIBS service_rig)
 caracara_unit_test(test_i2c_bus_object SOURCES unit/test_i2c_bus_object.cpp LIBS service_rig)
 caracara_unit_test(test_teensy_object SOURCES unit/test_teensy_object.cpp LIBS service_rig)
@@ -28,5 +32,10 @@ caracara_unit_test(test_service_status SOURCES unit/test_service_status.cpp LIBS
 caracara_unit_test(test_motor_test SOURCES unit/test_motor_test.cpp LIBS daemon_fakes)
 caracara_unit_test(test_bus_scan SOURCES unit/test_bus_scan.cpp LIBS daemon_fakes)
 caracara_unit_test(test_teensy_port SOURCES unit/test_teensy_port.cpp LIBS daemon_fakes)
+# The Teensy's link on the simulator's own Teensy model behind the SPI side of the seam.
+add_library(teensy_fakes STATIC unit/fakes/fake_teensy_io.cpp)
+target_link_libraries(teensy_fakes PUBLIC daemon_fakes caracara_simcore)
+caracara_unit_test(test_teensy_connection SOURCES unit/test_teensy_connection.cpp LIBS teensy_fakes)
+caracara_unit_test(test_teensy_turn SOURCES unit/test_teensy_turn.cpp LIBS teensy_fakes)
 caracara_unit_test(test_announced_object SOURCES unit/test_announced_object.cpp LIBS service_rig)
 caracara_unit_test(test_bus_input_probe SOURCES unit/test_bus_input_probe.cpp LIBS service_rig)

@@ -18,21 +18,8 @@ namespace {
 
 const std::vector<int32_t> kThrust{1000, -2000, 3000, -4000, 500, -500, 1500, -1500};
 
-bool each_ordered(const std::vector<WireEvent>& ev, const std::vector<int32_t>& values, long from = 0) {
-    for (std::size_t i = 0; i < values.size(); ++i)
-        if (find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(values[i])); }, from) < 0)
-            return false;
-    return true;
-}
-
-bool all_zeroed(const std::vector<WireEvent>& ev, long from = 0) { return each_ordered(ev, std::vector<int32_t>(8, 0), from); }
-
 long first_nonzero_order(const std::vector<WireEvent>& ev, long from = 0) {
     return find(ev, [](const WireEvent& e) { return e.kind == Kind::Order && e.value != 0; }, from);
-}
-
-long kill_output(const std::vector<WireEvent>& ev, int value, long from = 0) {
-    return find(ev, [&](const WireEvent& e) { return e.kind == Kind::KillOutput && e.value == value; }, from);
 }
 
 // The kill output was asserted, then every thruster got its zero; after the kill output at most

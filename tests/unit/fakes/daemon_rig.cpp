@@ -24,12 +24,12 @@ DaemonConfig parse(const std::string& control, const std::string& sections) {
 }
 } // namespace
 
-DaemonRig::DaemonRig(const std::string& control, const std::string& sections, bool kill_switch_set)
+DaemonRig::DaemonRig(const std::string& control, const std::string& sections, bool kill_switch_set, DeviceIo* spi_io)
     : config_(parse(control, sections)), io_(wire_, config_), gpio_(wire_) {
     gpio_.set_kill_switch(kill_switch_set); // before the daemon reads it
     if (sd_event_new(&event_) < 0)
         throw std::runtime_error("sd_event_new");
-    daemon_ = std::make_unique<VehicleDaemon>(event_, io_, io_, io_, gpio_, config_);
+    daemon_ = std::make_unique<VehicleDaemon>(event_, io_, io_, spi_io ? *spi_io : io_, gpio_, config_);
     if (std::string e = daemon_->start(); !e.empty())
         throw std::runtime_error(e);
 }
@@ -73,6 +73,22 @@ long find(const std::vector<WireEvent>& events, const std::function<bool(const W
         if (match(events[static_cast<std::size_t>(i)]))
             return i;
     return -1;
+}
+
+bool each_ordered(const std::vector<WireEvent>& events, const std::vector<int32_t>& values, long from) {
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (find(events, [&](const WireEvent& e) { return e.is_order(i, on_wire(values[i])); }, from) < 0)
+            return false;
+    return true;
+}
+
+bool all_zeroed(const std::vector<WireEvent>& events, long from) {
+    return each_ordered(events, std::vector<int32_t>(kMotorCount, 0), from);
+}
+
+long kill_output(const std::vector<WireEvent>& events, int value, long from) {
+    return find(events, [&](const WireEvent& e) { return e.kind == WireEvent::Kind::KillOutput && e.value == value; },
+                from);
 }
 
 } // namespace caracara::test

@@ -19,9 +19,10 @@ public:
     // `control`: the [control] section's lines (armed at start unless they say arm_at_start, no
     // arming delay by default); `sections`: more tables, whole (e.g. "[failsafe.pilot-lost]\n
     // persistence_ms = 300\n"; the Teensy is not fitted unless they have an [spi]);
-    // `kill_switch_set`: the switch as the daemon finds it at start.
+    // `kill_switch_set`: the switch as the daemon finds it at start; `spi_io`: the Teensy's side
+    // of the seam (FakeTeensyIo, outliving the rig; null: no Teensy's node).
     explicit DaemonRig(const std::string& control = "loop_rate_hz = 50\n", const std::string& sections = "",
-                       bool kill_switch_set = false);
+                       bool kill_switch_set = false, DeviceIo* spi_io = nullptr);
     ~DaemonRig();
 
     VehicleDaemon& daemon() { return *daemon_; }
@@ -52,5 +53,11 @@ private:
 int32_t on_wire(int32_t v);
 // The index of the first event at or after `from` that `match` accepts, or -1.
 long find(const std::vector<WireEvent>& events, const std::function<bool(const WireEvent&)>& match, long from = 0);
+// Each thruster i was ordered values[i] at or after event `from`.
+bool each_ordered(const std::vector<WireEvent>& events, const std::vector<int32_t>& values, long from = 0);
+// Every thruster was ordered zero at or after event `from`.
+bool all_zeroed(const std::vector<WireEvent>& events, long from = 0);
+// The first write of `value` to the kill output at or after `from`, or -1.
+long kill_output(const std::vector<WireEvent>& events, int value, long from = 0);
 
 } // namespace caracara::test

@@ -38,10 +38,12 @@ int FakeDeviceIo::transfer(void* arg) {
         }
         const std::size_t i = static_cast<std::size_t>(it - ts.begin());
         wire_.wait_released();
+        if (wire_.locked())
+            return -ETIMEDOUT;
         if (int err = wire_.failure(i))
             return -err;
         if (m.flags & I2C_M_RD) {
-            const auto reply = encode_seabotix_status(it->mt, 0, 0, 0, kSpeedStop, 20);
+            const auto reply = encode_seabotix_status(it->mt, 0, wire_.faults(i), 0, kSpeedStop, 20);
             std::copy_n(reply.begin(), std::min<std::size_t>(m.len, reply.size()), m.buf);
             wire_.add({WireEvent::Kind::StatusRead, i, 0, 0});
             continue;

@@ -1,7 +1,8 @@
 // The device seam's I2C side in process: a DeviceIo whose adapter is eight SeaBotix thrusters
 // at the configured addresses (on the trunk; a mux select is taken and ignored). Orders and
-// status reads land on a FakeWire; a status read gets a clean reply. Other devices (the
-// Teensy's SPI, sysfs) are absent. Thread-safe, like the kernel.
+// status reads land on a FakeWire; a status read gets a reply with the FAULT bits the wire
+// holds for it (none unless a test sets them); on a locked wire every transfer times out. Other
+// devices (the Teensy's SPI, sysfs) are absent. Thread-safe, like the kernel.
 #pragma once
 
 #include "core/config.hpp"
