@@ -29,9 +29,11 @@ namespace {
 const std::vector<int32_t> kDrive{1000, -2000, 3000, -4000, 500, -500, 1500, -1500};
 const char* const kDevice = "/dev/spidev0.0";
 
-// A DaemonRig whose Teensy is the model behind a FakeTeensyIo (there, or gone at start).
+// A DaemonRig whose Teensy is the model behind a FakeTeensyIo (there, or gone at start). Its
+// silence_ms is 600, not the default 200: these tests run on the wall clock, also under ASan and
+// qemu-user (arm64), where a stalled poll must not read as a Teensy falling silent.
 struct TeensyRig {
-    explicit TeensyRig(const std::string& spi = "[spi]\nfitted = true\n", bool absent = false) {
+    explicit TeensyRig(const std::string& spi = "[spi]\nfitted = true\nsilence_ms = 600\n", bool absent = false) {
         io.set_gone(absent);
         rig = std::make_unique<DaemonRig>("loop_rate_hz = 50\ncommand_timeout_ms = 60000\n", spi, false, &io);
     }
@@ -177,7 +179,7 @@ TEST_CASE("TeensyConnection: the node gone kills at once; TeensyReopen asks agai
 }
 
 TEST_CASE("TeensyConnection: a fitted Teensy absent at start keeps the vehicle killed; picked up once it comes") {
-    TeensyRig t("[spi]\nfitted = true\n", true);
+    TeensyRig t("[spi]\nfitted = true\nsilence_ms = 600\n", true);
     t.rig->run_for(60);
     CHECK(t.state() == SafetyState::Killed);
     CHECK(t.port().loss() == TeensyLoss::Absent);
@@ -191,7 +193,7 @@ TEST_CASE("TeensyConnection: a fitted Teensy absent at start keeps the vehicle k
 }
 
 TEST_CASE("TeensyLinkWatch: a Teensy not fitted is relied on once it has answered: its silence kills") {
-    TeensyRig t("[spi]\nfitted = false\n");
+    TeensyRig t("[spi]\nfitted = false\nsilence_ms = 600\n");
     t.drive();
     t.io.model([](sim::TeensyModel& m) { m.faults().inject_no_answer(1'000'000); });
     t.check_killed(TeensyLoss::Silent);

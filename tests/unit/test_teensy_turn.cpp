@@ -23,10 +23,11 @@ namespace fw = caracara::sim::teensy; // the firmware's command ids
 
 namespace {
 
-// A DaemonRig whose Teensy is the model behind a FakeTeensyIo; no command timeout in the test.
+// A DaemonRig whose Teensy is the model behind a FakeTeensyIo; no command timeout in the test,
+// and a silence of 600 ms (as test_teensy_connection's, for runs under ASan and qemu-user).
 struct TurnRig {
     TurnRig() {
-        rig = std::make_unique<DaemonRig>("loop_rate_hz = 50\ncommand_timeout_ms = 60000\n", "[spi]\nfitted = true\n",
+        rig = std::make_unique<DaemonRig>("loop_rate_hz = 50\ncommand_timeout_ms = 60000\n", "[spi]\nfitted = true\nsilence_ms = 600\n",
                                           false, &io);
         rig->run_until_ready();
         REQUIRE(rig->run_until([&] { return port().telemetry().online; }));
