@@ -13,8 +13,9 @@ DaemonConfig parse(const std::string& control, const std::string& sections) {
     const std::string arm = control.find("arm_at_start") == std::string::npos ? "arm_at_start = true\n" : "";
     // The fakes have no Teensy: not fitted, unless the test's own [spi] says it is.
     const std::string spi = sections.find("[spi]") == std::string::npos ? "[spi]\nfitted = false\n" : "";
+    const std::string recorder = sections.find("[recorder]") == std::string::npos ? "[recorder]\nenabled = false\n" : "";
     ConfigResult r = parse_config_string("[control]\n" + arm + "arming_delay_ms = 0\n" + control +
-                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n" + spi +
+                                             FakeGpio::config_section() + recorder + spi +
                                              // The test runner's own thread is the loop here: not at a real-time policy.
                                              "[realtime]\nenabled = false\n" + sections,
                                          "the test rig");
@@ -24,12 +25,12 @@ DaemonConfig parse(const std::string& control, const std::string& sections) {
 }
 } // namespace
 
-DaemonRig::DaemonRig(const std::string& control, const std::string& sections, bool kill_switch_set)
+DaemonRig::DaemonRig(const std::string& control, const std::string& sections, bool kill_switch_set, DeviceIo* spi_io)
     : config_(parse(control, sections)), io_(wire_, config_), gpio_(wire_) {
     gpio_.set_kill_switch(kill_switch_set); // before the daemon reads it
     if (sd_event_new(&event_) < 0)
         throw std::runtime_error("sd_event_new");
-    daemon_ = std::make_unique<VehicleDaemon>(event_, io_, io_, io_, gpio_, config_);
+    daemon_ = std::make_unique<VehicleDaemon>(event_, io_, io_, spi_io ? *spi_io : io_, gpio_, config_);
     if (std::string e = daemon_->start(); !e.empty())
         throw std::runtime_error(e);
 }
