@@ -34,6 +34,7 @@ caracara_unit_test(test_bus_input_probe SOURCES unit/test_bus_input_probe.cpp LI
 # reporting the attitude of a vehicle in the pool that the thrusters on the fake wire turn.
 add_library(teensy_fakes STATIC unit/fakes/fake_teensy.cpp unit/fakes/pool_vehicle.cpp)
 target_link_libraries(teensy_fakes PUBLIC daemon_fakes caracara_simcore)
+caracara_unit_test(test_attitude_samples SOURCES unit/test_attitude_samples.cpp LIBS caracara_daemon)
 caracara_unit_test(test_direction_detection SOURCES unit/test_direction_detection.cpp LIBS teensy_fakes)
 caracara_unit_test(test_dive_recorder SOURCES unit/test_dive_recorder.cpp LIBS teensy_fakes)
 caracara_unit_test(test_log SOURCES unit/test_log.cpp LIBS caracara_daemon)

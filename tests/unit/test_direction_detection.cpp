@@ -25,8 +25,9 @@ namespace {
 // The shortest settle and pulse [commissioning] allows, so that eight thrusters take seconds.
 const std::string kSections = "[commissioning]\ndetect_pulse_ms = 300\ndetect_settle_ms = 100\n"
                               "detect_settle_timeout_ms = 1000\n";
-// At 100 Hz each orientation axis is read every 40 ms (one frame a cycle, four slots).
-const std::string kControl = "loop_rate_hz = 100\n";
+// At 100 Hz each orientation axis is read every 40 ms (one frame a cycle, four slots). The
+// command timeout far: the zeros on the wire are the detection's own, not the timeout's.
+const std::string kControl = "loop_rate_hz = 100\ncommand_timeout_ms = 60000\n";
 constexpr int32_t kPulse = 3000; // detect_pulse_value's default
 // Eight thrusters, each a settle of three windows and a pulse: a few seconds; the give-up far.
 constexpr int kRunGiveUpMs = 30000;
