@@ -35,7 +35,9 @@ constexpr double kTurnRad = PoolVehicle::kTurnRad;
 
 // A DaemonRig whose Teensy reports the pool's vehicle; armed, the Teensy answering.
 struct DetectionRig {
-    DetectionRig() : rig(kControl, kSections + "[spi]\nfitted = true\n", false, &teensy) {
+    // `spi`: the [spi] table's further keys.
+    explicit DetectionRig(const std::string& spi = "")
+        : rig(kControl, kSections + "[spi]\nfitted = true\n" + spi, false, &teensy) {
         pool.attach(rig);
         rig.run_until_ready();
         REQUIRE(rig.run_until([&] { return rig.daemon().teensy().telemetry().online; }));
@@ -218,10 +220,10 @@ TEST_CASE("DirectionDetection: a vehicle that will not hold still ends it NotSti
     CHECK(d.detection().judged() == 0);
 }
 
-TEST_CASE("DirectionDetection: the Teensy falling silent ends it LinkError, thrusters at zero") {
-    // Its first unanswered frame takes it offline; teensy-link-lost (a kill) comes only after
-    // spi.silence_ms, and the detection's own check, each step, is first.
-    DetectionRig d;
+TEST_CASE("DirectionDetection: the Teensy falling silent ends it LinkError, its own zeros on the wire") {
+    // Its first unanswered frame takes it offline; teensy-link-lost (a kill, whose zeros would
+    // hide the detection's) only after spi.silence_ms, here far beyond the test.
+    DetectionRig d("silence_ms = 60000\n");
     DirectionDetection& det = d.detection();
     std::optional<Result> end;
     det.run(":1.7", [&](const Result& r) { end = r; });
@@ -231,5 +233,6 @@ TEST_CASE("DirectionDetection: the Teensy falling silent ends it LinkError, thru
     CHECK(end->status == Status::LinkError);
     CHECK(end->message == "the Teensy went offline");
     REQUIRE(d.rig.run_until([&] { return all_zero(d.rig.wire().events()); }));
+    CHECK(d.rig.vehicle().readings().may_drive()); // not the kill's zeros
     CHECK(d.rig.vehicle().readings().requested_values() == MotorValues{});
 }
