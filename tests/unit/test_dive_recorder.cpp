@@ -15,8 +15,10 @@
 #include "tests/unit/fakes/pool_vehicle.hpp"
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
-#include <memory>
+#include <initializer_list>
+#include <iterator>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -64,6 +66,24 @@ bool closed(DaemonRig& rig, const TempDir& dir, std::size_t n) {
         const auto d = dives(dir);
         return d.size() == n && std::all_of(d.begin(), d.end(), [](const dive::Dive& x) { return x.ended; });
     });
+}
+
+// Kills the vehicle (the dive's end) and returns its dive, the one in `dir`, read back whole.
+dive::Dive killed_dive(DaemonRig& rig, const TempDir& dir) {
+    REQUIRE(rig.vehicle().kill(KillSource::DBus, "test").ok());
+    REQUIRE(closed(rig, dir, 1));
+    const dive::Dive d = dives(dir).front();
+    REQUIRE(d.ok());
+    return d;
+}
+
+// The dive's events of these kinds, in order.
+std::vector<dive::Event> events_of(const dive::Dive& d, std::initializer_list<dive::EventKind> kinds) {
+    std::vector<dive::Event> out;
+    std::copy_if(d.events.begin(), d.events.end(), std::back_inserter(out), [&](const dive::Event& e) {
+        return std::find(kinds.begin(), kinds.end(), e.kind) != kinds.end();
+    });
+    return out;
 }
 
 const dive::Event* last_of(const dive::Dive& d, dive::EventKind kind) {
@@ -152,13 +172,8 @@ TEST_CASE("DiveRecorder: a motor test starts and stops in the dive, with its thr
     REQUIRE(t.run(2, 800, ":1.7").ok());
     REQUIRE(rig.run_until([&] { return t.active_thruster() < 0; })); // its keep-alive ran out
     rig.run_for(100);
-    REQUIRE(rig.vehicle().kill(KillSource::DBus, "test").ok());
-    REQUIRE(closed(rig, dir, 1));
-    const dive::Dive d = dives(dir).front();
-    REQUIRE(d.ok());
-    std::vector<dive::Event> tests;
-    std::copy_if(d.events.begin(), d.events.end(), std::back_inserter(tests),
-                 [](const dive::Event& e) { return e.kind == dive::EventKind::MotorTest; });
+    const dive::Dive d = killed_dive(rig, dir);
+    const auto tests = events_of(d, {dive::EventKind::MotorTest});
     REQUIRE(tests.size() == 2);
     CHECK(tests[0].thruster == 2);
     CHECK(tests[0].value == dive::kOn);
@@ -210,15 +225,9 @@ TEST_CASE("DiveRecorder: a direction detection in the dive: its start and end, e
     REQUIRE(rig.run_until([&] { return end.has_value(); }, kDetectionGiveUpMs));
     REQUIRE(end->ok());
     rig.run_for(100);
-    REQUIRE(rig.vehicle().kill(KillSource::DBus, "test").ok());
-    REQUIRE(closed(rig, dir, 1));
-    const dive::Dive d = dives(dir).front();
-    REQUIRE(d.ok());
-    std::vector<dive::Event> ev;
-    std::copy_if(d.events.begin(), d.events.end(), std::back_inserter(ev), [](const dive::Event& e) {
-        return e.kind == dive::EventKind::Detection || e.kind == dive::EventKind::DetectionPulse ||
-               e.kind == dive::EventKind::DetectionResult;
-    });
+    const dive::Dive d = killed_dive(rig, dir);
+    const auto ev = events_of(d, {dive::EventKind::Detection, dive::EventKind::DetectionPulse,
+                                  dive::EventKind::DetectionResult});
     // Started, then for each thruster: pulse on, pulse off, its verdict; then ended, 8 judged.
     REQUIRE(ev.size() == 2 + 3 * kMotorCount);
     CHECK(ev.front().kind == dive::EventKind::Detection);

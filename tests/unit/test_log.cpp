@@ -5,48 +5,14 @@
 #include "daemon/loop/log.hpp"
 
 #include "tests/catch.hpp"
+#include "tests/unit/fakes/stderr_lines.hpp"
 
-#include <cstdio>
 #include <cstdlib>
-#include <fcntl.h>
-#include <stdexcept>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 using namespace caracara;
-
-namespace {
-
-// What the calls in `write` put on stderr (fd 2), split into lines.
-template <typename F>
-std::vector<std::string> stderr_lines(F write) {
-    std::FILE* tmp = std::tmpfile();
-    if (!tmp)
-        throw std::runtime_error("tmpfile");
-    std::fflush(stderr);
-    const int saved = ::dup(2);
-    ::dup2(::fileno(tmp), 2);
-    write();
-    std::fflush(stderr);
-    ::dup2(saved, 2);
-    ::close(saved);
-    std::string all;
-    std::rewind(tmp);
-    for (int c; (c = std::fgetc(tmp)) != EOF;)
-        all += static_cast<char>(c);
-    std::fclose(tmp);
-    std::vector<std::string> lines;
-    for (std::size_t at = 0; at < all.size();) {
-        const std::size_t nl = all.find('\n', at);
-        REQUIRE(nl != std::string::npos); // every line ends
-        lines.push_back(all.substr(at, nl - at));
-        at = nl + 1;
-    }
-    return lines;
-}
-
-} // namespace
+using namespace caracara::test;
 
 TEST_CASE("log: each level one line, its journald priority in front") {
     const auto lines = stderr_lines([] {

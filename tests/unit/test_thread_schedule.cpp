@@ -7,8 +7,8 @@
 #include "daemon/loop/thread_schedule.hpp"
 
 #include "tests/catch.hpp"
+#include "tests/unit/fakes/stderr_lines.hpp"
 
-#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <linux/capability.h>
@@ -32,6 +32,7 @@
 #endif
 
 using namespace caracara;
+using namespace caracara::test;
 
 namespace {
 
@@ -47,31 +48,6 @@ Schedule current() {
     pthread_getschedparam(pthread_self(), &s.policy, &sp);
     s.priority = sp.sched_priority;
     return s;
-}
-
-// What `f` wrote on stderr, as lines.
-std::vector<std::string> stderr_lines(const std::function<void()>& f) {
-    std::FILE* tmp = std::tmpfile();
-    if (!tmp)
-        throw std::runtime_error("tmpfile");
-    std::fflush(stderr);
-    const int saved = ::dup(2);
-    ::dup2(::fileno(tmp), 2);
-    f();
-    std::fflush(stderr);
-    ::dup2(saved, 2);
-    ::close(saved);
-    std::rewind(tmp);
-    std::vector<std::string> lines;
-    char buf[2048];
-    while (std::fgets(buf, sizeof buf, tmp)) {
-        std::string l(buf);
-        if (!l.empty() && l.back() == '\n')
-            l.pop_back();
-        lines.push_back(l);
-    }
-    std::fclose(tmp);
-    return lines;
 }
 
 // The calling thread's effective capability `cap` dropped (capabilities are per thread; the
