@@ -40,3 +40,5 @@ caracara_unit_test(test_dive_recorder SOURCES unit/test_dive_recorder.cpp LIBS t
 caracara_unit_test(test_log SOURCES unit/test_log.cpp unit/fakes/stderr_lines.cpp LIBS caracara_daemon)
 caracara_unit_test(test_thread_schedule SOURCES unit/test_thread_schedule.cpp unit/fakes/stderr_lines.cpp LIBS caracara_daemon)
 caracara_unit_test(test_cold_libraries SOURCES unit/test_cold_libraries.cpp LIBS caracara_daemon)
+# Under qemu-user (a cross build's tests) smaps shows the emulator's mappings, not the program's.
+target_compile_definitions(test_cold_libraries PRIVATE CARACARA_TEST_EMULATED=$<BOOL:${CMAKE_CROSSCOMPILING_EMULATOR}>)

@@ -86,6 +86,14 @@ TEST_CASE("ColdLibraries: around mlockall the cold libraries stay unlocked but l
     volatile double x = 0.5;
     CHECK(std::lround(x * 10) == 5);
     CHECK(std::cos(x) == Approx(0.8775825619));
+#if CARACARA_TEST_EMULATED
+    // qemu-user maps the arm64 program's code as data it translates: which libraries are locked
+    // is judged on the native builds (as e2e test_realtime does).
+    if (locked == 0)
+        munlockall();
+    WARN("the cold libraries' locking: not judged under an emulator");
+    return;
+#endif
     const auto maps = mappings();
     if (locked == 0)
         munlockall();

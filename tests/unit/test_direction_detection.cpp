@@ -22,9 +22,9 @@ using namespace caracara::test;
 
 namespace {
 
-// The shortest settle and pulse [commissioning] allows, so that eight thrusters take seconds.
-const std::string kSections = "[commissioning]\ndetect_pulse_ms = 300\ndetect_settle_ms = 100\n"
-                              "detect_settle_timeout_ms = 1000\n";
+// The shortest settle and pulse [commissioning] allows, so that eight thrusters take seconds (the
+// settle's timeout left at its default: a late loop, under an emulator, still settles).
+const std::string kSections = "[commissioning]\ndetect_pulse_ms = 300\ndetect_settle_ms = 100\n";
 // At 100 Hz each orientation axis is read every 40 ms (one frame a cycle, four slots). The
 // command timeout far: the zeros on the wire are the detection's own, not the timeout's.
 const std::string kControl = "loop_rate_hz = 100\ncommand_timeout_ms = 60000\n";
@@ -35,9 +35,9 @@ constexpr double kTurnRad = PoolVehicle::kTurnRad;
 
 // A DaemonRig whose Teensy reports the pool's vehicle; armed, the Teensy answering.
 struct DetectionRig {
-    // `spi`: the [spi] table's further keys.
-    explicit DetectionRig(const std::string& spi = "")
-        : rig(kControl, kSections + "[spi]\nfitted = true\n" + spi, false, &teensy) {
+    // `commissioning`, `spi`: those tables' further keys.
+    explicit DetectionRig(const std::string& commissioning = "", const std::string& spi = "")
+        : rig(kControl, kSections + commissioning + "[spi]\nfitted = true\n" + spi, false, &teensy) {
         pool.attach(rig);
         rig.run_until_ready();
         REQUIRE(rig.run_until([&] { return rig.daemon().teensy().telemetry().online; }));
@@ -210,7 +210,7 @@ TEST_CASE("DirectionDetection: another client's command ends it Busy, leaving th
 }
 
 TEST_CASE("DirectionDetection: a vehicle that will not hold still ends it NotStill before any pulse") {
-    DetectionRig d;
+    DetectionRig d("detect_settle_timeout_ms = 1000\n"); // its floor
     d.pool.turning = true;
     d.rig.wire().clear();
     const Result r = d.run();
@@ -223,7 +223,7 @@ TEST_CASE("DirectionDetection: a vehicle that will not hold still ends it NotSti
 TEST_CASE("DirectionDetection: the Teensy falling silent ends it LinkError, its own zeros on the wire") {
     // Its first unanswered frame takes it offline; teensy-link-lost (a kill, whose zeros would
     // hide the detection's) only after spi.silence_ms, here far beyond the test.
-    DetectionRig d("silence_ms = 60000\n");
+    DetectionRig d("", "silence_ms = 60000\n");
     DirectionDetection& det = d.detection();
     std::optional<Result> end;
     det.run(":1.7", [&](const Result& r) { end = r; });
