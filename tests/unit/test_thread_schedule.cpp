@@ -51,7 +51,7 @@ Schedule current() {
 }
 
 // The calling thread's effective capability `cap` dropped (capabilities are per thread; the
-// permitted set keeps it, so restore() gives it back).
+// permitted set keeps it, and it is given back when this goes).
 class DroppedCapability {
 public:
     explicit DroppedCapability(int cap) : cap_(cap) { set(false); }

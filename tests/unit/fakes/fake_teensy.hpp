@@ -1,13 +1,14 @@
 // The device seam's SPI side in process: the simulator's own Teensy (sim/TeensyModel, the
 // firmware's protocol byte by byte) behind the spidev node [spi] device names, its orientation
 // given by the test (`attitude`, asked at each Get orientation, on the Teensy worker's thread).
-// Thread-safe: the worker's frames and a test's reads of the model are serialised.
+// Thread-safe: the worker's frames and a test's set_silent are serialised.
 #pragma once
 
 #include "core/config.hpp"
 #include "drivers/platform/device_io.hpp"
 #include "sim/teensy_model.hpp"
 
+#include <cerrno>
 #include <mutex>
 #include <string>
 
