@@ -28,15 +28,16 @@ caracara_unit_test(test_service_status SOURCES unit/test_service_status.cpp LIBS
 caracara_unit_test(test_motor_test SOURCES unit/test_motor_test.cpp LIBS daemon_fakes)
 caracara_unit_test(test_bus_scan SOURCES unit/test_bus_scan.cpp LIBS daemon_fakes)
 caracara_unit_test(test_teensy_port SOURCES unit/test_teensy_port.cpp LIBS daemon_fakes)
+# The Teensy's link on the simulator's own Teensy model behind the SPI side of the seam.
+add_library(teensy_fakes STATIC unit/fakes/fake_teensy_io.cpp)
+target_link_libraries(teensy_fakes PUBLIC daemon_fakes caracara_simcore)
 caracara_unit_test(test_announced_object SOURCES unit/test_announced_object.cpp LIBS service_rig)
 caracara_unit_test(test_bus_input_probe SOURCES unit/test_bus_input_probe.cpp LIBS service_rig)
-# A Teensy on the device seam: the simulator's own model behind the spidev node (fake_teensy),
-# reporting the attitude of a vehicle in the pool that the thrusters on the fake wire turn.
-add_library(teensy_fakes STATIC unit/fakes/fake_teensy.cpp unit/fakes/pool_vehicle.cpp)
-target_link_libraries(teensy_fakes PUBLIC daemon_fakes caracara_simcore)
 caracara_unit_test(test_attitude_samples SOURCES unit/test_attitude_samples.cpp LIBS caracara_daemon)
-caracara_unit_test(test_direction_detection SOURCES unit/test_direction_detection.cpp LIBS teensy_fakes)
-caracara_unit_test(test_dive_recorder SOURCES unit/test_dive_recorder.cpp LIBS teensy_fakes)
+# Direction detection (and the dive that records it) on a vehicle in the pool (PoolVehicle) that
+# the thrusters on the fake wire turn, as the Teensy's model reports it.
+caracara_unit_test(test_direction_detection SOURCES unit/test_direction_detection.cpp unit/fakes/pool_vehicle.cpp LIBS teensy_fakes)
+caracara_unit_test(test_dive_recorder SOURCES unit/test_dive_recorder.cpp unit/fakes/pool_vehicle.cpp LIBS teensy_fakes)
 caracara_unit_test(test_log SOURCES unit/test_log.cpp unit/fakes/stderr_lines.cpp LIBS caracara_daemon)
 caracara_unit_test(test_thread_schedule SOURCES unit/test_thread_schedule.cpp unit/fakes/stderr_lines.cpp LIBS caracara_daemon)
 caracara_unit_test(test_cold_libraries SOURCES unit/test_cold_libraries.cpp LIBS caracara_daemon)

@@ -1,6 +1,6 @@
 // daemon/commissioning/DirectionDetection (with its AttitudeSamples and DirectionFindings) on the
 // daemon's objects over the fakes of the device seam (DaemonRig), the Teensy the simulator's own
-// model (FakeTeensy) reporting the attitude of a vehicle in the pool (PoolVehicle) that turns,
+// model (FakeTeensyIo) reporting the attitude of a vehicle in the pool (PoolVehicle) that turns,
 // along what the mixing says, while a thruster's last order on the fake wire is not zero: each
 // thruster pulsed alone, in turn, at detect_pulse_value and ordered zero after; the mounting it found; refused by
 // name while one runs, killed or without a Teensy; ended by a kill (the pulse zeroed at once), by
@@ -9,7 +9,7 @@
 
 #include "tests/catch.hpp"
 #include "tests/unit/fakes/daemon_rig.hpp"
-#include "tests/unit/fakes/fake_teensy.hpp"
+#include "tests/unit/fakes/fake_teensy_io.hpp"
 #include "tests/unit/fakes/pool_vehicle.hpp"
 
 #include <cmath>
@@ -37,8 +37,7 @@ constexpr double kTurnRad = PoolVehicle::kTurnRad;
 struct DetectionRig {
     // `commissioning`, `spi`: those tables' further keys.
     explicit DetectionRig(const std::string& commissioning = "", const std::string& spi = "")
-        : rig(kControl, kSections + commissioning + "[spi]\nfitted = true\n" + spi, false, &teensy) {
-        pool.attach(rig);
+        : rig(kControl, kSections + commissioning + "[spi]\nfitted = true\n" + spi, false, &teensy), pool(rig, teensy) {
         rig.run_until_ready();
         REQUIRE(rig.run_until([&] { return rig.daemon().teensy().telemetry().online; }));
     }
@@ -51,9 +50,9 @@ struct DetectionRig {
         return *end;
     }
 
-    PoolVehicle pool;
-    FakeTeensy teensy{[this] { return pool.attitude(); }};
+    FakeTeensyIo teensy{SpiSettings{}.device};
     DaemonRig rig;
+    PoolVehicle pool;
 };
 
 std::vector<DirectionVerdict> verdicts(const DirectionDetection& d) {
@@ -89,9 +88,12 @@ TEST_CASE("DirectionDetection: each thruster pulsed alone, in turn, then zero; t
     CHECK(det.pulsing() == -1);
     using V = DirectionVerdict;
     CHECK(verdicts(det) == std::vector<V>{V::Ok, V::Ok, V::Reversed, V::Ok, V::Ok, V::Reversed, V::Ok, V::Ok});
-    // What it measured: the turn the pulse made, along the mixing's rotation.
-    for (std::size_t i = 0; i < kMotorCount; ++i)
-        CHECK(std::abs(det.findings()[i].judgement.along) == Approx(kTurnRad).epsilon(0.05));
+    // What it measured: the turn the pulse made, along the mixing's rotation (the Teensy reads
+    // one axis a cycle: a sample or two of the window may predate the turn), at most the turn.
+    for (std::size_t i = 0; i < kMotorCount; ++i) {
+        CHECK(std::abs(det.findings()[i].judgement.along) > kTurnRad / 2);
+        CHECK(std::abs(det.findings()[i].judgement.along) <= kTurnRad + 1e-6);
+    }
     // The fragment flips the two found reversed, and only them.
     const std::string f = det.fragment();
     std::size_t flipped = 0;
@@ -228,7 +230,7 @@ TEST_CASE("DirectionDetection: the Teensy falling silent ends it LinkError, its 
     std::optional<Result> end;
     det.run(":1.7", [&](const Result& r) { end = r; });
     REQUIRE(d.rig.run_until([&] { return det.pulsing() == 0; }, kRunGiveUpMs));
-    d.teensy.set_silent(true);
+    d.teensy.model([](sim::TeensyModel& m) { m.faults().inject_no_answer(1u << 30); });
     REQUIRE(d.rig.run_until([&] { return end.has_value(); }));
     CHECK(end->status == Status::LinkError);
     CHECK(end->message == "the Teensy went offline");

@@ -1,6 +1,6 @@
 // daemon/dive/DiveRecorder (with its DiveSampler, CommissioningEvents and DiveWriter) on the
 // daemon's objects over the fakes of the device seam (DaemonRig), the Teensy the simulator's model
-// (FakeTeensy): the dive file a user reads back (core/dive_format's decode, as caracara-dive does)
+// (FakeTeensyIo): the dive file a user reads back (core/dive_format's decode, as caracara-dive does)
 // opens at the arming, holds a sample every cycle with what the pilot asked and the Teensy
 // reported, an event for the kill with its source and reason, for each motor test and for each
 // step of a direction detection (a PoolVehicle turned by the pulses), and closes at the kill, the
@@ -11,7 +11,7 @@
 #include "drivers/platform/dive_files.hpp"
 #include "tests/catch.hpp"
 #include "tests/unit/fakes/daemon_rig.hpp"
-#include "tests/unit/fakes/fake_teensy.hpp"
+#include "tests/unit/fakes/fake_teensy_io.hpp"
 #include "tests/unit/fakes/pool_vehicle.hpp"
 
 #include <algorithm>
@@ -189,7 +189,8 @@ TEST_CASE("DiveRecorder: a motor test starts and stops in the dive, with its thr
 
 TEST_CASE("DiveRecorder: the daemon stopping ends the dive 'stopped'; the Teensy's attitude is in its samples") {
     TempDir dir;
-    FakeTeensy teensy([] { return sim::BodyAttitude{0.5, -0.25, 0.125}; });
+    FakeTeensyIo teensy(SpiSettings{}.device);
+    teensy.set_attitude({0.5, -0.25, 0.125});
     {
         DaemonRig rig("loop_rate_hz = 50\n", recorder(dir) + "[spi]\nfitted = true\n", false, &teensy);
         rig.run_until_ready();
@@ -212,12 +213,11 @@ TEST_CASE("DiveRecorder: the daemon stopping ends the dive 'stopped'; the Teensy
 
 TEST_CASE("DiveRecorder: a direction detection in the dive: its start and end, each pulse on and off, each verdict") {
     TempDir dir;
-    PoolVehicle pool;
-    pool.mounting[2] = -1;
-    FakeTeensy teensy([&] { return pool.attitude(); });
+    FakeTeensyIo teensy(SpiSettings{}.device);
     DaemonRig rig("loop_rate_hz = 100\n",
                   recorder(dir) + "[commissioning]\ndetect_pulse_ms = 300\ndetect_settle_ms = 100\n[spi]\nfitted = true\n", false, &teensy);
-    pool.attach(rig);
+    PoolVehicle pool(rig, teensy);
+    pool.mounting[2] = -1;
     rig.run_until_ready();
     REQUIRE(rig.run_until([&] { return rig.daemon().teensy().telemetry().online; }));
     std::optional<Result> end;

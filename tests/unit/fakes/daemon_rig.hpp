@@ -18,9 +18,9 @@ class DaemonRig {
 public:
     // `control`: the [control] section's lines (armed at start unless they say arm_at_start, no
     // arming delay by default); `sections`: more tables, whole (e.g. "[failsafe.pilot-lost]\n
-    // persistence_ms = 300\n"; the Teensy is not fitted unless they have an [spi], the recorder
-    // off unless they have a [recorder]); `kill_switch_set`: the switch as the daemon finds it at
-    // start; `spi_io`: the Teensy's side of the seam (a FakeTeensy), else the fakes' (no Teensy).
+    // persistence_ms = 300\n"; the Teensy is not fitted unless they have an [spi]);
+    // `kill_switch_set`: the switch as the daemon finds it at start; `spi_io`: the Teensy's side
+    // of the seam (FakeTeensyIo, outliving the rig; null: no Teensy's node).
     explicit DaemonRig(const std::string& control = "loop_rate_hz = 50\n", const std::string& sections = "",
                        bool kill_switch_set = false, DeviceIo* spi_io = nullptr);
     ~DaemonRig();

@@ -1,16 +1,16 @@
-// The vehicle in the pool as its Teensy (a FakeTeensy) reports it to direction detection: still,
-// but while a thruster's last order on the fake wire is not zero, turned by kTurnRad along the
-// rotation its mixing row gives it, times its mounting (+1 as configured, -1 mounted reversed, 0
-// its motor lead off). `turning`: a vehicle that keeps turning at 1 rad/s, never still.
-// attitude() is asked on the Teensy worker's thread: the rig is attached once it exists.
+// The vehicle in the pool as its Teensy (a FakeTeensyIo) reports it to direction detection:
+// still, but while a thruster's last order on the fake wire is not zero, turned by kTurnRad
+// along the rotation its mixing row gives it, times its mounting (+1 as configured, -1 mounted
+// reversed, 0 its motor lead off); `turning`: a vehicle that keeps turning at 1 rad/s, never
+// still. It runs on the rig's loop, a timer of its own setting the Teensy's attitude from the wire.
 #pragma once
 
 #include "core/mixing.hpp"
 #include "sim/vehicle_body.hpp"
 #include "tests/unit/fakes/daemon_rig.hpp"
+#include "tests/unit/fakes/fake_teensy_io.hpp"
 
 #include <array>
-#include <atomic>
 
 namespace caracara::test {
 
@@ -18,14 +18,22 @@ class PoolVehicle {
 public:
     static constexpr double kTurnRad = 0.1; // ten times the default detect_threshold_mrad
 
-    void attach(DaemonRig& rig) { rig_ = &rig; }
-    sim::BodyAttitude attitude() const;
+    // Made after the rig (whose Teensy's side is `teensy`), gone before it.
+    PoolVehicle(DaemonRig& rig, FakeTeensyIo& teensy);
+    ~PoolVehicle();
+    PoolVehicle(const PoolVehicle&) = delete;
+    PoolVehicle& operator=(const PoolVehicle&) = delete;
 
     std::array<int, kMotorCount> mounting{1, 1, 1, 1, 1, 1, 1, 1};
-    std::atomic<bool> turning{false};
+    bool turning = false;
 
 private:
-    std::atomic<DaemonRig*> rig_{nullptr};
+    static int on_timer(sd_event_source* s, uint64_t usec, void* self);
+    sim::BodyAttitude attitude() const;
+
+    DaemonRig& rig_;
+    FakeTeensyIo& teensy_;
+    sd_event_source* timer_ = nullptr;
 };
 
 } // namespace caracara::test
