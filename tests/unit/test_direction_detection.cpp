@@ -2,9 +2,10 @@
 // daemon's objects over the fakes of the device seam (DaemonRig), the Teensy the simulator's own
 // model (FakeTeensyIo) reporting the attitude of a vehicle in the pool (PoolVehicle) that turns,
 // along what the mixing says, while a thruster's last order on the fake wire is not zero: each
-// thruster pulsed alone, in turn, at detect_pulse_value and ordered zero after; the mounting it found; refused by
-// name while one runs, killed or without a Teensy; ended by a kill (the pulse zeroed at once), by
-// another client's command, by a vehicle that will not hold still, by the Teensy falling silent.
+// thruster pulsed alone, in turn, at detect_pulse_value and ordered zero after; the mounting it
+// found; refused by name while one runs, killed or without a Teensy; ended by a kill (the pulse
+// zeroed at once), by another client's command, by a vehicle that will not hold still, by the
+// Teensy falling silent.
 #include "daemon/commissioning/direction_detection.hpp"
 
 #include "tests/catch.hpp"
