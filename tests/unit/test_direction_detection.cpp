@@ -151,6 +151,10 @@ TEST_CASE("DirectionDetection: refused while one runs, the running one going on"
     CHECK(d.rig.vehicle().readings().controller_client() == ":1.7");
     REQUIRE(d.rig.run_until([&] { return det.pulsing() == 0; }, kRunGiveUpMs));
     CHECK_FALSE(first.has_value());
+    // Ended here, its result into `first` while it lives (the rig's stop would complete it later).
+    REQUIRE(d.rig.vehicle().kill(KillSource::DBus, "test").ok());
+    REQUIRE(d.rig.run_until([&] { return first.has_value(); }));
+    CHECK(first->status == Status::Killed);
 }
 
 TEST_CASE("DirectionDetection: refused while killed, and without a Teensy; nothing ordered") {
