@@ -41,5 +41,8 @@ caracara_unit_test(test_dive_recorder SOURCES unit/test_dive_recorder.cpp unit/f
 caracara_unit_test(test_log SOURCES unit/test_log.cpp unit/fakes/stderr_lines.cpp LIBS caracara_daemon)
 caracara_unit_test(test_thread_schedule SOURCES unit/test_thread_schedule.cpp unit/fakes/stderr_lines.cpp LIBS caracara_daemon)
 caracara_unit_test(test_cold_libraries SOURCES unit/test_cold_libraries.cpp LIBS caracara_daemon)
-# Under qemu-user (a cross build's tests) smaps shows the emulator's mappings, not the program's.
-target_compile_definitions(test_cold_libraries PRIVATE CARACARA_TEST_EMULATED=$<BOOL:${CMAKE_CROSSCOMPILING_EMULATOR}>)
+# Under qemu-user (a cross build's tests) smaps shows the emulator's mappings, not the program's;
+# under AddressSanitizer mlock is a no-op and caracarad never locks.
+target_compile_definitions(test_cold_libraries PRIVATE CARACARA_TEST_EMULATED=$<BOOL:${CMAKE_CROSSCOMPILING_EMULATOR}>
+                           CARACARA_TEST_ASAN=$<BOOL:${CARACARA_SANITIZE}>)
+target_compile_definitions(test_thread_schedule PRIVATE CARACARA_TEST_ASAN=$<BOOL:${CARACARA_SANITIZE}>)

@@ -17,15 +17,6 @@
 #include <unistd.h>
 #include <vector>
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define CARACARA_TEST_ASAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__)
-#define CARACARA_TEST_ASAN 1
-#endif
-
 using namespace caracara;
 
 namespace {
@@ -95,7 +86,7 @@ TEST_CASE("ColdLibraries: around mlockall the cold libraries stay unlocked but l
     volatile double x = 0.5;
     CHECK(std::lround(x * 10) == 5);
     CHECK(std::cos(x) == Approx(0.8775825619));
-#if CARACARA_TEST_EMULATED || defined(CARACARA_TEST_ASAN)
+#if CARACARA_TEST_EMULATED || CARACARA_TEST_ASAN
     // qemu-user maps the arm64 program's code as data it translates, and AddressSanitizer makes
     // mlock a no-op (caracarad never locks under it): which libraries are locked is judged on
     // the native, unsanitized builds (as e2e test_realtime does).

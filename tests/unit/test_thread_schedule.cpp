@@ -22,15 +22,6 @@
 #include <unistd.h>
 #include <vector>
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define CARACARA_TEST_ASAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__)
-#define CARACARA_TEST_ASAN 1
-#endif
-
 using namespace caracara;
 using namespace caracara::test;
 
@@ -188,7 +179,7 @@ TEST_CASE("ThreadSchedule: memory is not locked under a limit an allocation woul
     const DroppedCapability lock(CAP_IPC_LOCK);
     const LoweredLimit memlock(RLIMIT_MEMLOCK, 64 * 1024);
     const std::string why = ThreadSchedule::lock_memory();
-#ifdef CARACARA_TEST_ASAN
+#if CARACARA_TEST_ASAN
     CHECK(why.find("AddressSanitizer") != std::string::npos);
 #else
     CHECK(why == "RLIMIT_MEMLOCK is 64 kB, not unlimited (caracarad.service's LimitMEMLOCK=infinity): past it every "
