@@ -20,6 +20,10 @@ void AttitudeSamples::keep_window(uint64_t window_ns, uint64_t now) {
 }
 
 bool AttitudeSamples::still(uint64_t now, uint64_t half_ns, double max_rad) const {
+    // Two halves to compare: a late step (a loaded machine) leaves the window its last half only,
+    // or one sample, whose mean is trivially the whole window's.
+    if (samples_.empty() || samples_.front().t_ns + half_ns > now)
+        return false;
     const Attitude moved = change(mean_from(0), mean_from(now - half_ns));
     double worst = 0.0;
     for (const double m : moved)

@@ -17,7 +17,8 @@ public:
     // Drops the samples older than `window_ns` before `now`.
     void keep_window(uint64_t window_ns, uint64_t now);
     // Still: the mean attitude of the last `half_ns` is within `max_rad` of the whole window's on
-    // every axis (a spread test would be fooled by the sensor's noise).
+    // every axis (a spread test would be fooled by the sensor's noise); never while no sample is
+    // older than `half_ns` (nothing of the first half to compare with).
     bool still(uint64_t now, uint64_t half_ns, double max_rad) const;
     // The mean attitude of the samples from `from_ns` on; yaw averaged as offsets from the first
     // sample so a heading near +-pi does not average to zero.

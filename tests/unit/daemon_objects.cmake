@@ -39,3 +39,16 @@ caracara_unit_test(test_teensy_connection SOURCES unit/test_teensy_connection.cp
 caracara_unit_test(test_teensy_turn SOURCES unit/test_teensy_turn.cpp LIBS teensy_fakes)
 caracara_unit_test(test_announced_object SOURCES unit/test_announced_object.cpp LIBS service_rig)
 caracara_unit_test(test_bus_input_probe SOURCES unit/test_bus_input_probe.cpp LIBS service_rig)
+caracara_unit_test(test_attitude_samples SOURCES unit/test_attitude_samples.cpp LIBS caracara_daemon)
+# Direction detection (and the dive that records it) on a vehicle in the pool (PoolVehicle) that
+# the thrusters on the fake wire turn, as the Teensy's model reports it.
+caracara_unit_test(test_direction_detection SOURCES unit/test_direction_detection.cpp unit/fakes/pool_vehicle.cpp LIBS teensy_fakes)
+caracara_unit_test(test_dive_recorder SOURCES unit/test_dive_recorder.cpp unit/fakes/pool_vehicle.cpp LIBS teensy_fakes)
+caracara_unit_test(test_log SOURCES unit/test_log.cpp unit/fakes/stderr_lines.cpp LIBS caracara_daemon)
+caracara_unit_test(test_thread_schedule SOURCES unit/test_thread_schedule.cpp unit/fakes/stderr_lines.cpp LIBS caracara_daemon)
+caracara_unit_test(test_cold_libraries SOURCES unit/test_cold_libraries.cpp LIBS caracara_daemon)
+# Under qemu-user (a cross build's tests) smaps shows the emulator's mappings, not the program's;
+# under AddressSanitizer mlock is a no-op and caracarad never locks.
+target_compile_definitions(test_cold_libraries PRIVATE CARACARA_TEST_EMULATED=$<BOOL:${CMAKE_CROSSCOMPILING_EMULATOR}>
+                           CARACARA_TEST_ASAN=$<BOOL:${CARACARA_SANITIZE}>)
+target_compile_definitions(test_thread_schedule PRIVATE CARACARA_TEST_ASAN=$<BOOL:${CARACARA_SANITIZE}>)

@@ -13,8 +13,10 @@ DaemonConfig parse(const std::string& control, const std::string& sections) {
     const std::string arm = control.find("arm_at_start") == std::string::npos ? "arm_at_start = true\n" : "";
     // The fakes have no Teensy: not fitted, unless the test's own [spi] says it is.
     const std::string spi = sections.find("[spi]") == std::string::npos ? "[spi]\nfitted = false\n" : "";
+    // The recorder off, unless the test's own [recorder] says otherwise.
+    const std::string recorder = sections.find("[recorder]") == std::string::npos ? "[recorder]\nenabled = false\n" : "";
     ConfigResult r = parse_config_string("[control]\n" + arm + "arming_delay_ms = 0\n" + control +
-                                             FakeGpio::config_section() + "[recorder]\nenabled = false\n" + spi +
+                                             FakeGpio::config_section() + recorder + spi +
                                              // The test runner's own thread is the loop here: not at a real-time policy.
                                              "[realtime]\nenabled = false\n" + sections,
                                          "the test rig");
