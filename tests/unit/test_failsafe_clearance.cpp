@@ -155,34 +155,15 @@ TEST_CASE("ClearKillOverride over D-Bus: the caller's override is announced; Fai
     hall_kill(s.rig());
     using Row = std::tuple<std::string, std::string, int32_t>;
     std::vector<Row> announced; // the last Failsafes announced
-    auto on_changed = [](sd_bus_message* m, void* userdata, sd_bus_error*) {
-        auto* rows = static_cast<std::vector<Row>*>(userdata);
-        const char* iface = nullptr;
-        if (sd_bus_message_read(m, "s", &iface) < 0 || sd_bus_message_enter_container(m, 'a', "{sv}") < 0)
-            return 0;
-        while (sd_bus_message_enter_container(m, 'e', "sv") > 0) {
-            const char* name = nullptr;
-            sd_bus_message_read(m, "s", &name);
-            if (std::string(name) == "Failsafes" && sd_bus_message_enter_container(m, 'v', "a(ssi)") > 0) {
-                rows->clear();
-                sd_bus_message_enter_container(m, 'a', "(ssi)");
-                const char *condition = nullptr, *action = nullptr;
-                int32_t thruster = 0;
-                while (sd_bus_message_read(m, "(ssi)", &condition, &action, &thruster) > 0)
-                    rows->emplace_back(condition, action, thruster);
-                sd_bus_message_exit_container(m);
-                sd_bus_message_exit_container(m);
-            } else {
-                sd_bus_message_skip(m, "v");
-            }
-            sd_bus_message_exit_container(m);
-        }
-        return 0;
-    };
-    sd_bus_slot* slot = nullptr;
-    REQUIRE(sd_bus_match_signal(s.client(), &slot, dbus::kBusName, dbus::kRootPath, "org.freedesktop.DBus.Properties",
-                                "PropertiesChanged", on_changed, &announced) >= 0);
-    dbus::SlotPtr held(slot);
+    s.watch_property(dbus::kRootPath, "Failsafes", "a(ssi)", [&](sd_bus_message* m) {
+        announced.clear();
+        sd_bus_message_enter_container(m, 'a', "(ssi)");
+        const char *condition = nullptr, *action = nullptr;
+        int32_t thruster = 0;
+        while (sd_bus_message_read(m, "(ssi)", &condition, &action, &thruster) > 0)
+            announced.emplace_back(condition, action, thruster);
+        sd_bus_message_exit_container(m);
+    });
 
     REQUIRE(s.call(dbus::kRootPath, dbus::kVehicleIface, "ClearKillOverride", "s", "hall").ok());
     const std::vector<Row> warns{{"hall", "warn", static_cast<int32_t>(kFaulty)}};

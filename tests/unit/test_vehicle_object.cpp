@@ -267,31 +267,13 @@ TEST_CASE("VehicleObject: a command's change is announced in PropertiesChanged")
     ServiceRig s;
     s.rig().run_until_ready();
     std::vector<int32_t> announced;
-    auto on_changed = [](sd_bus_message* m, void* userdata, sd_bus_error*) {
-        const char* iface = nullptr;
-        if (sd_bus_message_read(m, "s", &iface) < 0 || sd_bus_message_enter_container(m, 'a', "{sv}") < 0)
-            return 0;
-        while (sd_bus_message_enter_container(m, 'e', "sv") > 0) {
-            const char* name = nullptr;
-            sd_bus_message_read(m, "s", &name);
-            if (std::string(name) == "MotorValues" && sd_bus_message_enter_container(m, 'v', "ai") > 0) {
-                const void* p = nullptr;
-                size_t n = 0;
-                sd_bus_message_read_array(m, 'i', &p, &n);
-                const auto* v = static_cast<const int32_t*>(p);
-                *static_cast<std::vector<int32_t>*>(userdata) = {v, v + n / sizeof(int32_t)};
-                sd_bus_message_exit_container(m);
-            } else {
-                sd_bus_message_skip(m, "v");
-            }
-            sd_bus_message_exit_container(m);
-        }
-        return 0;
-    };
-    sd_bus_slot* slot = nullptr;
-    REQUIRE(sd_bus_match_signal(s.client(), &slot, dbus::kBusName, kRootPath, "org.freedesktop.DBus.Properties",
-                                "PropertiesChanged", on_changed, &announced) >= 0);
-    dbus::SlotPtr held(slot);
+    s.watch_property(kRootPath, "MotorValues", "ai", [&](sd_bus_message* m) {
+        const void* p = nullptr;
+        size_t n = 0;
+        sd_bus_message_read_array(m, 'i', &p, &n);
+        const auto* v = static_cast<const int32_t*>(p);
+        announced.assign(v, v + n / sizeof(int32_t));
+    });
     REQUIRE(set_thrust(s, kThrust).ok());
     CHECK(s.rig().run_until([&] { return announced == kThrust; }));
 }

@@ -35,6 +35,7 @@ ServiceRig::~ServiceRig() {
     rig_.loop().set_input_probe(nullptr);
     rig_.daemon().events().attach(nullptr);
     service_.reset();
+    watches_.clear();
     client_.reset();
     server_.reset();
     dbus_daemon_.stop();
@@ -135,6 +136,35 @@ bool ServiceRig::each_ordered(const std::vector<int32_t>& values, long from) {
         if (find(ev, [&](const WireEvent& e) { return e.is_order(i, on_wire(values[i])); }, from) < 0)
             return false;
     return true;
+}
+
+void ServiceRig::watch_property(const char* path, const char* property, const char* type,
+                                std::function<void(sd_bus_message*)> read) {
+    auto watch = std::make_unique<PropertyWatch>(PropertyWatch{property, type, std::move(read), nullptr});
+    auto on_changed = [](sd_bus_message* m, void* userdata, sd_bus_error*) {
+        auto* w = static_cast<PropertyWatch*>(userdata);
+        const char* iface = nullptr;
+        if (sd_bus_message_read(m, "s", &iface) < 0 || sd_bus_message_enter_container(m, 'a', "{sv}") < 0)
+            return 0;
+        while (sd_bus_message_enter_container(m, 'e', "sv") > 0) {
+            const char* name = nullptr;
+            sd_bus_message_read(m, "s", &name);
+            if (w->property == name && sd_bus_message_enter_container(m, 'v', w->type.c_str()) > 0) {
+                w->read(m);
+                sd_bus_message_exit_container(m);
+            } else {
+                sd_bus_message_skip(m, "v");
+            }
+            sd_bus_message_exit_container(m);
+        }
+        return 0;
+    };
+    sd_bus_slot* slot = nullptr;
+    if (sd_bus_match_signal(client(), &slot, dbus::kBusName, path, "org.freedesktop.DBus.Properties",
+                            "PropertiesChanged", on_changed, watch.get()) < 0)
+        throw std::runtime_error(std::string("cannot watch ") + property);
+    watch->slot.reset(slot);
+    watches_.push_back(std::move(watch));
 }
 
 } // namespace caracara::test

@@ -74,7 +74,19 @@ public:
     // Each thruster was ordered its value of `values` on the fake wire (from event `from` on).
     bool each_ordered(const std::vector<int32_t>& values, long from = 0);
 
+    // Watches PropertiesChanged on `path` for the rig's life: `read` gets each announced value of
+    // `property`, the message inside its variant (of `type`), and reads it all.
+    void watch_property(const char* path, const char* property, const char* type,
+                        std::function<void(sd_bus_message*)> read);
+
 private:
+    struct PropertyWatch {
+        std::string property;
+        std::string type;
+        std::function<void(sd_bus_message*)> read;
+        dbus::SlotPtr slot;
+    };
+
     DaemonRig rig_;
     std::string dir_;
     Process dbus_daemon_;
@@ -82,6 +94,7 @@ private:
     dbus::BusPtr client_;
     std::unique_ptr<dbus::VehicleService> service_;
     std::unique_ptr<dbus::BusInputProbe> probe_;
+    std::vector<std::unique_ptr<PropertyWatch>> watches_;
 };
 
 } // namespace caracara::test
