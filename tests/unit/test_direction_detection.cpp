@@ -13,6 +13,7 @@
 #include "tests/unit/fakes/fake_teensy_io.hpp"
 #include "tests/unit/fakes/pool_vehicle.hpp"
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <string>

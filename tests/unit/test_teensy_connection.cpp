@@ -14,10 +14,12 @@
 #include "tests/unit/fakes/daemon_rig.hpp"
 #include "tests/unit/fakes/fake_teensy_io.hpp"
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace caracara;

@@ -2,6 +2,7 @@
 
 #include "core/clock.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <linux/spi/spidev.h>
 #include <span>
