@@ -180,11 +180,11 @@ def table(results):
               Suite("release (version)", "normal"),
               Suite("system Debian 12", "normal", systemable, need_root),
               Suite("kernel Debian 12", "normal", systemable, need_root),
-              Suite("Debian 13 build+ctest", "debian13", systemable, need_root),
-              Suite("system Debian 13", "debian13", systemable, need_root),
-              Suite("kernel Debian 13", "debian13", systemable, need_root),
-              Suite("bridge Debian 13", "debian13", left_out=LEFT_OUT["Debian 13"]),
-              Suite("cockpit Debian 13", "debian13", left_out=LEFT_OUT["Debian 13"]),
+              Suite("Debian 13 build+ctest", "normal", systemable, need_root),
+              Suite("system Debian 13", "normal", systemable, need_root),
+              Suite("kernel Debian 13", "normal", systemable, need_root),
+              Suite("bridge Debian 13", "normal", left_out=LEFT_OUT["Debian 13"]),
+              Suite("cockpit Debian 13", "normal", left_out=LEFT_OUT["Debian 13"]),
               Suite("ASan+UBSan", "sanitize"), Suite("arm64", "cross"),
               Suite("bridge arm64", "cross", left_out=LEFT_OUT["arm64"]),
               Suite("cockpit arm64", "cross", left_out=LEFT_OUT["arm64"]),
@@ -201,11 +201,8 @@ def table(results):
         if status == "skipped" and reason:
             suite.skip_reason = reason
 
-    # The normal step's tests and the Debian 13 step's one (run beside the others, from a tree
-    # of its own: scripts/test.sh).
     labels = read_labels(os.path.join(results, "normal.json"))
-    labels.update(read_labels(os.path.join(results, "debian13.json")))
-    for t in read_junit(os.path.join(results, "normal.xml")) + read_junit(os.path.join(results, "debian13.xml")):
+    for t in read_junit(os.path.join(results, "normal.xml")):
         name, status, secs, text = t
         ls = labels.get(name, [])
         if name == "system_debian13":
@@ -275,13 +272,12 @@ def table(results):
         sel, rc, _ = steps.get(step, (False, 0, 0))
         if sel and rc != 0 and not by[sname].tests:
             by[sname].status = ("FAILED (exit %d before its tests)" % rc, True)
-    # A step that failed before ctest (build, packages, configure) fails its suites.
-    for step in ("normal", "debian13"):
-        sel, rc, _ = steps.get(step, (False, 0, 0))
-        if sel and rc != 0 and not any(s.tests for s in suites if s.step == step):
-            for s in suites:
-                if s.step == step:
-                    s.status = ("FAILED (exit %d before its tests)" % rc, True)
+    # A step that failed before ctest (build, packages) fails its suites.
+    sel, rc, _ = steps.get("normal", (False, 0, 0))
+    if sel and rc != 0 and not any(s.tests for s in suites if s.step == "normal"):
+        for s in suites:
+            if s.step == "normal":
+                s.status = ("FAILED (exit %d before its tests)" % rc, True)
     sel, rc, _ = steps.get("arm64-packages", (False, 0, 0))
     if sel and rc != 0:
         by["arm64"].status = ("FAILED (arm64 packages: exit %d)" % rc, True)

@@ -49,13 +49,13 @@ ctest_run() {
   ctest --test-dir "$dir" --output-on-failure --output-junit "$results/$step.xml" \
     --test-output-size-passed 1048576 --test-output-size-failed 1048576 "$@"
 }
-# run_suite STEP DIR CTEST_JOBS EXCLUDE [cmake options...]: EXCLUDE is ctest's -E ('' for none).
+# run_suite STEP DIR CTEST_JOBS [cmake options...]
 run_suite() {
-  local step=$1 dir=$2 test_jobs=$3 exclude=$4; shift 4
+  local step=$1 dir=$2 test_jobs=$3; shift 3
   echo "== build $dir ($*)"
   "$top/scripts/build.sh" "$dir" -DCARACARA_WERROR=ON "$@" || return
-  echo "== test $dir (ctest -j$test_jobs${exclude:+ -E $exclude})"
-  ctest_run "$step" "$dir" -j"$test_jobs" --timeout 900 ${exclude:+-E "$exclude"}
+  echo "== test $dir (ctest -j$test_jobs)"
+  ctest_run "$step" "$dir" -j"$test_jobs" --timeout 900
 }
 # Each step's wall time, so that the 30-minute budget of CI can be read from its log.
 stamp() { echo "== $1 done at $((SECONDS / 60)) min $((SECONDS % 60)) s"; }
@@ -65,19 +65,12 @@ step() {
   local name=$1 selected=0 rc=0 t0=$SECONDS; shift
   case $which in all|"$name") selected=1 ;; esac
   [ "$name" = arm64-packages ] && case $which in all|cross) selected=1 ;; esac
-  [ "$name" = debian13 ] && case $which in all|normal) selected=1 ;; esac
   if [ "$selected" = 1 ]; then
     "$@" || rc=$?
     [ "$rc" -eq 0 ] || failed=1
     stamp "$name (exit $rc)"
   fi
   echo "$name $selected $rc $((SECONDS - t0))" >>"$results/steps.txt"
-}
-# The Debian 13 suite (CTest system_debian13, tests/system/debian13.sh) from a tree of its own
-# that is only configured: it builds this source in its Debian 13 root, not from the host's build.
-debian13_suite() {
-  cmake -S "$top" -B "$top/build-debian13" -DCARACARA_WERROR=ON >/dev/null || return
-  ctest_run debian13 "$top/build-debian13" -R '^system_debian13$' --timeout 2400
 }
 fuzz_suite() {
   echo "== build $top/build-fuzz (libFuzzer harnesses)"
@@ -98,33 +91,14 @@ sanitize_suite() {
   # At the cores, not twice: under ASan the bridge's and the cockpit's tests keep a core busy,
   # and beside three others they missed their waits (the 256 MB listing's first page, the
   # failsafe banner while surfacing; 2026-12-05).
-  run_suite sanitize "$top/build-asan" "$jobs" '' -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
+  run_suite sanitize "$top/build-asan" "$jobs" -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 }
 
-# The Debian 13 suite runs beside all the others, from the start: it is the longest (1,388 s in
-# the CI run of ab47031, 2026-12-05: its build, ctest, packages, container and VM), and most of
-# it waits on the vehicle's clock. Run inside the normal step's ctest, it left the host's tests
-# two slots and then ran alone for about 7 minutes after they had finished. Its output is
-# printed when it ends.
-debian13_log=$results/debian13.log
-( step debian13 debian13_suite ) >"$debian13_log" 2>&1 &
-debian13_pid=$!
-echo "== debian13 started beside the other steps (its output follows when it ends)"
-step normal run_suite normal "$top/build" "$CARACARA_TEST_JOBS" '^system_debian13$'
+step normal run_suite normal "$top/build" "$CARACARA_TEST_JOBS"
 step cross cross_suite
 step arm64-packages arm64_packages
 step sanitize sanitize_suite
 step fuzz fuzz_suite
-wait "$debian13_pid" || failed=1
-echo "== debian13 (run beside the steps above)"
-cat "$debian13_log"
-# Its step line, written by the background job; none means it did not finish.
-if grep -q '^debian13 1 ' "$results/steps.txt"; then
-  grep -q '^debian13 1 0 ' "$results/steps.txt" || failed=1
-elif [ "$which" = all ] || [ "$which" = normal ]; then
-  echo "== debian13: no step line (the background job did not finish)"
-  failed=1
-fi
 # The figures the normal step's tests printed, as the record the docs quote (bench/figures.json;
 # scripts/doc_figures.py --write then rewrites README.md and docs/ from it, CTest doc_figures
 # checks them). Written after the last step: the later steps' own doc_figures check judges the

@@ -35,8 +35,8 @@ suite=trixie
 arch=$(dpkg --print-architecture)
 cache_dir=${CARACARA_SYSTEST_CACHE:-/var/cache/caracara-systest}
 # A guard against a hang, not a goal: on a fresh machine the root's three compiles (build,
-# packages, kernel coverage) share the 2 cores with every other step's (scripts/test.sh starts
-# this suite beside them). A run from a clone at a new path (a new build tree here, 30% ccache
+# packages, kernel coverage) share the 2 cores with the host's tests and, on a fresh machine,
+# with nothing cached. A run from a clone at a new path (a new build tree here, 30% ccache
 # hits) with other compiles beside it was stopped at 1,500 s, 73% into the build (2026-12-05).
 build_timeout_s=${CARACARA_DEBIAN13_BUILD_TIMEOUT:-2400}
 # Build and test dependencies (scripts/deps.sh's, by their Debian 13 names), scripts/package.sh's
