@@ -103,6 +103,13 @@ TEST_CASE("ColdLibraries: around mlockall the cold libraries stay unlocked but l
     bool libm = false;
     const std::size_t libm_locked = locked_kib(maps, "libm.so", &libm);
     REQUIRE(libm);
+    if (locked != 0 && error == EPERM) {
+        // Locking refused outright (systemd-nspawn's seccomp filter denies mlock too, as in
+        // the Debian 13 root of tests/system/debian13.sh): nothing is locked, lround's pages
+        // neither; what is left to see is the access given back (above).
+        CHECK(libm_locked == 0);
+        return;
+    }
     CHECK(libm_locked > 0);             // lround()'s page(s), locked again
     CHECK(libm_locked <= 2 * page_kib); // and nothing more of libm
     if (locked != 0) {
