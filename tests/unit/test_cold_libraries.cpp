@@ -47,11 +47,13 @@ std::vector<Mapping> mappings() {
 
 std::string file_name(const std::string& path) { return path.substr(path.rfind('/') + 1); }
 
-// KiB locked of the mappings of the library whose file name starts with `stem`.
+// KiB locked of the code of the library whose file name starts with `stem`: its executable
+// mappings. Its data (the writable segment, the relocated read-only one) is written memory that
+// mlockall keeps locked, as it must.
 std::size_t locked_kib(const std::vector<Mapping>& maps, const std::string& stem, bool* mapped = nullptr) {
     std::size_t kib = 0;
     for (const Mapping& m : maps)
-        if (file_name(m.path).rfind(stem, 0) == 0) {
+        if (file_name(m.path).rfind(stem, 0) == 0 && m.perms[2] == 'x') {
             kib += m.locked_kib;
             if (mapped)
                 *mapped = true;
