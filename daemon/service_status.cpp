@@ -1,5 +1,7 @@
 #include "daemon/service_status.hpp"
 
+#include "core/clock.hpp"
+
 #include <systemd/sd-daemon.h>
 
 namespace caracara {
@@ -26,7 +28,11 @@ void ServiceStatus::start_watchdog() {
     uint64_t wd_usec = 0;
     if (sd_watchdog_enabled(0, &wd_usec) <= 0)
         return;
-    interval_us_ = wd_usec / 2;
+    // Four times a period, not the usual two: at half the period one unhealthy look (a loop
+    // late by just over its second of grace) withheld a ping, and the next one, due exactly at
+    // the deadline, lost the race to systemd's check under load. At a quarter, only a loop that
+    // stays unhealthy for three looks in a row (no cycle for 3.5 s or more) is restarted.
+    interval_us_ = wd_usec / 4;
     uint64_t now_us = 0;
     sd_event_now(event_, CLOCK_MONOTONIC, &now_us);
     sd_event_source* s = nullptr;
@@ -39,7 +45,10 @@ void ServiceStatus::start_watchdog() {
 int ServiceStatus::on_watchdog(sd_event_source* s, uint64_t usec, void* userdata) {
     auto* self = static_cast<ServiceStatus*>(userdata);
     // Only a control loop that keeps completing cycles keeps systemd from restarting us.
-    if (self->loop_.healthy(usec * 1000))
+    // Judged now, not at `usec`: sd-event hands the time this source was due, and a cycle that
+    // ended after it while the dispatch was late made the loop look 584 years stale
+    // (caracarad restarted by its watchdog with the loop running, CI run of 86172d3).
+    if (self->loop_.healthy(monotonic_ns()))
         sd_notify(0, "WATCHDOG=1");
     sd_event_source_set_time(s, usec + self->interval_us_);
     return 0;

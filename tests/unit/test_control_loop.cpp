@@ -133,3 +133,16 @@ TEST_CASE("the loop counts its cycles and is healthy while they complete") {
     CHECK(rig.loop().cycles() >= before + 5);
     CHECK(rig.loop().healthy(monotonic_ns()));
 }
+
+TEST_CASE("a time taken before the last cycle ended is a healthy loop, not a stale one") {
+    // The watchdog's look, late in a loaded event loop, once judged with the time its timer was
+    // due: a cycle that ended since then wrapped the age round (unsigned) and systemd was not fed.
+    DaemonRig rig("loop_rate_hz = 100\n");
+    const uint64_t before = monotonic_ns();
+    rig.run_until_ready();
+    const uint64_t cycles = rig.loop().cycles();
+    REQUIRE(rig.run_until([&] { return rig.loop().cycles() > cycles + 2; }));
+    CHECK(rig.loop().healthy(before));
+    CHECK(rig.loop().healthy(monotonic_ns()));
+    CHECK_FALSE(rig.loop().healthy(monotonic_ns() + 2'000'000'000ull)); // a loop 2 s without a cycle
+}
