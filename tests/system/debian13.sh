@@ -211,6 +211,14 @@ grep -m 60 -E '^== |^   [A-Za-z]|^package: |tests passed|tests failed|Total Test
 build_s=$(($(date +%s) - t1))
 say "build, ctest and packages: $build_s s (exit status $rc)"
 if [ "$rc" -ne 0 ]; then
+  # Each failed test's own output (ctest --output-on-failure prints it after its "***Failed"
+  # line), which the tail below has mostly scrolled past: e2e_caracaractl failed in CI's run of
+  # d8da134 and what it said was lost.
+  echo "---- the failed tests' output ----"
+  sed 's/\x1b\[[0-9;]*m//g' "$work/build.log" | awk '
+    /\*\*\*(Failed|Timeout|Exception)/ { show = 1; n = 0 }
+    show && n > 0 && /^ *(Start +[0-9]+:|[0-9]+\/[0-9]+ Test +#)/ { show = 0 }
+    show && n++ < 300' || true
   echo "---- build and test log (last 150 lines) ----"
   tail -n 150 "$work/build.log"
   die "the build, ctest or the package build failed in the Debian 13 root"
