@@ -2,8 +2,6 @@
 # The arm64 cross build and its tests, on this amd64 machine:
 #   scripts/cross_test.sh [BUILD_DIR]        (default build-arm64/ in the repository)
 #
-# CARACARA_CROSS_STAGE=deps stops after the packages, =build after the build (scripts/test.sh
-# builds the tree early, at idle priority, while the normal step's tests run).
 # Installs what it lacks (dpkg --add-architecture arm64, crossbuild-essential-arm64,
 # qemu-user-static, the :arm64 -dev packages), configures with cmake/aarch64-linux-gnu.cmake
 # (warnings as errors), builds, and runs ctest: the unit and integration test programs, the
@@ -34,15 +32,11 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-stage=${CARACARA_CROSS_STAGE:-all}
-[ "$stage" != deps ] || exit 0
-
 echo "== cross build $dir (arm64)"
 t0=$(date +%s)
 "$top/scripts/build.sh" "$dir" -DCMAKE_TOOLCHAIN_FILE="$top/cmake/aarch64-linux-gnu.cmake" -DCARACARA_WERROR=ON
 readelf -h "$dir/daemon/caracarad" | grep -q 'Machine: *AArch64' || { echo "cross: $dir/daemon/caracarad is not an arm64 program" >&2; exit 1; }
 echo "cross: built in $(($(date +%s) - t0)) s"
-[ "$stage" != build ] || exit 0
 echo "== test $dir (arm64 under qemu-aarch64-static)"
 # scripts/test.sh's table reads the results from CARACARA_CTEST_JUNIT when it is set.
 junit=()

@@ -94,38 +94,7 @@ sanitize_suite() {
   run_suite sanitize "$top/build-asan" "$jobs" -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
 }
 
-# The later steps' trees (arm64, ASan, fuzz) are compiled while the normal step's tests run, at
-# idle priority (SCHED_IDLE, ionice idle): they take only the CPU the tests leave, which is most
-# of it once the host's tests are done and the Debian 13 suite runs on alone (its tests wait more
-# than they compute). A timing-bound test preempts them at once. Their steps build again after,
-# finding the trees up to date (or showing the error if this build failed: its log is kept).
-# Only in a whole run; the cross packages are installed first, in the foreground (apt's lock).
-early_builds() {
-  CARACARA_CROSS_STAGE=build "$top/scripts/cross_test.sh" "$top/build-arm64" &&
-    "$top/scripts/build.sh" "$top/build-asan" -DCARACARA_WERROR=ON -DCARACARA_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug &&
-    CARACARA_FUZZ_BUILD="$top/build-fuzz" "$top/scripts/fuzz.sh" build
-}
-early_pid=
-if [ "$which" = all ]; then
-  CARACARA_CROSS_STAGE=deps "$top/scripts/cross_test.sh" "$top/build-arm64"
-  (
-    # Idle priority for this subshell, inherited by every compile it starts.
-    chrt -i -p 0 "$BASHPID" >/dev/null 2>&1 || true
-    renice -n 19 -p "$BASHPID" >/dev/null 2>&1 || true
-    ionice -c 3 -p "$BASHPID" >/dev/null 2>&1 || true
-    t0=$SECONDS
-    early_builds >"$results/early-builds.log" 2>&1 && rc=0 || rc=$?
-    echo "== early builds (arm64, ASan, fuzz; $(chrt -p "$BASHPID" | sed -n 's/.*policy: //p')) done after $((SECONDS - t0)) s, exit $rc"
-  ) &
-  early_pid=$!
-fi
-
 step normal run_suite normal "$top/build" "$CARACARA_TEST_JOBS"
-if [ -n "$early_pid" ]; then
-  t0=$SECONDS
-  wait "$early_pid" || true
-  echo "== waited $((SECONDS - t0)) s for the early builds after the normal step"
-fi
 step cross cross_suite
 step arm64-packages arm64_packages
 step sanitize sanitize_suite
