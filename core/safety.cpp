@@ -1,12 +1,8 @@
 #include "core/safety.hpp"
 
-namespace caracara {
+#include "core/clock.hpp"
 
-namespace {
-// A monotonic clock never goes back, but a caller's stale timestamp must not wrap around
-// into a huge elapsed time (which would end arming or expire the watchdog early).
-uint64_t elapsed(uint64_t since, uint64_t now) { return now > since ? now - since : 0; }
-} // namespace
+namespace caracara {
 
 SafetyMachine::SafetyMachine(SafetyConfig config, bool kill_switch_set, uint64_t now)
     : config_(config), switch_set_(kill_switch_set), arming_started_(now) {

@@ -133,9 +133,8 @@ bool ControlLoop::healthy(uint64_t now_ns) const {
     const uint64_t period = settings_.loop_rate_hz ? 1'000'000'000ull / settings_.loop_rate_hz : 0;
     const uint64_t allowed = std::max<uint64_t>(1'000'000'000ull, 5 * period);
     // A bus under recovery is not an unhealthy loop: restarting the daemon would not help it.
-    // A cycle that ended after `now_ns` (a time taken before it) is a healthy loop, not an
-    // unsigned wrap to 584 years.
-    return started_ && (now_ns <= last_cycle_ns_ || now_ns - last_cycle_ns_ <= allowed);
+    // A cycle that ended after `now_ns` (a time taken before it) is a healthy loop.
+    return started_ && elapsed(last_cycle_ns_, now_ns) <= allowed;
 }
 
 void ControlLoop::publish_telemetry_if_due(uint64_t now_ns) {

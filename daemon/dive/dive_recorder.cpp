@@ -44,7 +44,7 @@ void DiveRecorder::stop() {
 }
 
 uint32_t DiveRecorder::since_start(uint64_t now_ns) const {
-    const uint64_t t = now_ns > start_ns_ ? (now_ns - start_ns_) / kNsPer100us : 0;
+    const uint64_t t = elapsed(start_ns_, now_ns) / kNsPer100us;
     return static_cast<uint32_t>(std::min<uint64_t>(t, UINT32_MAX));
 }
 

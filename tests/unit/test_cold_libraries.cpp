@@ -36,9 +36,8 @@ std::vector<Mapping> mappings() {
         std::istringstream in(line);
         std::string range, perms, offset, dev, inode, path;
         in >> range >> perms;
-        if (range.find('-') != std::string::npos && range.back() != ':' && perms.size() == 4) {
+        if (const std::size_t dash = range.find('-'); dash != std::string::npos && range.back() != ':' && perms.size() == 4) {
             in >> offset >> dev >> inode >> path;
-            const std::size_t dash = range.find('-');
             const std::size_t bytes = std::stoul(range.substr(dash + 1), nullptr, 16) - std::stoul(range.substr(0, dash), nullptr, 16);
             out.push_back({path, perms, bytes / 1024, false});
         } else if (!out.empty() && range == "VmFlags:") {

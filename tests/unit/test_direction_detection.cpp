@@ -24,8 +24,9 @@ using namespace caracara::test;
 
 namespace {
 
-// The shortest settle and pulse [commissioning] allows, so that eight thrusters take seconds (the
-// settle's timeout left at its default: a late loop, under an emulator, still settles).
+// The shortest pulse [commissioning] allows, and with DetectionRig's default the shortest settle
+// window, so that eight thrusters take seconds (the settle's timeout left at its default: a late
+// loop, under an emulator, still settles).
 const std::string kSections = "[commissioning]\ndetect_pulse_ms = 300\n";
 // At 100 Hz each orientation axis is read every 40 ms (one frame a cycle, four slots). The
 // command timeout far: the zeros on the wire are the detection's own, not the timeout's.
