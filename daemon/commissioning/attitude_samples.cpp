@@ -15,6 +15,11 @@ double wrap(double a) {
 
 } // namespace
 
+void AttitudeSamples::add(uint64_t t_ns, const Attitude& attitude) {
+    if (samples_.empty() || t_ns > samples_.back().t_ns)
+        samples_.push_back({t_ns, attitude});
+}
+
 void AttitudeSamples::keep_window(uint64_t window_ns, uint64_t now) {
     std::erase_if(samples_, [&](const Sample& s) { return s.t_ns + window_ns < now; });
 }
@@ -24,14 +29,17 @@ bool AttitudeSamples::still(uint64_t now, uint64_t half_ns, double max_rad) cons
     // or one sample, whose mean is trivially the whole window's.
     if (samples_.empty() || samples_.front().t_ns + half_ns > now)
         return false;
-    const Attitude moved = change(mean_from(0), mean_from(now - half_ns));
+    const std::optional<Attitude> last_half = mean_from(now - half_ns);
+    if (!last_half)
+        return false;
+    const Attitude moved = change(*mean_from(0), *last_half);
     double worst = 0.0;
     for (const double m : moved)
         worst = std::max(worst, std::abs(m));
     return worst <= max_rad;
 }
 
-AttitudeSamples::Attitude AttitudeSamples::mean_from(uint64_t from_ns) const {
+std::optional<AttitudeSamples::Attitude> AttitudeSamples::mean_from(uint64_t from_ns) const {
     Attitude sum{};
     std::size_t n = 0;
     double ref = 0.0;
@@ -46,8 +54,8 @@ AttitudeSamples::Attitude AttitudeSamples::mean_from(uint64_t from_ns) const {
         ++n;
     }
     if (n == 0)
-        return {};
-    return {wrap(ref + sum[0] / double(n)), sum[1] / double(n), sum[2] / double(n)};
+        return std::nullopt;
+    return Attitude{wrap(ref + sum[0] / double(n)), sum[1] / double(n), sum[2] / double(n)};
 }
 
 AttitudeSamples::Attitude AttitudeSamples::change(const Attitude& before, const Attitude& after) {

@@ -103,8 +103,9 @@ void DirectionDetection::step() {
         return;
     }
     const uint64_t now = monotonic_ns();
-    const auto& o = teensy_.telemetry().orientation;
-    samples_.add(now, {o[0], o[1], o[2]});
+    // Each reading once, at its read time: a stalled poll's last value repeated would look still.
+    if (const TeensyTelemetry& tm = teensy_.telemetry(); tm.orientation_polled_ns != 0)
+        samples_.add(tm.orientation_polled_ns, {tm.orientation[0], tm.orientation[1], tm.orientation[2]});
     if (phase_ == Phase::Settle)
         settle_step(now);
     else
@@ -130,7 +131,7 @@ void DirectionDetection::settle_step(uint64_t now) {
     if (now - phase_start_ns_ >= 3 * window && samples_.still(now, window / 2, c.detect_settle_mrad / 1000.0)) {
         // The whole window's mean: the sensor's noise averaged over every sample. A slow drift
         // is left in (0.5 mrad/s moves ~1 mrad by the measurement, a tenth of the threshold).
-        baseline_ = samples_.mean_from(0);
+        baseline_ = *samples_.mean_from(0); // still: there are samples
         samples_.clear();
         phase_ = Phase::Pulse;
         phase_start_ns_ = now;
@@ -157,7 +158,12 @@ void DirectionDetection::pulse_step(uint64_t now) {
         return;
     }
     const auto after = samples_.mean_from(phase_start_ns_ + uint64_t(double(length) * kMeasureFrom));
-    findings_.record(motor_, AttitudeSamples::change(baseline_, after));
+    if (!after) {
+        end({Status::LinkError, "the Teensy gave no orientation reading over the end of thruster " +
+                                    std::to_string(motor_) + "'s pulse"});
+        return;
+    }
+    findings_.record(motor_, AttitudeSamples::change(baseline_, *after));
     samples_.clear();
     if (++motor_ >= kMotorCount) {
         end({});

@@ -1,13 +1,12 @@
 // Thruster direction detection (docs/commissioning.md; ArduSub's motor detection on our
-// mixing): armed, in the water, still; for each thruster in turn it waits until the vehicle
-// holds still (after a rest, the Teensy's orientation moved at most detect_settle_mrad between
-// the halves of detect_settle_ms), takes
-// that attitude, pulses the thruster alone (detect_pulse_value for detect_pulse_ms, through
-// MotorCommands::drive like any motor command: budget, state, commanding client, the wire), takes the
-// attitude over the end of the pulse, orders it zero, and has core/direction_judgement say ok,
-// reversed or inconclusive. It never changes the configuration: the caller gets the fragment.
-// A kill, the caller leaving or another pilot commanding, a failsafe, or a vehicle that will not
-// settle ends it with the error (the kill's zeros are the kill's own, at once).
+// mixing): armed, in the water; for each thruster in turn it waits until the vehicle holds
+// still (after a rest, the Teensy's readings over detect_settle_ms: AttitudeSamples), takes that
+// attitude, pulses the thruster alone (detect_pulse_value for detect_pulse_ms, through
+// MotorCommands::drive like any motor command), takes the attitude over the end of the pulse,
+// orders it zero, and has core/direction_judgement say ok, reversed or inconclusive. It never
+// changes the configuration: the caller gets the fragment. A kill, the caller leaving or another
+// pilot commanding, a failsafe, a vehicle that will not settle or a Teensy that gives no reading
+// ends it with the error (the kill's zeros are the kill's own, at once).
 #pragma once
 
 #include "core/config.hpp"

@@ -38,9 +38,12 @@ void TeensyPoll::answered() {
     if (frame_.ok) {
         if (frame_.slot >= 3) {
             tm_.distances[frame_.sensor] = static_cast<uint16_t>(frame_.value);
-        } else if (tm_.orientation[frame_.slot] != frame_.value) {
-            tm_.orientation[frame_.slot] = frame_.value;
-            tm_.orientation_read_ns = frame_.read_ns;
+        } else {
+            tm_.orientation_polled_ns = frame_.read_ns;
+            if (tm_.orientation[frame_.slot] != frame_.value) {
+                tm_.orientation[frame_.slot] = frame_.value;
+                tm_.orientation_read_ns = frame_.read_ns;
+            }
         }
     }
     done_(frame_.ok ? Outcome::Answered : frame_.err == ENODEV ? Outcome::Gone : Outcome::Failed);

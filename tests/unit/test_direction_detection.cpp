@@ -5,7 +5,8 @@
 // thruster pulsed alone, in turn, at detect_pulse_value and ordered zero after; the mounting it
 // found; refused by name while one runs, killed or without a Teensy; ended by a kill (the pulse
 // zeroed at once), by another client's command, by a vehicle that will not hold still, by the
-// Teensy falling silent.
+// Teensy falling silent; a stalled poll (the Teensy's frame held on the wire) is no reading: not
+// taken for a vehicle holding still, nor measured as a pulse's end.
 #include "daemon/commissioning/direction_detection.hpp"
 
 #include "tests/catch.hpp"
@@ -59,6 +60,16 @@ struct DetectionRig {
     FakeTeensyIo teensy{SpiSettings{}.device};
     DaemonRig rig;
     PoolVehicle pool;
+};
+
+// The Teensy's frames held on the wire for the scope (a stalled poll), released however the
+// test leaves it: a frame still held would keep the rig's Teensy worker from stopping.
+struct StalledPoll {
+    explicit StalledPoll(FakeTeensyIo& t) : teensy(t) { teensy.hold(true); }
+    ~StalledPoll() { teensy.hold(false); }
+    StalledPoll(const StalledPoll&) = delete;
+    StalledPoll& operator=(const StalledPoll&) = delete;
+    FakeTeensyIo& teensy;
 };
 
 std::vector<DirectionVerdict> verdicts(const DirectionDetection& d) {
@@ -236,18 +247,48 @@ TEST_CASE("DirectionDetection: a vehicle that will not hold still ends it NotSti
     CHECK(d.detection().judged() == 0);
 }
 
-TEST_CASE("DirectionDetection: the Teensy falling silent ends it LinkError, its own zeros on the wire") {
-    // Its first unanswered frame takes it offline; teensy-link-lost (a kill, whose zeros would
-    // hide the detection's) only after spi.silence_ms, here far beyond the test.
+TEST_CASE("DirectionDetection: a stalled Teensy poll is no reading: a turning vehicle is not taken as still") {
+    // The Teensy's frame held on the wire (a hung Teensy; teensy-link-lost only after
+    // spi.silence_ms, here far beyond the test): its last reading stays in the telemetry and no
+    // new one comes. Taken at each step as a sample, that value repeated made the turning vehicle
+    // still and thruster 0 was pulsed (checked on the step-sampling code).
+    DetectionRig d("detect_settle_timeout_ms = 1000\n", "silence_ms = 60000\n", 300);
+    d.pool.turning = true;
+    // Stalled once the Teensy has read the turning vehicle's yaw.
+    const uint64_t read_before = d.rig.daemon().teensy().telemetry().orientation_read_ns;
+    REQUIRE(d.rig.run_until([&] { return d.rig.daemon().teensy().telemetry().orientation_read_ns != read_before; }));
+    d.rig.wire().clear();
+    const Result r = [&] {
+        StalledPoll stalled(d.teensy);
+        return d.run();
+    }();
+    CHECK(r.status == Status::NotStill);
+    CHECK(find(d.rig.wire().events(), nonzero_order) < 0);
+    CHECK(d.detection().judged() == 0);
+}
+
+TEST_CASE("DirectionDetection: the Teensy falling silent or its poll stalling in a pulse ends it LinkError, its own zeros on the wire") {
+    // teensy-link-lost (a kill, whose zeros would hide the detection's) only after
+    // spi.silence_ms, here far beyond the test.
     DetectionRig d("", "silence_ms = 60000\n");
     DirectionDetection& det = d.detection();
     std::optional<Result> end;
     det.run(":1.7", [&](const Result& r) { end = r; });
     REQUIRE(d.rig.run_until([&] { return det.pulsing() == 0; }, kRunGiveUpMs));
-    d.teensy.model([](sim::TeensyModel& m) { m.faults().inject_no_answer(1u << 30); });
-    REQUIRE(d.rig.run_until([&] { return end.has_value(); }));
+    std::string message;
+    SECTION("falling silent: its first unanswered frame takes it offline") {
+        d.teensy.model([](sim::TeensyModel& m) { m.faults().inject_no_answer(1u << 30); });
+        REQUIRE(d.rig.run_until([&] { return end.has_value(); }));
+        message = "the Teensy went offline";
+    }
+    SECTION("a stalled poll (its frame held on the wire): no reading over the pulse's end to measure") {
+        StalledPoll stalled(d.teensy);
+        REQUIRE(d.rig.run_until([&] { return end.has_value(); }));
+        message = "the Teensy gave no orientation reading over the end of thruster 0's pulse";
+    }
     CHECK(end->status == Status::LinkError);
-    CHECK(end->message == "the Teensy went offline");
+    CHECK(end->message == message);
+    CHECK(det.judged() == 0);
     REQUIRE(d.rig.run_until([&] { return all_zero(d.rig.wire().events()); }));
     CHECK(d.rig.vehicle().readings().may_drive()); // not the kill's zeros
     CHECK(d.rig.vehicle().readings().requested_values() == MotorValues{});
