@@ -29,6 +29,11 @@ TEST_CASE("a page load with the key in its query is redirected without it, setti
     CHECK(a.find("\r\nLocation: /index.html?a=1&b=2\r\n") != std::string::npos);
     CHECK(a.find("\r\nSet-Cookie: caracara_key_8765=0123456789abcdef; Path=/; HttpOnly; SameSite=Strict\r\n") !=
           std::string::npos);
+    // The key written again in another item (bare, or as another name's value) goes too: the
+    // Location stays in the browser's history.
+    j = key.judge(head("/?1&&key=0123456789abcdef&0123456789abcdef&x=0123456789abcdef&b=2"));
+    CHECK(j.verdict == V::Redirect);
+    CHECK(j.location == "/?1&b=2");
 }
 
 TEST_CASE("a WebSocket upgrade with the key in its query, or any request with the cookie, is relayed", "[bridge]") {

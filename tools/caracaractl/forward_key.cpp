@@ -125,9 +125,11 @@ ForwardKey::Judgement ForwardKey::judge(std::string_view head) const {
             j.verdict = Verdict::Relay;
         } else {
             // The same address without the key: it leaves the address bar and the page's own URL.
+            // Nor any other item holding it ("?key=K&K"): the Location stays in the browser's
+            // history (fuzz_bridge_http found it).
             std::string rest;
             each(query, '&', [&](std::string_view item) {
-                if (!item.empty() && !item_value(item, kKeyParam))
+                if (!item.empty() && !item_value(item, kKeyParam) && item.find(key_) == std::string_view::npos)
                     rest += (rest.empty() ? "" : "&") + std::string(item);
             });
             j.verdict = Verdict::Redirect;
