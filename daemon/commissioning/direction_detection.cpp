@@ -105,7 +105,7 @@ void DirectionDetection::step() {
     const uint64_t now = monotonic_ns();
     // Each reading once, at its read time: a stalled poll's last value repeated would look still.
     if (const TeensyTelemetry& tm = teensy_.telemetry(); tm.orientation_polled_ns != 0)
-        samples_.add(tm.orientation_polled_ns, {tm.orientation[0], tm.orientation[1], tm.orientation[2]});
+        samples_.add(tm.orientation_polled_ns, tm.orientation);
     if (phase_ == Phase::Settle)
         settle_step(now);
     else
